@@ -1,0 +1,5 @@
+//! The `pmvc` command line.
+
+pub fn main() -> std::process::ExitCode {
+    std::process::ExitCode::SUCCESS
+}

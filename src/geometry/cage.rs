@@ -1,0 +1,246 @@
+//! Cage validation: a cage must be a closed, edge-manifold, consistently oriented
+//! triangle mesh with no degenerate triangle. Inward-facing cages are flipped.
+
+use super::{CageError, TriMesh};
+use glam::DVec3;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// A validated cage: closed, edge-manifold, outward-facing triangles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cage {
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, the face of the file it came from.
+    pub triangle_faces: Vec<u32>,
+}
+
+impl Cage {
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Corner positions of triangle `t`.
+    pub fn triangle(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// Length of the bounding-box diagonal: the cage's size for relative tolerances.
+    pub fn diagonal(&self) -> f64 {
+        let (lo, hi) = super::bounds_of(&self.positions);
+        (hi - lo).length()
+    }
+
+    /// Enclosed volume; positive for an outward-facing cage.
+    pub fn signed_volume(&self) -> f64 {
+        signed_volume(&self.positions, &self.triangles)
+    }
+
+    /// The same cage with other vertex positions (a pose), keeping its topology.
+    pub fn with_positions(&self, positions: Vec<DVec3>) -> Cage {
+        assert_eq!(positions.len(), self.positions.len());
+        Cage {
+            positions,
+            ..self.clone()
+        }
+    }
+}
+
+/// What validation noticed without rejecting the cage.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CageReport {
+    /// All faces pointed inward and were reversed.
+    pub flipped: bool,
+    /// Vertices no face uses. They get zero weight everywhere.
+    pub unreferenced: Vec<u32>,
+    /// Enclosed volume after any flip (positive).
+    pub volume: f64,
+}
+
+impl CageReport {
+    /// Human-readable notices and warnings, one per line.
+    pub fn messages(&self) -> Vec<String> {
+        let mut messages = Vec::new();
+        if self.flipped {
+            messages.push(
+                "notice: the cage's faces pointed inward; they were flipped to face outward"
+                    .to_owned(),
+            );
+        }
+        if !self.unreferenced.is_empty() {
+            let shown: Vec<String> = self
+                .unreferenced
+                .iter()
+                .take(8)
+                .map(u32::to_string)
+                .collect();
+            let more = if self.unreferenced.len() > 8 {
+                ", …"
+            } else {
+                ""
+            };
+            messages.push(format!(
+                "warning: {} cage vertices are used by no face and get zero weight: {}{more}",
+                self.unreferenced.len(),
+                shown.join(", ")
+            ));
+        }
+        messages
+    }
+}
+
+fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            a.dot(b.cross(c))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
+/// Check that `mesh` is a usable cage and return it outward-facing.
+pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
+    let path_buf = || path.to_owned();
+    let count = mesh.positions.len();
+    if count < 4 {
+        return Err(CageError::TooFewVertices {
+            path: path_buf(),
+            count,
+        });
+    }
+    if let Some(vertex) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(CageError::NonFinite {
+            path: path_buf(),
+            vertex,
+        });
+    }
+    if mesh.triangles.is_empty() {
+        return Err(CageError::NoFaces { path: path_buf() });
+    }
+    let face_of = |t: usize| mesh.triangle_faces.get(t).map_or(t, |&f| f as usize);
+    for (t, triangle) in mesh.triangles.iter().enumerate() {
+        if let Some(&index) = triangle.iter().find(|&&i| i as usize >= count) {
+            return Err(CageError::IndexOutOfRange {
+                path: path_buf(),
+                face: face_of(t),
+                index,
+                count,
+            });
+        }
+    }
+
+    let diagonal = {
+        let (lo, hi) = mesh.bounds();
+        (hi - lo).length()
+    };
+    for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+        let [pa, pb, pc] = [a, b, c].map(|i| mesh.positions[i as usize]);
+        let doubled_area = (pb - pa).cross(pc - pa).length();
+        if a == b || b == c || a == c || doubled_area <= 1e-12 * diagonal * diagonal {
+            return Err(CageError::DegenerateTriangle {
+                path: path_buf(),
+                face: face_of(t),
+                a,
+                b,
+                c,
+            });
+        }
+    }
+
+    // Each undirected edge must be used by exactly two triangles, once in each direction.
+    let mut edges: HashMap<(u32, u32), Vec<(usize, bool)>> =
+        HashMap::with_capacity(mesh.triangles.len() * 2);
+    for (t, triangle) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (from, to) = (triangle[k], triangle[(k + 1) % 3]);
+            edges
+                .entry((from.min(to), from.max(to)))
+                .or_default()
+                .push((t, from < to));
+        }
+    }
+    let mut sorted_edges: Vec<_> = edges.into_iter().collect();
+    sorted_edges.sort_unstable_by_key(|(edge, uses)| (uses.iter().map(|u| u.0).min(), *edge));
+    for ((a, b), uses) in &sorted_edges {
+        match uses.as_slice() {
+            [(t, _)] => {
+                return Err(CageError::OpenEdge {
+                    path: path_buf(),
+                    a: *a,
+                    b: *b,
+                    face: face_of(*t),
+                })
+            }
+            [(first, first_forward), (second, second_forward)] => {
+                if first_forward == second_forward {
+                    let (from, to) = if *first_forward { (*a, *b) } else { (*b, *a) };
+                    return Err(CageError::InconsistentOrientation {
+                        path: path_buf(),
+                        a: from,
+                        b: to,
+                        first: face_of(*first),
+                        second: face_of(*second),
+                    });
+                }
+            }
+            _ => {
+                let mut faces: Vec<usize> = uses.iter().map(|(t, _)| face_of(*t)).collect();
+                faces.dedup();
+                return Err(CageError::NonManifoldEdge {
+                    path: path_buf(),
+                    a: *a,
+                    b: *b,
+                    count: uses.len(),
+                    faces: faces
+                        .iter()
+                        .map(usize::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                });
+            }
+        }
+    }
+
+    let mut triangles = mesh.triangles;
+    let mut volume = signed_volume(&mesh.positions, &triangles);
+    if volume.abs() <= 1e-12 * diagonal.powi(3) {
+        return Err(CageError::ZeroVolume { path: path_buf() });
+    }
+    let flipped = volume < 0.0;
+    if flipped {
+        // Reversing the corner order makes a reversed copy of an outward cage identical to it.
+        for triangle in &mut triangles {
+            triangle.reverse();
+        }
+        volume = -volume;
+    }
+
+    let mut referenced = vec![false; count];
+    for triangle in &triangles {
+        for &i in triangle {
+            referenced[i as usize] = true;
+        }
+    }
+    let unreferenced = (0..count as u32)
+        .filter(|&i| !referenced[i as usize])
+        .collect();
+    let triangle_faces = if mesh.triangle_faces.len() == triangles.len() {
+        mesh.triangle_faces
+    } else {
+        (0..triangles.len() as u32).collect()
+    };
+    Ok((
+        Cage {
+            positions: mesh.positions,
+            triangles,
+            triangle_faces,
+        },
+        CageReport {
+            flipped,
+            unreferenced,
+            volume,
+        },
+    ))
+}

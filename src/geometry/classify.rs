@@ -1,0 +1,118 @@
+//! Where mesh vertices lie relative to the cage: inside, outside, or on its surface.
+//!
+//! Inside/outside is decided by the generalized winding number (the solid angle the
+//! cage subtends, over 4π), which stays correct for points near the surface and for
+//! cages with small defects, where ray-parity tests flip.
+
+use super::Cage;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Points closer than this fraction of the cage diagonal count as on the surface.
+pub const SURFACE_TOLERANCE: f64 = 1e-9;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PointClass {
+    Inside,
+    Outside,
+    /// On triangle `triangle`, at these barycentric coordinates of its corners.
+    OnSurface {
+        triangle: u32,
+        barycentric: DVec3,
+    },
+}
+
+/// The classes of a point set, with the outside ones listed for reporting.
+#[derive(Clone, Debug, Default)]
+pub struct PointClasses {
+    pub classes: Vec<PointClass>,
+    /// Indices of the points outside the cage, ascending.
+    pub outside: Vec<u32>,
+}
+
+/// Classify every point against the cage (in parallel).
+pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
+    let tolerance = SURFACE_TOLERANCE * cage.diagonal();
+    let classes: Vec<PointClass> = points
+        .par_iter()
+        .map(|&x| classify_point(cage, x, tolerance))
+        .collect();
+    let outside = classes
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| matches!(c, PointClass::Outside))
+        .map(|(i, _)| i as u32)
+        .collect();
+    PointClasses { classes, outside }
+}
+
+fn classify_point(cage: &Cage, x: DVec3, tolerance: f64) -> PointClass {
+    let tolerance_squared = tolerance * tolerance;
+    for t in 0..cage.triangles.len() {
+        let [a, b, c] = cage.triangle(t);
+        let (closest, barycentric) = closest_point_on_triangle(x, a, b, c);
+        if closest.distance_squared(x) <= tolerance_squared {
+            return PointClass::OnSurface {
+                triangle: t as u32,
+                barycentric,
+            };
+        }
+    }
+    if generalized_winding_number(cage, x) > 0.5 {
+        PointClass::Inside
+    } else {
+        PointClass::Outside
+    }
+}
+
+/// Σ over triangles of their signed solid angle seen from `x`, over 4π (Van Oosterom
+/// and Strackee). 1 inside an outward cage, 0 outside.
+pub fn generalized_winding_number(cage: &Cage, x: DVec3) -> f64 {
+    let mut total = 0.0;
+    for t in 0..cage.triangles.len() {
+        let [a, b, c] = cage.triangle(t).map(|p| p - x);
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let numerator = a.dot(b.cross(c));
+        let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+        total += 2.0 * numerator.atan2(denominator);
+    }
+    total / (4.0 * std::f64::consts::PI)
+}
+
+/// Closest point to `p` on triangle `abc` and its barycentric coordinates
+/// (Ericson, Real-Time Collision Detection, 5.1.5).
+pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, DVec3) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, DVec3::X);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, DVec3::Y);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, DVec3::new(1.0 - v, v, 0.0));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, DVec3::Z);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + w * ac, DVec3::new(1.0 - w, 0.0, w));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + w * (c - b), DVec3::new(0.0, 1.0 - w, w));
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denominator, vc * denominator);
+    (a + ab * v + ac * w, DVec3::new(1.0 - v - w, v, w))
+}

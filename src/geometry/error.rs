@@ -1,0 +1,138 @@
+//! Errors for reading meshes and validating cages. Every variant names the file and
+//! the offending line, face, edge or vertex, so that the message alone is enough to
+//! find the problem.
+
+use std::path::PathBuf;
+
+/// A mesh file could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error("{path}: cannot read: {source}", path = path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: the file is empty", path = path.display())]
+    Empty { path: PathBuf },
+    #[error("{path}: not a text mesh file (binary data near byte {offset})", path = path.display())]
+    Binary { path: PathBuf, offset: usize },
+    #[error("{path}: unknown mesh format (expected a .obj or .off file)", path = path.display())]
+    UnknownFormat { path: PathBuf },
+    #[error("{path}:{line}: {message}", path = path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{path}: the file has no vertices", path = path.display())]
+    NoVertices { path: PathBuf },
+    #[error("{path}:{line}: vertex {vertex} has a non-finite coordinate", path = path.display())]
+    NonFinite {
+        path: PathBuf,
+        line: usize,
+        vertex: usize,
+    },
+    #[error(
+        "{path}:{line}: face {face} refers to vertex {index}, but the file has {count} vertices",
+        path = path.display()
+    )]
+    IndexOutOfRange {
+        path: PathBuf,
+        line: usize,
+        face: usize,
+        index: i64,
+        count: usize,
+    },
+    #[error("{path}: {message}", path = path.display())]
+    Obj { path: PathBuf, message: String },
+    #[error("{path}: {count} vertices is more than the {limit} this tool supports", path = path.display())]
+    TooLarge {
+        path: PathBuf,
+        count: usize,
+        limit: usize,
+    },
+}
+
+/// A mesh was read but is not usable as a cage. Faces are numbered from 0 in file
+/// order (the n-th face line); vertices from 0 in `v` order.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CageError {
+    #[error("{path}: a cage needs at least 4 vertices, this one has {count}", path = path.display())]
+    TooFewVertices { path: PathBuf, count: usize },
+    #[error("{path}: the cage has no faces", path = path.display())]
+    NoFaces { path: PathBuf },
+    #[error("{path}: vertex {vertex} has a non-finite coordinate", path = path.display())]
+    NonFinite { path: PathBuf, vertex: usize },
+    #[error(
+        "{path}: face {face} refers to vertex {index}, but the cage has {count} vertices",
+        path = path.display()
+    )]
+    IndexOutOfRange {
+        path: PathBuf,
+        face: usize,
+        index: u32,
+        count: usize,
+    },
+    #[error(
+        "{path}: face {face} is degenerate (zero area) at vertices {a}, {b}, {c}",
+        path = path.display()
+    )]
+    DegenerateTriangle {
+        path: PathBuf,
+        face: usize,
+        a: u32,
+        b: u32,
+        c: u32,
+    },
+    #[error(
+        "{path}: the cage is not closed: edge {a}–{b} of face {face} has no neighbouring face",
+        path = path.display()
+    )]
+    OpenEdge {
+        path: PathBuf,
+        a: u32,
+        b: u32,
+        face: usize,
+    },
+    #[error(
+        "{path}: the cage is not edge-manifold: edge {a}–{b} is shared by {count} faces ({faces})",
+        path = path.display()
+    )]
+    NonManifoldEdge {
+        path: PathBuf,
+        a: u32,
+        b: u32,
+        count: usize,
+        faces: String,
+    },
+    #[error(
+        "{path}: faces {first} and {second} are oriented inconsistently: both run along edge {a}→{b}",
+        path = path.display()
+    )]
+    InconsistentOrientation {
+        path: PathBuf,
+        a: u32,
+        b: u32,
+        first: usize,
+        second: usize,
+    },
+    #[error("{path}: the cage encloses no volume", path = path.display())]
+    ZeroVolume { path: PathBuf },
+}
+
+/// A cage file could not be read, or was read but is not a valid cage.
+#[derive(Debug, thiserror::Error)]
+pub enum CageLoadError {
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    #[error(transparent)]
+    Invalid(#[from] CageError),
+}
+
+/// An output file could not be written. Any existing file at `path` is untouched.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: cannot write: {source}", path = path.display())]
+pub struct WriteError {
+    pub path: PathBuf,
+    pub source: std::io::Error,
+}

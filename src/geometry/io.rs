@@ -1,0 +1,158 @@
+//! Reading mesh and cage files, and writing results so that a failure never
+//! damages an existing file: output goes to a temporary file beside the target,
+//! which is renamed over it only once complete.
+
+use super::error::{CageLoadError, WriteError};
+use super::{obj, off, validate_cage, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
+use glam::DVec3;
+use std::io::Write;
+use std::path::Path;
+
+/// Read an OBJ or OFF file (chosen by extension, case-insensitive).
+pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(LoadError::Empty {
+            path: path.to_owned(),
+        });
+    }
+    let binary_at = bytes.iter().position(|&b| b == 0);
+    let text = match (binary_at, String::from_utf8(bytes)) {
+        (None, Ok(text)) => text,
+        (Some(offset), _) => {
+            return Err(LoadError::Binary {
+                path: path.to_owned(),
+                offset,
+            })
+        }
+        (None, Err(error)) => {
+            return Err(LoadError::Binary {
+                path: path.to_owned(),
+                offset: error.utf8_error().valid_up_to(),
+            })
+        }
+    };
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("obj") => obj::parse_obj(path, text),
+        Some("off") => off::parse_off(path, &text),
+        _ => Err(LoadError::UnknownFormat {
+            path: path.to_owned(),
+        }),
+    }
+}
+
+/// Read a cage file and validate it (see [`validate_cage`]).
+pub fn load_cage(path: &Path) -> Result<(Cage, CageReport), CageLoadError> {
+    let file = load_mesh(path)?;
+    Ok(validate_cage(path, file.mesh)?)
+}
+
+/// Write a file through a temporary sibling that is renamed over `path` on success.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), WriteError> {
+    let wrap = |source| WriteError {
+        path: path.to_owned(),
+        source,
+    };
+    let directory = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut temporary = tempfile::Builder::new()
+        .prefix(".pmvc-")
+        .suffix(".tmp")
+        .tempfile_in(directory)
+        .map_err(wrap)?;
+    {
+        let mut buffered = std::io::BufWriter::new(temporary.as_file_mut());
+        write(&mut buffered).map_err(wrap)?;
+        buffered.flush().map_err(wrap)?;
+    }
+    temporary.as_file().sync_all().map_err(wrap)?;
+    temporary.persist(path).map_err(|error| wrap(error.error))?;
+    Ok(())
+}
+
+/// Write a triangle mesh as OBJ.
+pub fn write_obj(path: &Path, mesh: &TriMesh) -> Result<(), WriteError> {
+    write_atomically(path, |out| {
+        writeln!(out, "# written by pmvc")?;
+        for p in &mesh.positions {
+            write_vertex(out, *p)?;
+        }
+        for [a, b, c] in &mesh.triangles {
+            writeln!(out, "f {} {} {}", a + 1, b + 1, c + 1)?;
+        }
+        Ok(())
+    })
+}
+
+/// Write `file` with its vertices moved to `positions` (one per `v` line, in order).
+///
+/// An OBJ source keeps everything but its vertex positions and normals: faces,
+/// texture coordinates, groups, materials and comments are copied. Normals are
+/// dropped (both `vn` lines and the normal part of face corners) because they
+/// would be stale after the deformation; viewers recompute them.
+pub fn write_deformed_mesh(
+    file: &MeshFile,
+    positions: &[DVec3],
+    path: &Path,
+) -> Result<(), WriteError> {
+    assert_eq!(
+        positions.len(),
+        file.mesh.positions.len(),
+        "one position per mesh vertex"
+    );
+    match (&file.format, &file.obj_text) {
+        (MeshFormat::Obj, Some(text)) => write_atomically(path, |out| {
+            let mut next_vertex = positions.iter();
+            for line in text.lines() {
+                let mut tokens = line.split_whitespace();
+                match tokens.next() {
+                    Some("v") => write_vertex(
+                        out,
+                        *next_vertex.next().expect("vertex count checked on load"),
+                    )?,
+                    Some("vn") => {}
+                    Some("f") => {
+                        write!(out, "f")?;
+                        for corner in tokens {
+                            let mut parts = corner.split('/');
+                            let vertex = parts.next().unwrap_or("");
+                            match parts.next() {
+                                Some(texcoord) if !texcoord.is_empty() => {
+                                    write!(out, " {vertex}/{texcoord}")?
+                                }
+                                _ => write!(out, " {vertex}")?,
+                            }
+                        }
+                        writeln!(out)?;
+                    }
+                    _ => writeln!(out, "{line}")?,
+                }
+            }
+            Ok(())
+        }),
+        _ => write_obj(
+            path,
+            &TriMesh {
+                positions: positions.to_vec(),
+                ..file.mesh.clone()
+            },
+        ),
+    }
+}
+
+fn write_vertex(out: &mut dyn Write, p: DVec3) -> std::io::Result<()> {
+    // f32 precision matches the f32 weights and keeps files compact.
+    writeln!(out, "v {} {} {}", p.x as f32, p.y as f32, p.z as f32)
+}

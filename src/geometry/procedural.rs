@@ -1,0 +1,297 @@
+//! Procedural cages and point sets: the test shapes (a convex box, a comb of close
+//! prongs, an extruded star, subdivided spheres) and benchmark scenes of the sizes
+//! in the paper's tables. Deterministic: the same arguments give the same geometry.
+
+use super::Cage;
+use glam::{DVec2, DVec3};
+
+/// An axis-aligned cube cage of half-size `half`, centred at the origin, 8 vertices.
+pub fn cube_cage(half: f64) -> Cage {
+    let positions: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -half } else { half },
+                if i & 2 == 0 { -half } else { half },
+                if i & 4 == 0 { -half } else { half },
+            )
+        })
+        .collect();
+    // Outward quads (corner bits: x=1, y=2, z=4), split into triangles.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut triangles = Vec::new();
+    for [a, b, c, d] in quads {
+        triangles.push([a, b, c]);
+        triangles.push([a, c, d]);
+    }
+    cage_from(positions, triangles)
+}
+
+/// An extruded comb: a spine along x with `prongs` teeth along +y, each `width`
+/// wide with gaps of `gap`, `length` long, extruded over `z ∈ [−depth/2, depth/2]`.
+/// Close prongs are where MVC goes negative (the paper's Figure 1).
+pub fn comb_outline(prongs: usize, width: f64, gap: f64, length: f64) -> Vec<DVec2> {
+    let spine = width;
+    let total = prongs as f64 * width + (prongs as f64 - 1.0) * gap;
+    let mut outline = vec![DVec2::new(0.0, 0.0), DVec2::new(total, 0.0)];
+    // The rightmost tooth's outer side continues the spine's right end, the leftmost its left end.
+    // Counter-clockwise: along the bottom, then up and down each tooth from the right.
+    for k in (0..prongs).rev() {
+        let x0 = k as f64 * (width + gap);
+        let x1 = x0 + width;
+        outline.push(DVec2::new(x1, spine + length));
+        outline.push(DVec2::new(x0, spine + length));
+        if k > 0 {
+            outline.push(DVec2::new(x0, spine));
+            outline.push(DVec2::new(x0 - gap, spine));
+        }
+    }
+    outline
+}
+
+/// A star outline with `points` tips at radius `outer` and notches at `inner`.
+pub fn star_outline(points: usize, inner: f64, outer: f64) -> Vec<DVec2> {
+    (0..2 * points)
+        .map(|k| {
+            let angle = std::f64::consts::PI * k as f64 / points as f64;
+            let radius = if k % 2 == 0 { outer } else { inner };
+            DVec2::new(radius * angle.cos(), radius * angle.sin())
+        })
+        .collect()
+}
+
+/// Extrude a simple counter-clockwise polygon over `z ∈ [z0, z1]` into a closed cage.
+/// Caps are ear-clipped, so the outline may be non-convex. `2n` vertices.
+pub fn extrude(outline: &[DVec2], z0: f64, z1: f64) -> Cage {
+    let n = outline.len();
+    let mut positions: Vec<DVec3> = outline.iter().map(|p| p.extend(z0)).collect();
+    positions.extend(outline.iter().map(|p| p.extend(z1)));
+    let mut triangles = Vec::new();
+    for [a, b, c] in ear_clip(outline) {
+        triangles.push([c, b, a]); // bottom faces −z
+        triangles.push([a + n as u32, b + n as u32, c + n as u32]);
+    }
+    for k in 0..n as u32 {
+        let next = (k + 1) % n as u32;
+        triangles.push([k, next, next + n as u32]);
+        triangles.push([k, next + n as u32, k + n as u32]);
+    }
+    cage_from(positions, triangles)
+}
+
+/// Triangulate a simple counter-clockwise polygon by ear clipping (O(n²), for cages).
+pub fn ear_clip(outline: &[DVec2]) -> Vec<[u32; 3]> {
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut remaining: Vec<u32> = (0..outline.len() as u32).collect();
+    let mut triangles = Vec::new();
+    while remaining.len() > 3 {
+        let m = remaining.len();
+        let ear = (0..m).find(|&k| {
+            let (ia, ib, ic) = (
+                remaining[(k + m - 1) % m],
+                remaining[k],
+                remaining[(k + 1) % m],
+            );
+            let (a, b, c) = (
+                outline[ia as usize],
+                outline[ib as usize],
+                outline[ic as usize],
+            );
+            if cross(a, b, c) <= 0.0 {
+                return false;
+            }
+            remaining.iter().all(|&other| {
+                if other == ia || other == ib || other == ic {
+                    return true;
+                }
+                let p = outline[other as usize];
+                !(cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0)
+            })
+        });
+        let k = ear.expect("a simple polygon always has an ear");
+        triangles.push([
+            remaining[(k + m - 1) % m],
+            remaining[k],
+            remaining[(k + 1) % m],
+        ]);
+        remaining.remove(k);
+    }
+    triangles.push([remaining[0], remaining[1], remaining[2]]);
+    triangles
+}
+
+/// An icosphere of radius `radius` after `subdivisions` 1-to-4 splits.
+pub fn icosphere(radius: f64, subdivisions: u32) -> Cage {
+    let phi = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<DVec3> = [
+        [-1.0, phi, 0.0],
+        [1.0, phi, 0.0],
+        [-1.0, -phi, 0.0],
+        [1.0, -phi, 0.0],
+        [0.0, -1.0, phi],
+        [0.0, 1.0, phi],
+        [0.0, -1.0, -phi],
+        [0.0, 1.0, -phi],
+        [phi, 0.0, -1.0],
+        [phi, 0.0, 1.0],
+        [-phi, 0.0, -1.0],
+        [-phi, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| DVec3::from_array(*p).normalize() * radius)
+    .collect();
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoints = std::collections::HashMap::new();
+        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<DVec3>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let p = (positions[a as usize] + positions[b as usize]).normalize() * radius;
+                positions.push(p);
+                positions.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(triangles.len() * 4);
+        for [a, b, c] in triangles {
+            let (ab, bc, ca) = (
+                midpoint(a, b, &mut positions),
+                midpoint(b, c, &mut positions),
+                midpoint(c, a, &mut positions),
+            );
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    cage_from(positions, triangles)
+}
+
+/// A UV sphere with `rings` latitude bands and `segments` longitudes: `segments·(rings−1) + 2` vertices.
+/// Used to make spherical cages of chosen vertex counts (the paper's Table 2).
+pub fn uv_sphere(radius: f64, rings: u32, segments: u32) -> Cage {
+    let mut positions = vec![DVec3::new(0.0, 0.0, radius)];
+    for ring in 1..rings {
+        let polar = std::f64::consts::PI * ring as f64 / rings as f64;
+        for segment in 0..segments {
+            let azimuth = 2.0 * std::f64::consts::PI * segment as f64 / segments as f64;
+            positions.push(
+                radius
+                    * DVec3::new(
+                        polar.sin() * azimuth.cos(),
+                        polar.sin() * azimuth.sin(),
+                        polar.cos(),
+                    ),
+            );
+        }
+    }
+    positions.push(DVec3::new(0.0, 0.0, -radius));
+    let south = positions.len() as u32 - 1;
+    let at = |ring: u32, segment: u32| 1 + (ring - 1) * segments + segment % segments;
+    let mut triangles = Vec::new();
+    for segment in 0..segments {
+        triangles.push([0, at(1, segment), at(1, segment + 1)]);
+        triangles.push([south, at(rings - 1, segment + 1), at(rings - 1, segment)]);
+    }
+    for ring in 1..rings - 1 {
+        for segment in 0..segments {
+            let (a, b, c, d) = (
+                at(ring, segment),
+                at(ring, segment + 1),
+                at(ring + 1, segment + 1),
+                at(ring + 1, segment),
+            );
+            triangles.push([a, d, c]);
+            triangles.push([a, c, b]);
+        }
+    }
+    cage_from(positions, triangles)
+}
+
+/// `count` points strictly inside `cage`, uniformly distributed, from a fixed seed.
+/// Points closer than `margin` (relative to the cage diagonal) to the surface are rejected.
+pub fn points_inside(cage: &Cage, count: usize, seed: u64, margin: f64) -> Vec<DVec3> {
+    let (lo, hi) = super::bounds_of(&cage.positions);
+    let min_distance = margin * cage.diagonal();
+    let mut random = SplitMix64(seed);
+    let mut points = Vec::with_capacity(count);
+    while points.len() < count {
+        let candidates: Vec<DVec3> = (0..count.max(64))
+            .map(|_| lo + (hi - lo) * DVec3::new(random.unit(), random.unit(), random.unit()))
+            .collect();
+        let inside: Vec<DVec3> = {
+            use rayon::prelude::*;
+            candidates
+                .into_par_iter()
+                .filter(|&x| {
+                    super::generalized_winding_number(cage, x) > 0.5
+                        && distance_to_surface(cage, x) > min_distance
+                })
+                .collect()
+        };
+        points.extend(inside.into_iter().take(count - points.len()));
+    }
+    points
+}
+
+/// Unsigned distance from `x` to the cage surface.
+pub fn distance_to_surface(cage: &Cage, x: DVec3) -> f64 {
+    (0..cage.triangles.len())
+        .map(|t| {
+            let [a, b, c] = cage.triangle(t);
+            super::closest_point_on_triangle(x, a, b, c).0.distance(x)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A small deterministic generator (SplitMix64), so scenes need no RNG dependency.
+#[derive(Clone, Debug)]
+pub struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn cage_from(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Cage {
+    let triangle_faces = (0..triangles.len() as u32).collect();
+    Cage {
+        positions,
+        triangles,
+        triangle_faces,
+    }
+}
