@@ -7,7 +7,9 @@
 //! - [`gpu`]: the wgpu device and the binding kernels. No UI code.
 //! - [`cli`]: the `pmvc` command line.
 
+pub mod app;
 pub mod cli;
 pub mod coords;
 pub mod geometry;
 pub mod gpu;
+pub mod render;

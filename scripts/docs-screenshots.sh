@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Regenerate the screenshots in docs/images with the editor's --screenshot mode,
+# under Xvfb. Usage: scripts/docs-screenshots.sh  (set PMVC_EDITOR to use a built binary)
+set -euo pipefail
+if [[ -z "${PMVC_EDITOR:-}" ]]; then
+  cargo build --release --example editor
+  PMVC_EDITOR="${CARGO_TARGET_DIR:-target}/release/examples/editor"
+fi
+shoot() { # NAME ARGS...
+  local name="$1"; shift
+  xvfb-run -a -s "-screen 0 1280x800x24" "$PMVC_EDITOR" "$@" --screenshot "docs/images/$name.png" 2>&1 \
+    | grep -v XDG_RUNTIME_DIR || true
+  echo "docs/images/$name.png"
+}
+shoot default-scene
+shoot pmvc-posed --pose docs/poses/middle-finger-sideways.obj
+shoot mvc-posed --method mvc --pose docs/poses/middle-finger-sideways.obj
+shoot scanned-elephant assets/scan_mesh.obj assets/scan_cage.obj

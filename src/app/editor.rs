@@ -1,0 +1,1258 @@
+//! The editor application: menus, side panel, status bar, and the viewport's
+//! mouse and keyboard handling. GPU work goes through [`crate::render`]; binding
+//! through [`super::jobs`].
+
+use super::jobs::BindJob;
+use super::scene::{PoseHistory, Scene};
+use super::scenes::BundledScene;
+use super::EditorOptions;
+use crate::coords::{BindOptions, Method, DEFAULT_RESOLUTION};
+use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
+use crate::render::{
+    FrameParams, OrbitCamera, RenderError, SceneUpload, ScreenProjection, ViewportCallback,
+    ViewportRenderer,
+};
+use eframe::egui_wgpu;
+use egui::{Color32, Key, KeyboardShortcut, Modifiers, PointerButton, Pos2, Rect, Sense, Stroke};
+use glam::{DVec3, Vec2, Vec3};
+use std::collections::{BTreeSet, VecDeque};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Handles are picked within this many points of the cursor.
+const PICK_RADIUS: f32 = 9.0;
+/// Handle half-size in points.
+const HANDLE_RADIUS: f32 = 4.0;
+const RECENT_LIMIT: usize = 8;
+/// Frame times kept for the statistics readout.
+const FRAME_SAMPLES: usize = 120;
+/// Frames drawn after the bind before `--screenshot` captures.
+const SCREENSHOT_FRAMES: u32 = 90;
+
+/// What a mouse drag in the viewport is doing.
+#[derive(Clone, Debug)]
+enum Drag {
+    Orbit,
+    Pan,
+    /// Moving the selected handles: the pose when the drag began, and the total
+    /// pointer motion since then (so axis constraints can change mid-drag).
+    Move {
+        start_pose: Vec<DVec3>,
+        motion: egui::Vec2,
+    },
+    /// Rubber-band selection from `origin`; `additive` keeps the old selection.
+    Box {
+        origin: Pos2,
+        additive: bool,
+    },
+}
+
+/// A message shown in the status area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Notice {
+    pub text: String,
+    pub is_error: bool,
+}
+
+/// The wgpu handles the editor needs outside paint callbacks (uploads, readback).
+struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
+}
+
+/// Which kind of file is being opened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileRole {
+    Mesh,
+    Cage,
+}
+
+pub struct EditorApp {
+    gpu: Option<Gpu>,
+    pub scene: Scene,
+    pub camera: OrbitCamera,
+    pub selection: BTreeSet<usize>,
+    hovered: Option<usize>,
+    history: PoseHistory,
+    drag: Option<Drag>,
+    job: Option<BindJob>,
+    /// Method and resolution for the next bind.
+    pub bind_options: BindOptions,
+    pub notices: Vec<Notice>,
+    pub show_statistics: bool,
+    pub highlight_outside: bool,
+    recent: Vec<(FileRole, PathBuf)>,
+    frame_times: VecDeque<f32>,
+    last_frame: Option<Instant>,
+    /// Set when the pose or selection changed and the GPU copy is stale.
+    pose_dirty: bool,
+    handles_dirty: bool,
+    projection: Option<ScreenProjection>,
+    path_input: String,
+    screenshot: Option<ScreenshotState>,
+    /// Vertices done / total reported by the last bind when it ended.
+    pub last_bind_progress: Option<(usize, usize)>,
+}
+
+/// `--screenshot`: wait for the bind, let a few frames settle, capture, quit.
+struct ScreenshotState {
+    path: PathBuf,
+    frames_after_bind: u32,
+    requested: bool,
+    saved: Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl EditorApp {
+    /// Create the app from eframe's creation context and start binding.
+    pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> Self {
+        let gpu = cc.wgpu_render_state.as_ref().map(|state| {
+            let renderer = ViewportRenderer::new(&state.device, state.target_format);
+            state.renderer.write().callback_resources.insert(renderer);
+            Gpu {
+                device: state.device.clone(),
+                queue: state.queue.clone(),
+                renderer: Arc::clone(&state.renderer),
+            }
+        });
+        let (mesh, cage) = BundledScene::Comb.build();
+        let mut app = Self {
+            gpu,
+            scene: Scene::new(BundledScene::Comb.title(), mesh, cage),
+            camera: OrbitCamera::default(),
+            selection: BTreeSet::new(),
+            hovered: None,
+            history: PoseHistory::default(),
+            drag: None,
+            job: None,
+            bind_options: BindOptions {
+                method: options.method.unwrap_or(Method::Pmvc),
+                resolution: options.resolution.unwrap_or(DEFAULT_RESOLUTION).max(1),
+            },
+            notices: Vec::new(),
+            show_statistics: false,
+            highlight_outside: false,
+            recent: Vec::new(),
+            frame_times: VecDeque::new(),
+            last_frame: None,
+            pose_dirty: true,
+            handles_dirty: true,
+            projection: None,
+            path_input: String::new(),
+            last_bind_progress: None,
+            screenshot: options.screenshot.map(|path| ScreenshotState {
+                path,
+                frames_after_bind: 0,
+                requested: false,
+                saved: Arc::new(std::sync::atomic::AtomicBool::new(false)),
+            }),
+        };
+        if app.gpu.is_none() {
+            app.error("no wgpu device: the viewport cannot draw (run with the wgpu renderer)");
+        }
+        let mut opened = false;
+        match (&options.mesh, &options.cage) {
+            (Some(mesh), Some(cage)) => opened = app.open_pair(mesh, cage),
+            (None, None) => {}
+            _ => app.error("give both a mesh and a cage; showing the default scene"),
+        }
+        if !opened {
+            app.install_scene(app.scene.clone());
+        }
+        if let Some(pose) = &options.pose {
+            app.load_pose(pose);
+        }
+        app.start_bind(&cc.egui_ctx);
+        app
+    }
+
+    fn error(&mut self, text: impl Into<String>) {
+        let text = text.into();
+        log::warn!("{text}");
+        self.notices.push(Notice {
+            text,
+            is_error: true,
+        });
+    }
+
+    fn info(&mut self, text: impl Into<String>) {
+        self.notices.push(Notice {
+            text: text.into(),
+            is_error: false,
+        });
+    }
+
+    /// The latest error, if any (for tests and the status bar).
+    pub fn last_error(&self) -> Option<&str> {
+        self.notices
+            .iter()
+            .rev()
+            .find(|n| n.is_error)
+            .map(|n| n.text.as_str())
+    }
+
+    fn with_renderer<R>(
+        &self,
+        f: impl FnOnce(&mut ViewportRenderer, &wgpu::Device, &wgpu::Queue) -> R,
+    ) -> Option<R> {
+        let gpu = self.gpu.as_ref()?;
+        let mut renderer = gpu.renderer.write();
+        let viewport = renderer.callback_resources.get_mut::<ViewportRenderer>()?;
+        Some(f(viewport, &gpu.device, &gpu.queue))
+    }
+
+    /// Make `scene` current: upload it, reset selection and history, frame it.
+    fn install_scene(&mut self, scene: Scene) {
+        self.job = None;
+        self.scene = scene;
+        self.selection.clear();
+        self.hovered = None;
+        self.history.clear();
+        self.drag = None;
+        let rest: Vec<Vec3> = self
+            .scene
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p.as_vec3())
+            .collect();
+        let cage_rest: Vec<Vec3> = self
+            .scene
+            .cage
+            .positions
+            .iter()
+            .map(|p| p.as_vec3())
+            .collect();
+        let triangles = self.scene.mesh.triangles.clone();
+        let cage_triangles = self.scene.cage.triangles.clone();
+        self.with_renderer(|renderer, device, _| {
+            renderer.upload_scene(
+                device,
+                &SceneUpload {
+                    rest_positions: &rest,
+                    triangles: &triangles,
+                    cage_rest: &cage_rest,
+                    cage_triangles: &cage_triangles,
+                },
+            )
+        });
+        self.pose_dirty = true;
+        self.handles_dirty = true;
+        self.frame_scene();
+    }
+
+    /// Start binding the current mesh and cage with `bind_options`, replacing any
+    /// running bind. Existing weights stay in use until the new ones arrive.
+    pub fn start_bind(&mut self, ctx: &egui::Context) {
+        let ctx = ctx.clone();
+        let points = Arc::new(self.scene.mesh.positions.clone());
+        self.job = Some(BindJob::start(
+            points,
+            Arc::clone(&self.scene.cage),
+            self.bind_options,
+            move || ctx.request_repaint(),
+        ));
+    }
+
+    pub fn is_binding(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// Bind progress as (done, total), while binding.
+    pub fn bind_progress(&self) -> Option<(usize, usize)> {
+        self.job.as_ref().map(|job| (job.done(), job.total()))
+    }
+
+    pub fn cancel_bind(&mut self) {
+        if let Some(job) = &self.job {
+            job.cancel();
+        }
+    }
+
+    /// Wait for the running bind (tests and `--screenshot`); true if it finished.
+    pub fn wait_for_bind(&mut self, timeout: Duration) -> bool {
+        let Some(job) = &mut self.job else {
+            return true;
+        };
+        match job.wait(timeout) {
+            Some(result) => {
+                self.finish_bind(result);
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn poll_bind(&mut self) {
+        let Some(job) = &mut self.job else { return };
+        if let Some(result) = job.poll() {
+            self.finish_bind(result);
+        }
+    }
+
+    fn finish_bind(&mut self, result: Result<super::jobs::BindOutcome, crate::coords::Cancelled>) {
+        if let Some(job) = self.job.take() {
+            self.last_bind_progress = Some((job.done(), job.total()));
+        }
+        let outcome = match result {
+            Ok(outcome) => outcome,
+            Err(_) => {
+                self.info("binding cancelled; the previous weights (if any) stay in use");
+                return;
+            }
+        };
+        if outcome.weights.rows != self.scene.mesh.positions.len()
+            || outcome.weights.cols != self.scene.cage.vertex_count()
+        {
+            return; // A bind for a scene that has since been replaced.
+        }
+        let uploaded = self.with_renderer(|renderer, device, queue| {
+            let rest: Vec<Vec3> = self
+                .scene
+                .mesh
+                .positions
+                .iter()
+                .map(|p| p.as_vec3())
+                .collect();
+            renderer.set_outside(queue, &rest, &outcome.outside);
+            renderer.set_weights(device, Some(&outcome.weights))
+        });
+        if let Some(Err(error)) = uploaded {
+            self.error(error.to_string());
+        }
+        self.scene.weights = Some(outcome.weights);
+        self.scene.bound_with = Some(outcome.options);
+        self.scene.bind_time = Some(outcome.elapsed);
+        self.scene.outside = outcome.outside;
+        self.pose_dirty = true;
+    }
+
+    /// Deformed mesh positions as the vertex shader computes them, read back from
+    /// the GPU.
+    pub fn read_back_deformed(&self) -> Option<Result<Vec<Vec3>, RenderError>> {
+        self.with_renderer(|renderer, device, queue| renderer.read_back_deformed(device, queue))
+    }
+
+    /// Push pending pose and selection changes to the GPU.
+    pub fn sync_gpu(&mut self) {
+        if self.pose_dirty {
+            let pose: Vec<Vec3> = self.scene.pose.iter().map(|p| p.as_vec3()).collect();
+            self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
+            self.pose_dirty = false;
+        }
+        if self.handles_dirty {
+            let states: Vec<u32> = (0..self.scene.pose.len())
+                .map(|i| {
+                    if self.selection.contains(&i) {
+                        1
+                    } else if self.hovered == Some(i) {
+                        2
+                    } else {
+                        0
+                    }
+                })
+                .collect();
+            self.with_renderer(|renderer, _, queue| renderer.set_handle_states(queue, &states));
+            self.handles_dirty = false;
+        }
+    }
+
+    fn set_pose(&mut self, pose: Vec<DVec3>) {
+        if pose.len() == self.scene.pose.len() {
+            self.scene.pose = pose;
+            self.pose_dirty = true;
+        }
+    }
+
+    pub fn undo(&mut self) {
+        if let Some(pose) = self.history.undo(&self.scene.pose) {
+            self.set_pose(pose);
+        }
+    }
+
+    pub fn redo(&mut self) {
+        if let Some(pose) = self.history.redo(&self.scene.pose) {
+            self.set_pose(pose);
+        }
+    }
+
+    pub fn reset_pose(&mut self) {
+        if self.scene.pose != self.scene.cage.positions {
+            self.history.record(self.scene.pose.clone());
+            let rest = self.scene.cage.positions.clone();
+            self.set_pose(rest);
+        }
+    }
+
+    /// Move one handle to `position`, recording the change for undo.
+    pub fn set_handle_position(&mut self, handle: usize, position: DVec3) {
+        if handle < self.scene.pose.len() && self.scene.pose[handle] != position {
+            self.history.record(self.scene.pose.clone());
+            let mut pose = self.scene.pose.clone();
+            pose[handle] = position;
+            self.set_pose(pose);
+        }
+    }
+
+    pub fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
+        self.selection = handles.into_iter().collect();
+        self.handles_dirty = true;
+    }
+
+    pub fn frame_scene(&mut self) {
+        let (centre, radius) = self.scene.bounding_sphere();
+        self.camera.frame(centre.as_vec3(), radius as f32);
+    }
+
+    fn remember(&mut self, role: FileRole, path: &Path) {
+        let entry = (role, path.to_owned());
+        self.recent.retain(|e| *e != entry);
+        self.recent.insert(0, entry);
+        self.recent.truncate(RECENT_LIMIT);
+    }
+
+    /// Open a mesh and cage together; on any failure the current scene stays.
+    fn open_pair(&mut self, mesh_path: &Path, cage_path: &Path) -> bool {
+        let mesh = match load_mesh(mesh_path) {
+            Ok(mesh) => mesh,
+            Err(error) => {
+                self.error(error.to_string());
+                return false;
+            }
+        };
+        let (cage, report) = match load_cage(cage_path) {
+            Ok(cage) => cage,
+            Err(error) => {
+                self.error(error.to_string());
+                return false;
+            }
+        };
+        for message in report.messages() {
+            self.info(message);
+        }
+        let title = mesh_path
+            .file_name()
+            .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned());
+        let mut scene = Scene::new(title, mesh.mesh.clone(), cage);
+        scene.mesh_file = Some(mesh);
+        scene.cage_path = Some(cage_path.to_owned());
+        self.install_scene(scene);
+        self.remember(FileRole::Mesh, mesh_path);
+        self.remember(FileRole::Cage, cage_path);
+        true
+    }
+
+    /// Replace the mesh (keeping the cage) or the cage (keeping the mesh), then
+    /// rebind. A file that fails to load or validate changes nothing.
+    pub fn open_file(&mut self, ctx: &egui::Context, role: FileRole, path: &Path) -> bool {
+        let mut scene = match role {
+            FileRole::Mesh => match load_mesh(path) {
+                Ok(file) => {
+                    let mut scene = Scene::new(
+                        path.file_name()
+                            .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned()),
+                        file.mesh.clone(),
+                        (*self.scene.cage).clone(),
+                    );
+                    scene.mesh_file = Some(file);
+                    scene.cage_path = self.scene.cage_path.clone();
+                    scene
+                }
+                Err(error) => {
+                    self.error(error.to_string());
+                    return false;
+                }
+            },
+            FileRole::Cage => match load_cage(path) {
+                Ok((cage, report)) => {
+                    for message in report.messages() {
+                        self.info(message);
+                    }
+                    let mut scene =
+                        Scene::new(self.scene.title.clone(), (*self.scene.mesh).clone(), cage);
+                    scene.mesh_file = self.scene.mesh_file.clone();
+                    scene.cage_path = Some(path.to_owned());
+                    scene
+                }
+                Err(error) => {
+                    self.error(error.to_string());
+                    return false;
+                }
+            },
+        };
+        scene.weights = None;
+        self.install_scene(scene);
+        self.remember(role, path);
+        self.info(format!("opened {}", path.display()));
+        self.start_bind(ctx);
+        true
+    }
+
+    pub fn open_bundled(&mut self, ctx: &egui::Context, bundled: BundledScene) {
+        let (mesh, cage) = bundled.build();
+        self.install_scene(Scene::new(bundled.title(), mesh, cage));
+        self.start_bind(ctx);
+    }
+
+    /// Load a pose: a cage-shaped OBJ/OFF with one vertex per cage vertex.
+    pub fn load_pose(&mut self, path: &Path) -> bool {
+        match load_mesh(path) {
+            Ok(file) if file.mesh.positions.len() == self.scene.pose.len() => {
+                self.history.record(self.scene.pose.clone());
+                self.set_pose(file.mesh.positions);
+                self.info(format!("loaded pose {}", path.display()));
+                true
+            }
+            Ok(file) => {
+                self.error(format!(
+                    "{}: the pose has {} vertices but the cage has {}",
+                    path.display(),
+                    file.mesh.positions.len(),
+                    self.scene.pose.len()
+                ));
+                false
+            }
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
+        }
+    }
+
+    pub fn save_pose(&mut self, path: &Path) {
+        let posed = TriMesh {
+            positions: self.scene.pose.clone(),
+            triangles: self.scene.cage.triangles.clone(),
+            triangle_faces: self.scene.cage.triangle_faces.clone(),
+        };
+        match write_obj(path, &posed) {
+            Ok(()) => self.info(format!("saved pose {}", path.display())),
+            Err(error) => self.error(error.to_string()),
+        }
+    }
+
+    pub fn export_deformed(&mut self, path: &Path) {
+        let positions = self.scene.deformed_positions();
+        let result = match &self.scene.mesh_file {
+            Some(file) => write_deformed_mesh(file, &positions, path),
+            None => write_obj(
+                path,
+                &TriMesh {
+                    positions,
+                    ..(*self.scene.mesh).clone()
+                },
+            ),
+        };
+        match result {
+            Ok(()) => self.info(format!("exported {}", path.display())),
+            Err(error) => self.error(error.to_string()),
+        }
+    }
+
+    /// Rest the cage in its current pose and rebind.
+    fn pose_as_rest(&mut self, ctx: &egui::Context) {
+        let cage = self.scene.cage.with_positions(self.scene.pose.clone());
+        let mut scene = Scene::new(self.scene.title.clone(), (*self.scene.mesh).clone(), cage);
+        scene.mesh_file = self.scene.mesh_file.clone();
+        self.install_scene(scene);
+        self.start_bind(ctx);
+    }
+
+    fn handle_dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_owned())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for path in dropped {
+            // A file whose name mentions "cage" replaces the cage; anything else the mesh.
+            let is_cage = path
+                .file_name()
+                .is_some_and(|n| n.to_string_lossy().to_lowercase().contains("cage"));
+            let role = if is_cage {
+                FileRole::Cage
+            } else {
+                FileRole::Mesh
+            };
+            self.open_file(ctx, role, &path);
+        }
+    }
+
+    fn handle_shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+        let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+        let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+        let (redo, undo, escape, frame) = ctx.input_mut(|i| {
+            (
+                i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y),
+                i.consume_shortcut(&undo),
+                i.key_pressed(Key::Escape),
+                i.key_pressed(Key::F) && i.modifiers.is_none(),
+            )
+        });
+        if redo {
+            self.redo();
+        }
+        if undo {
+            self.undo();
+        }
+        if escape {
+            self.select_only([]);
+        }
+        if frame {
+            self.frame_scene();
+        }
+    }
+
+    /// The handle nearest to `pointer` within the pick radius.
+    fn pick(&self, pointer: Pos2) -> Option<usize> {
+        let projection = self.projection?;
+        let pointer = Vec2::new(pointer.x, pointer.y);
+        self.scene
+            .pose
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| {
+                let screen = projection.project(p.as_vec3())?;
+                let distance = screen.distance(pointer);
+                (distance <= PICK_RADIUS).then_some((i, distance))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// Screen position (in points) of a cage handle, for tests and tools.
+    pub fn handle_screen_position(&self, handle: usize) -> Option<Pos2> {
+        let screen = self
+            .projection?
+            .project(self.scene.pose.get(handle)?.as_vec3())?;
+        Some(Pos2::new(screen.x, screen.y))
+    }
+
+    fn viewport(&mut self, ui: &mut egui::Ui) {
+        let rect = ui.available_rect_before_wrap();
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let aspect = rect.width() / rect.height().max(1.0);
+        let projection = ScreenProjection {
+            view_projection: self.camera.view_projection(aspect),
+            origin: Vec2::new(rect.min.x, rect.min.y),
+            size: Vec2::new(rect.width(), rect.height()),
+        };
+        self.projection = Some(projection);
+        self.viewport_input(ui, &response, rect);
+        // The input may have moved the camera; draw with the final one.
+        let projection = ScreenProjection {
+            view_projection: self.camera.view_projection(aspect),
+            ..projection
+        };
+        self.projection = Some(projection);
+        self.sync_gpu();
+
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        if self.gpu.is_some() {
+            let params = FrameParams {
+                view_projection: projection.view_projection,
+                eye: self.camera.eye(),
+                size_px: [
+                    (rect.width() * pixels_per_point).round().max(1.0) as u32,
+                    (rect.height() * pixels_per_point).round().max(1.0) as u32,
+                ],
+                handle_radius_px: HANDLE_RADIUS * pixels_per_point,
+                highlight_outside: self.highlight_outside,
+            };
+            ui.painter().add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                ViewportCallback { params },
+            ));
+        } else {
+            ui.painter().text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "No wgpu device: the viewport is unavailable",
+                egui::FontId::proportional(16.0),
+                Color32::LIGHT_RED,
+            );
+        }
+        if let Some(Drag::Box { origin, .. }) = &self.drag {
+            if let Some(current) = response.interact_pointer_pos() {
+                let band = Rect::from_two_pos(*origin, current);
+                ui.painter()
+                    .rect_filled(band, 0.0, Color32::from_white_alpha(20));
+                ui.painter().rect_stroke(
+                    band,
+                    0.0,
+                    Stroke::new(1.0, Color32::WHITE),
+                    egui::StrokeKind::Inside,
+                );
+            }
+        }
+        if self.scene.weights.is_none() {
+            ui.painter().text(
+                rect.left_top() + egui::vec2(10.0, 10.0),
+                egui::Align2::LEFT_TOP,
+                "Binding… the mesh is shown at rest until the weights are ready",
+                egui::FontId::proportional(14.0),
+                Color32::from_gray(200),
+            );
+        }
+    }
+
+    fn viewport_input(&mut self, ui: &egui::Ui, response: &egui::Response, rect: Rect) {
+        let (modifiers, press_origin, scroll, hover) = ui.input(|i| {
+            (
+                i.modifiers,
+                i.pointer.press_origin(),
+                i.smooth_scroll_delta.y,
+                i.pointer.hover_pos(),
+            )
+        });
+
+        // Hover highlight (not while dragging, so the highlight does not flicker).
+        if self.drag.is_none() {
+            let hovered = response.hover_pos().and_then(|p| self.pick(p));
+            if hovered != self.hovered {
+                self.hovered = hovered;
+                self.handles_dirty = true;
+            }
+        }
+
+        if response.hovered() && scroll != 0.0 {
+            if let (Some(pointer), Some(projection)) = (hover, self.projection) {
+                let ndc = projection.to_ndc(Vec2::new(pointer.x, pointer.y));
+                let factor = (-scroll * 0.0015).exp();
+                self.camera
+                    .zoom_towards(factor, ndc, rect.width() / rect.height().max(1.0));
+            }
+        }
+
+        if response.clicked_by(PointerButton::Primary) {
+            let picked = response.interact_pointer_pos().and_then(|p| self.pick(p));
+            match (picked, modifiers.shift) {
+                (Some(handle), true) => self.toggle(handle),
+                (Some(handle), false) => self.select_only([handle]),
+                (None, false) => self.select_only([]),
+                (None, true) => {}
+            }
+        }
+
+        if response.drag_started() {
+            let origin = press_origin.unwrap_or(rect.center());
+            self.drag = Some(if response.dragged_by(PointerButton::Primary) {
+                if modifiers.command || ui.input(|i| i.key_down(Key::B)) {
+                    Drag::Box {
+                        origin,
+                        additive: modifiers.shift,
+                    }
+                } else if let Some(handle) = self.pick(origin) {
+                    if modifiers.shift {
+                        if !self.selection.contains(&handle) {
+                            self.toggle(handle);
+                        }
+                    } else if !self.selection.contains(&handle) {
+                        self.select_only([handle]);
+                    }
+                    Drag::Move {
+                        start_pose: self.scene.pose.clone(),
+                        motion: egui::Vec2::ZERO,
+                    }
+                } else {
+                    Drag::Orbit
+                }
+            } else if response.dragged_by(PointerButton::Middle) {
+                if modifiers.shift {
+                    Drag::Pan
+                } else {
+                    Drag::Orbit
+                }
+            } else {
+                Drag::Pan
+            });
+        }
+
+        if response.dragged() {
+            let delta = response.drag_delta();
+            let axis = ui.input(|i| {
+                if i.key_down(Key::X) {
+                    Some(DVec3::X)
+                } else if i.key_down(Key::Y) {
+                    Some(DVec3::Y)
+                } else if i.key_down(Key::Z) {
+                    Some(DVec3::Z)
+                } else {
+                    None
+                }
+            });
+            match self.drag.take() {
+                Some(Drag::Orbit) => {
+                    self.camera.orbit(Vec2::new(delta.x, delta.y));
+                    self.drag = Some(Drag::Orbit);
+                }
+                Some(Drag::Pan) => {
+                    self.camera.pan(Vec2::new(delta.x, delta.y), rect.height());
+                    self.drag = Some(Drag::Pan);
+                }
+                Some(Drag::Move { start_pose, motion }) => {
+                    let motion = motion + delta;
+                    let pose = self.moved_pose(&start_pose, motion, axis, rect);
+                    self.set_pose(pose);
+                    self.drag = Some(Drag::Move { start_pose, motion });
+                }
+                other => self.drag = other,
+            }
+        }
+
+        if response.drag_stopped() {
+            match self.drag.take() {
+                Some(Drag::Move { start_pose, .. }) if start_pose != self.scene.pose => {
+                    self.history.record(start_pose);
+                }
+                Some(Drag::Box { origin, additive }) => {
+                    let end = response.interact_pointer_pos().unwrap_or(origin);
+                    self.box_select(Rect::from_two_pos(origin, end), additive);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn toggle(&mut self, handle: usize) {
+        if !self.selection.remove(&handle) {
+            self.selection.insert(handle);
+        }
+        self.handles_dirty = true;
+    }
+
+    fn box_select(&mut self, band: Rect, additive: bool) {
+        let Some(projection) = self.projection else {
+            return;
+        };
+        if !additive {
+            self.selection.clear();
+        }
+        for (i, p) in self.scene.pose.iter().enumerate() {
+            if let Some(screen) = projection.project(p.as_vec3()) {
+                if band.contains(Pos2::new(screen.x, screen.y)) {
+                    self.selection.insert(i);
+                }
+            }
+        }
+        self.handles_dirty = true;
+    }
+
+    /// `start_pose` with the selection moved by a pointer motion of `motion` points:
+    /// in the view plane, or along `axis` by the motion's component along the axis's
+    /// screen direction.
+    fn moved_pose(
+        &self,
+        start_pose: &[DVec3],
+        motion: egui::Vec2,
+        axis: Option<DVec3>,
+        rect: Rect,
+    ) -> Vec<DVec3> {
+        let mut pose = start_pose.to_vec();
+        if self.selection.is_empty() {
+            return pose;
+        }
+        let centre = self
+            .selection
+            .iter()
+            .filter_map(|&i| start_pose.get(i))
+            .sum::<DVec3>()
+            / self.selection.len() as f64;
+        let scale = self
+            .camera
+            .units_per_pixel(self.camera.depth_of(centre.as_vec3()), rect.height());
+        let (right, up) = self.camera.right_up();
+        let in_plane = (right * motion.x - up * motion.y) * scale;
+        let offset = match (axis, self.projection) {
+            (Some(axis), Some(projection)) => {
+                let from = projection.project(centre.as_vec3());
+                let to = projection.project((centre + axis).as_vec3());
+                match (from, to) {
+                    (Some(from), Some(to)) if (to - from).length_squared() > 1e-6 => {
+                        let screen_axis = to - from;
+                        let along = Vec2::new(motion.x, motion.y).dot(screen_axis)
+                            / screen_axis.length_squared();
+                        axis * f64::from(along)
+                    }
+                    _ => axis * in_plane.as_dvec3().dot(axis),
+                }
+            }
+            _ => in_plane.as_dvec3(),
+        };
+        for &i in &self.selection {
+            if let Some(p) = pose.get_mut(i) {
+                *p += offset;
+            }
+        }
+        pose
+    }
+
+    fn menu_bar(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open mesh…").clicked() {
+                    if let Some(path) = pick_file("Open mesh") {
+                        self.open_file(&ctx, FileRole::Mesh, &path);
+                    }
+                }
+                if ui.button("Open cage…").clicked() {
+                    if let Some(path) = pick_file("Open cage") {
+                        self.open_file(&ctx, FileRole::Cage, &path);
+                    }
+                }
+                ui.horizontal(|ui| {
+                    ui.label("Path:");
+                    ui.text_edit_singleline(&mut self.path_input);
+                });
+                ui.horizontal(|ui| {
+                    let path = PathBuf::from(self.path_input.trim());
+                    if ui.button("Open as mesh").clicked() {
+                        self.open_file(&ctx, FileRole::Mesh, &path);
+                    }
+                    if ui.button("Open as cage").clicked() {
+                        self.open_file(&ctx, FileRole::Cage, &path);
+                    }
+                });
+                ui.menu_button("Recent files", |ui| {
+                    if self.recent.is_empty() {
+                        ui.label("(none)");
+                    }
+                    for (role, path) in self.recent.clone() {
+                        let label = format!(
+                            "{} {}",
+                            if role == FileRole::Mesh {
+                                "mesh"
+                            } else {
+                                "cage"
+                            },
+                            path.display()
+                        );
+                        if ui.button(label).clicked() {
+                            self.open_file(&ctx, role, &path);
+                        }
+                    }
+                });
+                ui.separator();
+                if ui.button("Load pose…").clicked() {
+                    if let Some(path) = pick_file("Load pose") {
+                        self.load_pose(&path);
+                    }
+                }
+                if ui.button("Save pose…").clicked() {
+                    if let Some(path) = save_file("Save pose", "pose.obj") {
+                        self.save_pose(&path);
+                    }
+                }
+                if ui.button("Export deformed mesh…").clicked() {
+                    if let Some(path) = save_file("Export deformed mesh", "deformed.obj") {
+                        self.export_deformed(&path);
+                    }
+                }
+                ui.separator();
+                if ui.button("Quit").clicked() {
+                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add_enabled(self.history.can_undo(), egui::Button::new("Undo (Ctrl+Z)"))
+                    .clicked()
+                {
+                    self.undo();
+                }
+                if ui
+                    .add_enabled(
+                        self.history.can_redo(),
+                        egui::Button::new("Redo (Ctrl+Shift+Z)"),
+                    )
+                    .clicked()
+                {
+                    self.redo();
+                }
+                if ui.button("Reset pose").clicked() {
+                    self.reset_pose();
+                }
+                if ui.button("Use pose as rest shape (rebind)").clicked() {
+                    self.pose_as_rest(&ctx);
+                }
+            });
+            ui.menu_button("View", |ui| {
+                ui.checkbox(&mut self.show_statistics, "Statistics");
+                ui.checkbox(&mut self.highlight_outside, "Highlight outside vertices");
+                if ui.button("Frame scene (F)").clicked() {
+                    self.frame_scene();
+                }
+            });
+            ui.menu_button("Scenes", |ui| {
+                for bundled in BundledScene::ALL {
+                    if ui.button(bundled.title()).clicked() {
+                        self.open_bundled(&ctx, bundled);
+                    }
+                }
+            });
+        });
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        ui.heading(&self.scene.title);
+        ui.label(format!(
+            "{} mesh vertices, {} cage vertices",
+            self.scene.mesh.positions.len(),
+            self.scene.pose.len()
+        ));
+        ui.separator();
+        ui.label("Binding");
+        let mut options = self.bind_options;
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut options.method, Method::Pmvc, "PMVC");
+            ui.radio_value(&mut options.method, Method::Mvc, "MVC");
+        });
+        ui.horizontal(|ui| {
+            let label = ui.label("Resolution");
+            ui.add(egui::DragValue::new(&mut options.resolution).range(4..=128))
+                .labelled_by(label.id);
+        });
+        if options != self.bind_options {
+            self.bind_options = options;
+            self.start_bind(&ctx);
+        }
+        if let Some(job) = &self.job {
+            let (done, total) = (job.done(), job.total());
+            ui.add(
+                egui::ProgressBar::new(job.fraction()).text(format!("{done} / {total} vertices")),
+            );
+            let remaining = job.estimated_remaining().map_or("estimating…".into(), |r| {
+                format!("{:.1} s left", r.as_secs_f32())
+            });
+            ui.label(format!(
+                "{} {} — {:.1} s elapsed, {remaining}",
+                if job.is_cancelling() {
+                    "Cancelling"
+                } else {
+                    "Binding"
+                },
+                job.options().method.name(),
+                job.elapsed().as_secs_f32()
+            ));
+            if ui.button("Cancel").clicked() {
+                job.cancel();
+            }
+            ctx.request_repaint_after(Duration::from_millis(100));
+        } else if let (Some(time), Some(options)) = (self.scene.bind_time, self.scene.bound_with) {
+            ui.label(format!(
+                "Bound with {} (resolution {}) in {:.2} s",
+                options.method.name(),
+                options.resolution,
+                time.as_secs_f32()
+            ));
+        } else if ui.button("Bind").clicked() {
+            self.start_bind(&ctx);
+        }
+        if self.scene.weights.is_some() {
+            let outside = self.scene.outside.len();
+            ui.label(format!("{outside} mesh vertices outside the cage"));
+            if outside > 0 {
+                ui.checkbox(&mut self.highlight_outside, "Highlight them");
+            }
+        }
+        ui.separator();
+        ui.label(format!("Selection: {} handle(s)", self.selection.len()));
+        if self.selection.len() == 1 {
+            if let Some(&handle) = self.selection.iter().next() {
+                let mut position = self.scene.pose[handle];
+                let mut changed = false;
+                ui.horizontal(|ui| {
+                    ui.label(format!("Handle {handle}"));
+                    for (label, value) in [
+                        ("x", &mut position.x),
+                        ("y", &mut position.y),
+                        ("z", &mut position.z),
+                    ] {
+                        let label = ui.label(label);
+                        changed |= ui
+                            .add(egui::DragValue::new(value).speed(0.01).max_decimals(4))
+                            .labelled_by(label.id)
+                            .changed();
+                    }
+                });
+                if changed {
+                    self.set_handle_position(handle, position);
+                }
+            }
+        }
+        ui.horizontal(|ui| {
+            if ui.button("Reset pose").clicked() {
+                self.reset_pose();
+            }
+            if ui
+                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
+                .clicked()
+            {
+                self.undo();
+            }
+            if ui
+                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.redo();
+            }
+        });
+        ui.separator();
+        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · F: frame · Esc: deselect");
+        if self.show_statistics {
+            ui.separator();
+            self.statistics(ui);
+        }
+        ui.separator();
+        let mut dismiss = None;
+        for (index, notice) in self.notices.iter().enumerate().rev().take(6) {
+            ui.horizontal_wrapped(|ui| {
+                let colour = if notice.is_error {
+                    Color32::LIGHT_RED
+                } else {
+                    ui.visuals().text_color()
+                };
+                if ui.small_button("x").clicked() {
+                    dismiss = Some(index);
+                }
+                ui.colored_label(colour, &notice.text);
+            });
+        }
+        if let Some(index) = dismiss {
+            self.notices.remove(index);
+        }
+    }
+
+    fn statistics(&self, ui: &mut egui::Ui) {
+        let count = self.frame_times.len().max(1) as f32;
+        let average = self.frame_times.iter().sum::<f32>() / count;
+        let worst = self.frame_times.iter().copied().fold(0.0, f32::max);
+        ui.label(format!(
+            "Frame time: {:.1} ms average, {:.1} ms worst (last {} frames)",
+            average * 1000.0,
+            worst * 1000.0,
+            self.frame_times.len()
+        ));
+        ui.label(format!(
+            "{} triangles, {} weights",
+            self.scene.mesh.triangles.len(),
+            self.scene.mesh.positions.len() * self.scene.pose.len()
+        ));
+    }
+
+    /// Average frame interval over the recent frames, in seconds.
+    pub fn average_frame_time(&self) -> Option<f32> {
+        (!self.frame_times.is_empty())
+            .then(|| self.frame_times.iter().sum::<f32>() / self.frame_times.len() as f32)
+    }
+
+    fn record_frame_time(&mut self) {
+        let now = Instant::now();
+        if let Some(last) = self.last_frame.replace(now) {
+            self.frame_times.push_back((now - last).as_secs_f32());
+            if self.frame_times.len() > FRAME_SAMPLES {
+                self.frame_times.pop_front();
+            }
+        }
+    }
+
+    fn drive_screenshot(&mut self, ctx: &egui::Context) {
+        let Some(state) = &mut self.screenshot else {
+            return;
+        };
+        if self.job.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+            return;
+        }
+        if state
+            .saved
+            .swap(false, std::sync::atomic::Ordering::Relaxed)
+        {
+            if let Some(average) = self.average_frame_time() {
+                eprintln!("pmvc editor: average frame time {:.1} ms", average * 1000.0);
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        }
+        state.frames_after_bind += 1;
+        if state.frames_after_bind == 1 {
+            // Measure frame times of the idle scene only, not of the bind.
+            self.frame_times.clear();
+        }
+        // Frames before the capture let the GPU upload settle and give a frame-time
+        // sample of the continuously redrawn viewport.
+        if state.frames_after_bind >= SCREENSHOT_FRAMES && !state.requested {
+            state.requested = true;
+            let path = state.path.clone();
+            let saved = Arc::clone(&state.saved);
+            let repaint = ctx.clone();
+            ctx.request_screenshot(move |image| {
+                if let Err(error) = save_png(&path, &image) {
+                    eprintln!("pmvc editor: cannot save {}: {error}", path.display());
+                }
+                saved.store(true, std::sync::atomic::Ordering::Relaxed);
+                repaint.request_repaint();
+            });
+        }
+        ctx.request_repaint();
+    }
+}
+
+impl eframe::App for EditorApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.record_frame_time();
+        self.poll_bind();
+        self.handle_dropped_files(&ctx);
+        self.handle_shortcuts(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::right("side")
+            .default_size(300.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui))
+            });
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        if self.show_statistics {
+            // Keep frames coming so the readout measures rendering, not idling.
+            ctx.request_repaint();
+        }
+        self.drive_screenshot(&ctx);
+    }
+}
+
+fn pick_file(title: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .set_title(title)
+        .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
+        .pick_file()
+}
+
+fn save_file(title: &str, name: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .set_title(title)
+        .set_file_name(name)
+        .add_filter("OBJ", &["obj"])
+        .save_file()
+}
+
+fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageError> {
+    let [width, height] = image.size;
+    let bytes: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+    image::save_buffer(
+        path,
+        &bytes,
+        width as u32,
+        height as u32,
+        image::ColorType::Rgba8,
+    )
+}

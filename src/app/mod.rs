@@ -1,0 +1,51 @@
+//! The desktop editor: an eframe/egui application that binds a mesh to a cage in
+//! the background, deforms it on the GPU every frame, and edits the cage.
+//!
+//! - [`editor`]: the application state and its UI; talks only to [`jobs`] and
+//!   [`crate::render`].
+//! - [`scene`]: the loaded mesh, cage, pose and weights, and the pose history.
+//! - [`jobs`]: binding on a background thread with progress and cancel.
+//! - [`scenes`]: the bundled scenes and their generators.
+
+pub mod editor;
+pub mod jobs;
+pub mod scene;
+pub mod scenes;
+
+pub use editor::EditorApp;
+
+use std::path::PathBuf;
+
+/// How the editor starts (the `pmvc edit` arguments).
+#[derive(Clone, Debug, Default)]
+pub struct EditorOptions {
+    /// Mesh to open instead of the default scene (needs `cage` too).
+    pub mesh: Option<PathBuf>,
+    pub cage: Option<PathBuf>,
+    /// A pose (cage OBJ with the same vertex count) applied once loaded.
+    pub pose: Option<PathBuf>,
+    /// PMVC cube-map resolution; `None` for the default.
+    pub resolution: Option<u32>,
+    /// Coordinates to bind with; `None` for PMVC.
+    pub method: Option<crate::coords::Method>,
+    /// Save a PNG of the window once the first bind finishes, then quit.
+    pub screenshot: Option<PathBuf>,
+}
+
+/// Open the editor window and run until it is closed.
+pub fn run_editor(options: EditorOptions) -> anyhow::Result<()> {
+    let native_options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("pmvc editor")
+            .with_inner_size([1280.0, 800.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    eframe::run_native(
+        "pmvc editor",
+        native_options,
+        Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, options)))),
+    )
+    .map_err(|error| anyhow::anyhow!("the editor window failed: {error}"))
+}

@@ -1,0 +1,95 @@
+//! The cage overlay: wire edges and vertex handles, each drawn dimmed where the
+//! mesh hides it and bright where visible. Paired with `shaders/render_cage.wgsl`.
+
+use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT, SAMPLE_COUNT};
+
+const SHADER: &str = include_str!("../../shaders/render_cage.wgsl");
+
+pub struct CageRenderer {
+    hidden_edges: wgpu::RenderPipeline,
+    visible_edges: wgpu::RenderPipeline,
+    hidden_handles: wgpu::RenderPipeline,
+    visible_handles: wgpu::RenderPipeline,
+}
+
+impl CageRenderer {
+    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("render_cage.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cage"),
+            bind_group_layouts: &[Some(scene_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |vertex: &str, topology, hidden: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(vertex),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vertex),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    // The overlay never hides itself, only the mesh hides it.
+                    depth_write_enabled: Some(false),
+                    depth_compare: Some(if hidden {
+                        wgpu::CompareFunction::Greater
+                    } else {
+                        wgpu::CompareFunction::LessEqual
+                    }),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: SAMPLE_COUNT,
+                    ..Default::default()
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(if hidden { "fs_hidden" } else { "fs_visible" }),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: OFFSCREEN_FORMAT,
+                        blend: Some(wgpu::BlendState::ALPHA_BLENDING),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        use wgpu::PrimitiveTopology::{LineList, TriangleList};
+        Self {
+            hidden_edges: pipeline("vs_edge", LineList, true),
+            visible_edges: pipeline("vs_edge", LineList, false),
+            hidden_handles: pipeline("vs_handle", TriangleList, true),
+            visible_handles: pipeline("vs_handle", TriangleList, false),
+        }
+    }
+
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu) {
+        if scene.cage_vertex_count == 0 {
+            return;
+        }
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_index_buffer(scene.cage_edges.slice(..), wgpu::IndexFormat::Uint32);
+        for pipeline in [&self.hidden_edges, &self.visible_edges] {
+            pass.set_pipeline(pipeline);
+            pass.draw_indexed(0..scene.cage_edge_index_count, 0, 0..1);
+        }
+        for pipeline in [&self.hidden_handles, &self.visible_handles] {
+            pass.set_pipeline(pipeline);
+            pass.draw(0..6, 0..scene.cage_vertex_count);
+        }
+    }
+}

@@ -1,0 +1,152 @@
+//! An orbit camera (Blender conventions: orbit around a target, pan moves the
+//! target in the view plane, zoom moves towards the cursor) and the projections
+//! the editor needs for picking and dragging.
+
+use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
+
+/// Vertical field of view.
+const FOV_Y: f32 = 40.0 * std::f32::consts::PI / 180.0;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitCamera {
+    pub target: Vec3,
+    pub distance: f32,
+    /// Rotation about the world y axis, radians.
+    pub yaw: f32,
+    /// Elevation above the xz plane, radians, kept inside ±89°.
+    pub pitch: f32,
+}
+
+impl Default for OrbitCamera {
+    fn default() -> Self {
+        Self {
+            target: Vec3::ZERO,
+            distance: 5.0,
+            yaw: 0.35,
+            pitch: 0.3,
+        }
+    }
+}
+
+impl OrbitCamera {
+    /// Unit vector from the target towards the eye.
+    fn backward(&self) -> Vec3 {
+        let (sin_yaw, cos_yaw) = self.yaw.sin_cos();
+        let (sin_pitch, cos_pitch) = self.pitch.sin_cos();
+        Vec3::new(cos_pitch * sin_yaw, sin_pitch, cos_pitch * cos_yaw)
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        self.target + self.backward() * self.distance
+    }
+
+    /// Camera right and up vectors in world space.
+    pub fn right_up(&self) -> (Vec3, Vec3) {
+        let forward = -self.backward();
+        let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
+        (right, right.cross(forward))
+    }
+
+    pub fn view_projection(&self, aspect: f32) -> Mat4 {
+        let near = (self.distance * 0.01).max(1e-4);
+        let far = self.distance * 100.0 + 10.0;
+        // wgpu's clip space is DirectX's: z in [0, 1], y up.
+        glam::camera::rh::proj::directx::perspective(FOV_Y, aspect.max(1e-3), near, far)
+            * glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
+    }
+
+    /// World units per pixel at `depth` along the view direction, in a viewport
+    /// `height_px` tall.
+    pub fn units_per_pixel(&self, depth: f32, height_px: f32) -> f32 {
+        2.0 * depth.max(1e-4) * (FOV_Y / 2.0).tan() / height_px.max(1.0)
+    }
+
+    /// Depth of `point` along the view direction.
+    pub fn depth_of(&self, point: Vec3) -> f32 {
+        (point - self.eye()).dot(-self.backward())
+    }
+
+    /// Rotate by a mouse motion of `delta` pixels.
+    pub fn orbit(&mut self, delta: Vec2) {
+        self.yaw -= delta.x * 0.008;
+        let limit = 89f32.to_radians();
+        self.pitch = (self.pitch + delta.y * 0.008).clamp(-limit, limit);
+    }
+
+    /// Move the target with the mouse by `delta` pixels.
+    pub fn pan(&mut self, delta: Vec2, height_px: f32) {
+        let (right, up) = self.right_up();
+        let scale = self.units_per_pixel(self.distance, height_px);
+        self.target += (-right * delta.x + up * delta.y) * scale;
+    }
+
+    /// Zoom by `factor` (< 1 moves in) keeping the point under `cursor_ndc` fixed on
+    /// the plane through the target.
+    pub fn zoom_towards(&mut self, factor: f32, cursor_ndc: Vec2, aspect: f32) {
+        let (right, up) = self.right_up();
+        let half_height = self.distance * (FOV_Y / 2.0).tan();
+        let under_cursor = self.target
+            + right * cursor_ndc.x * half_height * aspect
+            + up * cursor_ndc.y * half_height;
+        self.target += (under_cursor - self.target) * (1.0 - factor);
+        self.distance = (self.distance * factor).max(1e-3);
+    }
+
+    /// Look at a sphere so that it fills the view.
+    pub fn frame(&mut self, centre: Vec3, radius: f32) {
+        self.target = centre;
+        self.distance = radius.max(1e-3) / (FOV_Y / 2.0).sin() * 1.1;
+    }
+}
+
+/// A projection from world space to a viewport rectangle in points.
+#[derive(Clone, Copy, Debug)]
+pub struct ScreenProjection {
+    pub view_projection: Mat4,
+    /// Viewport origin and size, in egui points.
+    pub origin: Vec2,
+    pub size: Vec2,
+}
+
+impl ScreenProjection {
+    /// Screen position of `point`, or `None` behind the camera.
+    pub fn project(&self, point: Vec3) -> Option<Vec2> {
+        let clip = self.view_projection * point.extend(1.0);
+        if clip.w <= 1e-6 {
+            return None;
+        }
+        let ndc = clip.xy() / clip.w;
+        Some(self.origin + Vec2::new((ndc.x + 1.0) / 2.0, (1.0 - ndc.y) / 2.0) * self.size)
+    }
+
+    /// Normalised device coordinates of a screen position.
+    pub fn to_ndc(&self, screen: Vec2) -> Vec2 {
+        let unit = (screen - self.origin) / self.size.max(Vec2::ONE);
+        Vec2::new(unit.x * 2.0 - 1.0, 1.0 - unit.y * 2.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn target_projects_to_the_viewport_centre() {
+        let camera = OrbitCamera::default();
+        let projection = ScreenProjection {
+            view_projection: camera.view_projection(2.0),
+            origin: Vec2::new(10.0, 20.0),
+            size: Vec2::new(200.0, 100.0),
+        };
+        let centre = projection.project(camera.target).unwrap();
+        assert!((centre - Vec2::new(110.0, 70.0)).length() < 1e-3);
+    }
+
+    #[test]
+    fn zoom_keeps_the_target_when_the_cursor_is_centred() {
+        let mut camera = OrbitCamera::default();
+        camera.zoom_towards(0.5, Vec2::ZERO, 1.0);
+        assert_eq!(camera.target, Vec3::ZERO);
+        assert!((camera.distance - 2.5).abs() < 1e-6);
+    }
+}

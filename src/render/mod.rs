@@ -1,0 +1,14 @@
+//! Viewport drawing for the editor through egui_wgpu paint callbacks. Each
+//! renderer is paired with its WGSL file in `shaders/render_*.wgsl`:
+//! - [`mesh`]: the deformed mesh (deformation in the vertex shader) and readback;
+//! - [`cage`]: the cage's edges and handles;
+//! - [`viewport`]: buffers, the offscreen target and compositing into egui;
+//! - [`camera`]: the orbit camera and screen projection (no GPU).
+
+pub mod cage;
+pub mod camera;
+pub mod mesh;
+pub mod viewport;
+
+pub use camera::{OrbitCamera, ScreenProjection};
+pub use viewport::{FrameParams, RenderError, SceneUpload, ViewportCallback, ViewportRenderer};
