@@ -154,6 +154,11 @@ fn existing_output_survives_a_failure_and_is_replaced_on_success() {
     let good = write(dir.path(), "good.obj", TETRA);
     let bad = write(dir.path(), "bad.obj", &TETRA.replace("f 2 3 4\n", ""));
     let out = write(dir.path(), "w.npy", "precious");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+    }
     let output = pmvc(&[
         "bind",
         "--mesh",
@@ -187,6 +192,15 @@ fn existing_output_survives_a_failure_and_is_replaced_on_success() {
     ]);
     assert!(output.status.success(), "{}", stderr(&output));
     assert!(std::fs::read(&out).unwrap().starts_with(b"\x93NUMPY"));
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(
+            mode, 0o640,
+            "the replaced file keeps its permissions, got {mode:o}"
+        );
+    }
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .filter_map(|e| e.ok())

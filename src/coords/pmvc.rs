@@ -116,8 +116,12 @@ pub fn pmvc_weights(
                 ];
                 let row_depth = v * depth.y + depth.z;
                 let row = j * resolution;
-                for i in columns.clone() {
-                    let u = table.centres[i];
+                let texels = row + columns.start..row + columns.end;
+                let nearest = &mut scratch.nearest[texels.clone()];
+                let hits = &mut scratch.hit_triangle[texels];
+                for ((&u, nearest), hit) in
+                    table.centres[columns.clone()].iter().zip(nearest).zip(hits)
+                {
                     // Exact per texel: a shared edge gives exactly negated values in its
                     // two triangles, so no ray slips between them.
                     let inside = (u * edges[0].x + row_offsets[0] >= 0.0)
@@ -125,10 +129,9 @@ pub fn pmvc_weights(
                         & (u * edges[2].x + row_offsets[2] >= 0.0);
                     // 1/t of the hit, linear in (u, v); larger is nearer.
                     let inverse_t = u * depth.x + row_depth;
-                    let texel = row + i;
-                    if inside & (inverse_t > scratch.nearest[texel]) {
-                        scratch.nearest[texel] = inverse_t;
-                        scratch.hit_triangle[texel] = t as u32;
+                    if inside & (inverse_t > *nearest) {
+                        *nearest = inverse_t;
+                        *hit = t as u32;
                     }
                 }
             }
