@@ -3,9 +3,11 @@
 use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{self, classify_points, Cage, MeshFile, PointClasses};
+use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Duration;
 
 /// A mesh, its validated cage, and where each mesh vertex lies.
@@ -66,35 +68,40 @@ pub(super) fn compute_weights(input: &BoundInput, choice: &MethodChoice) -> Resu
         method: choice.method.into(),
         resolution: choice.resolution,
     };
-    match choice.backend {
-        BackendArg::Gpu => {
-            bail!("--backend gpu: GPU binding is not available in this build; use --backend cpu")
-        }
-        BackendArg::Auto | BackendArg::Cpu => {}
-    }
+    let backend = choose_backend(choice.backend)?;
     let points = &input.mesh.mesh.positions;
-    let progress = BindProgress::default();
     let bar = progress_bar(points.len() as u64, options.method);
-    let weights = std::thread::scope(|scope| {
-        let job = scope.spawn(|| {
-            bind_cpu(
-                points,
-                &input.classes.classes,
-                &input.cage,
-                options,
-                &progress,
-            )
-        });
-        while !job.is_finished() {
-            bar.set_position(progress.done() as u64);
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        job.join()
-    });
+    let bind_input = BindInput {
+        points: points.clone(),
+        classes: input.classes.classes.clone(),
+        cage: input.cage.clone(),
+        options,
+    };
+    let handle = Binder::new(backend).start(bind_input);
+    while !handle.is_finished() {
+        bar.set_position(handle.progress().0 as u64);
+        std::thread::sleep(Duration::from_millis(50));
+    }
     bar.finish_and_clear();
-    match weights {
-        Ok(result) => Ok(result?),
-        Err(_) => bail!("internal error: the binding thread panicked"),
+    let output = handle.wait()?;
+    output
+        .weights
+        .context("internal error: the bind returned no CPU weights")
+}
+
+/// `auto` binds on a hardware GPU when there is one. With only a software adapter
+/// (lavapipe, llvmpipe) the CPU path is faster (docs/benchmarks.md), so it uses that.
+pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
+    match choice {
+        BackendArg::Cpu => Ok(Backend::Cpu),
+        BackendArg::Gpu => {
+            let context = GpuContext::new().context("--backend gpu")?;
+            Ok(Backend::Gpu(Arc::new(context)))
+        }
+        BackendArg::Auto => match GpuContext::new() {
+            Ok(context) if !context.is_software() => Ok(Backend::Gpu(Arc::new(context))),
+            _ => Ok(Backend::Cpu),
+        },
     }
 }
 
@@ -306,4 +313,9 @@ pub fn read_npy(path: &Path) -> Result<Weights> {
         cols: cols as usize,
         values,
     })
+}
+
+pub(super) fn info() -> Result<()> {
+    print!("{}", crate::gpu::adapters_report());
+    Ok(())
 }

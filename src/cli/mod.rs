@@ -1,4 +1,4 @@
-//! The `pmvc` command line: `bind`, `deform`, `check`, `bench` and `generate`.
+//! The `pmvc` command line: `bind`, `deform`, `check`, `bench`, `generate` and `info`.
 //!
 //! Errors are reported as one line on stderr naming the file, with exit status 1.
 //! Outputs are written through a temporary file, so an existing output survives a
@@ -31,6 +31,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Write one of the procedural benchmark scenes as OBJ files.
     Generate(GenerateArgs),
+    /// List GPU adapters, the one binding would use, and the limits that matter.
+    Info,
 }
 
 /// Which coordinates to compute.
@@ -151,6 +153,7 @@ pub fn main() -> ExitCode {
         Some(Command::Check(args)) => commands::check(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Generate(args)) => commands::generate(&args),
+        Some(Command::Info) => commands::info(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
