@@ -54,6 +54,36 @@ pub fn pmvc_weights(
     out: &mut [f64],
     scratch: &mut PmvcScratch,
 ) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has just been checked to support AVX2.
+        return unsafe { pmvc_weights_avx2(x, cage, table, out, scratch) };
+    }
+    pmvc_weights_any_cpu(x, cage, table, out, scratch)
+}
+
+/// The same code compiled for AVX2, so that the texel loops are vectorised four
+/// wide. Rust never fuses multiply-adds on its own, so the results are bit-identical.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn pmvc_weights_avx2(
+    x: DVec3,
+    cage: &Cage,
+    table: &TexelTable,
+    out: &mut [f64],
+    scratch: &mut PmvcScratch,
+) -> bool {
+    pmvc_weights_any_cpu(x, cage, table, out, scratch)
+}
+
+#[inline(always)]
+fn pmvc_weights_any_cpu(
+    x: DVec3,
+    cage: &Cage,
+    table: &TexelTable,
+    out: &mut [f64],
+    scratch: &mut PmvcScratch,
+) -> bool {
     let resolution = table.resolution as usize;
     let texels = resolution * resolution;
     out.fill(0.0);
@@ -177,6 +207,7 @@ pub fn pmvc_weights(
 /// Texel index ranges (along `right`, along `up`) covering the projection of the
 /// triangle onto `face`, or `None` when it lies entirely behind or beside the face.
 /// Conservative: the exact per-texel test decides.
+#[inline(always)]
 fn texel_bounds(local: &[DVec3; 3], table: &TexelTable) -> Option<(Range<usize>, Range<usize>)> {
     let (mut u_min, mut u_max, mut v_min, mut v_max) = (
         f64::INFINITY,
@@ -224,6 +255,7 @@ fn texel_bounds(local: &[DVec3; 3], table: &TexelTable) -> Option<(Range<usize>,
 }
 
 /// Texels whose centres may lie in `[low, high]`, widened by one texel against rounding.
+#[inline(always)]
 fn index_range(low: f64, high: f64, table: &TexelTable) -> Range<usize> {
     let resolution = table.resolution as f64;
     // Texel i has its centre at −1 + (2i + 1)/R. The index is ≥ −0.5 after clamping,
@@ -241,6 +273,7 @@ struct FaceFrame {
 }
 
 impl FaceFrame {
+    #[inline(always)]
     fn new(face: &super::cubemap::CubeFace) -> Self {
         let axis = |direction: DVec3| {
             let index = (0..3).find(|&k| direction[k] != 0.0).expect("a unit axis");
@@ -252,6 +285,7 @@ impl FaceFrame {
     }
 
     /// `(p·right, p·up, p·normal)`.
+    #[inline(always)]
     fn local(&self, p: DVec3) -> DVec3 {
         let [(r, rs), (u, us), (n, ns)] = self.axes;
         DVec3::new(p[r] * rs, p[u] * us, p[n] * ns)
@@ -260,6 +294,7 @@ impl FaceFrame {
 
 /// True when the whole triangle (in face coordinates, `z` along the face normal) is
 /// on the outer side of one of the face frustum's planes `z = 0`, `x = ±z`, `y = ±z`.
+#[inline(always)]
 fn outside_frustum(local: &[DVec3; 3]) -> bool {
     let outcode = |p: &DVec3| {
         u8::from(p.z <= 0.0)
