@@ -305,3 +305,23 @@ fn outside_frustum(local: &[DVec3; 3]) -> bool {
     };
     outcode(&local[0]) & outcode(&local[1]) & outcode(&local[2]) != 0
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::procedural;
+
+    /// The AVX2 build and the portable one run the same code; they must agree bit for bit.
+    #[test]
+    fn every_code_path_gives_identical_weights() {
+        let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
+        let table = TexelTable::new(16);
+        for x in procedural::points_inside(&cage, 20, 9, 1e-3) {
+            let mut dispatched = vec![0.0; cage.vertex_count()];
+            let mut portable = vec![0.0; cage.vertex_count()];
+            assert!(pmvc_weights(x, &cage, &table, &mut dispatched, &mut PmvcScratch::default()));
+            assert!(pmvc_weights_any_cpu(x, &cage, &table, &mut portable, &mut PmvcScratch::default()));
+            assert_eq!(dispatched, portable);
+        }
+    }
+}
