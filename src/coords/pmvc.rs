@@ -319,8 +319,20 @@ mod tests {
         for x in procedural::points_inside(&cage, 20, 9, 1e-3) {
             let mut dispatched = vec![0.0; cage.vertex_count()];
             let mut portable = vec![0.0; cage.vertex_count()];
-            assert!(pmvc_weights(x, &cage, &table, &mut dispatched, &mut PmvcScratch::default()));
-            assert!(pmvc_weights_any_cpu(x, &cage, &table, &mut portable, &mut PmvcScratch::default()));
+            assert!(pmvc_weights(
+                x,
+                &cage,
+                &table,
+                &mut dispatched,
+                &mut PmvcScratch::default()
+            ));
+            assert!(pmvc_weights_any_cpu(
+                x,
+                &cage,
+                &table,
+                &mut portable,
+                &mut PmvcScratch::default()
+            ));
             assert_eq!(dispatched, portable);
         }
     }
