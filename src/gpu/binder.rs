@@ -436,8 +436,9 @@ impl<'a> GpuBind<'a> {
         let limit = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
+        // Corner sums per triangle, for the whole sphere and for the current band.
         let sums_per_row = if method == Method::Pmvc {
-            triangles * 3
+            6 * triangles
         } else {
             0
         };
@@ -491,7 +492,6 @@ impl<'a> GpuBind<'a> {
                 table
                     .solid_angle_over_length
                     .iter()
-                    .chain(&table.centres)
                     .map(|&v| v as f32)
                     .collect()
             } else {
