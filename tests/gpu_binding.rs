@@ -345,3 +345,46 @@ fn bench_comb_15k() {
     eprintln!("CPU PMVC R=32: {:?} wall", started.elapsed());
     assert_agree("bench", &input, &actual, &expected);
 }
+
+#[test]
+fn a_resident_matrix_beyond_the_limits_is_an_error() {
+    let Some(context) = test_context("too large") else {
+        return;
+    };
+    let cage = pmvc::geometry::procedural::icosphere(1.0, 3);
+    let limit = context.limits.max_storage_buffer_binding_size;
+    let rows = (limit / (4 * cage.vertex_count() as u64)) as usize + 1;
+    let input = BindInput {
+        points: vec![DVec3::splat(5.0); rows],
+        classes: vec![PointClass::Outside; rows],
+        cage,
+        options: BindOptions::default(),
+    };
+    let config = BindConfig {
+        cpu_weights: false,
+        gpu_buffer: true,
+        batch: BatchSize::default(),
+    };
+    let result = bind_blocking(&input, &Backend::Gpu(context), config);
+    assert!(
+        matches!(
+            result,
+            Err(BindError::Gpu(pmvc::gpu::GpuError::TooLarge { .. }))
+        ),
+        "{result:?}"
+    );
+}
+
+#[test]
+fn a_lost_device_is_an_error_not_a_panic() {
+    if test_context("device loss").is_none() {
+        return;
+    }
+    // A device of its own: destroying the shared one would break the other tests.
+    let context = Arc::new(GpuContext::new().expect("a second device"));
+    let cage = cube_cage(1.0);
+    let input = input(&cage, points_inside(&cage, 50, 11, 1e-3), Method::Pmvc);
+    context.device.destroy();
+    let result = bind_blocking(&input, &Backend::Gpu(context), BindConfig::default());
+    assert!(matches!(result, Err(BindError::Gpu(_))), "{result:?}");
+}

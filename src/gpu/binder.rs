@@ -22,7 +22,6 @@ use rayon::prelude::*;
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
-use wgpu::util::DeviceExt;
 
 /// Wall time per GPU batch that adaptive batching aims for.
 pub const DEFAULT_BATCH_TARGET: Duration = Duration::from_millis(75);
@@ -286,6 +285,9 @@ fn run(
                 },
             })
         }
+        Backend::Gpu(_) if !config.cpu_weights && !config.gpu_buffer => Err(
+            BindError::InvalidInput("the bind keeps neither CPU nor GPU weights".into()),
+        ),
         Backend::Gpu(context) => {
             let mut output = GpuBind::new(context, input, config)?.run(progress)?;
             output.stats.elapsed = started.elapsed();
@@ -469,12 +471,16 @@ impl<'a> GpuBind<'a> {
 
         scoped(&context.device, || {
             let device = &context.device;
+            // Not `create_buffer_init`: it panics when the device is lost.
             let storage = |label: &str, contents: &[u8]| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
+                    size: contents.len() as u64,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                context.queue.write_buffer(&buffer, 0, contents);
+                buffer
             };
             let positions: Vec<[f32; 4]> = input
                 .cage
