@@ -9,6 +9,7 @@ use pmvc::geometry::{classify_points, Cage, PointClass};
 use pmvc::gpu::{
     bind_blocking, Backend, BatchSize, BindConfig, BindError, BindInput, Binder, GpuContext,
 };
+use std::io::Write as _;
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -29,7 +30,11 @@ fn test_context(test: &str) -> Option<Arc<GpuContext>> {
             if std::env::var("PMVC_REQUIRE_GPU").is_ok_and(|v| v == "1") {
                 panic!("PMVC_REQUIRE_GPU=1 but no GPU: {error}");
             }
-            eprintln!("{test}: not run, no GPU adapter ({error})");
+            // Straight to stderr: the harness captures `eprintln!`, and a skip should show.
+            let _ = writeln!(
+                std::io::stderr(),
+                "{test}: not run, no GPU adapter ({error})"
+            );
             None
         }
     }
