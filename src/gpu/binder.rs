@@ -453,6 +453,23 @@ impl<'a> GpuBind<'a> {
             }
             .into());
         }
+        let cage_bytes = [
+            ("the cage positions", byte_len::<[f32; 4]>(cols)),
+            (
+                "the cage topology",
+                byte_len::<u32>(6 * triangles + cols + 1),
+            ),
+        ];
+        for (what, needed) in cage_bytes {
+            if needed > limit {
+                return Err(GpuError::TooLarge {
+                    what,
+                    needed,
+                    limit,
+                }
+                .into());
+            }
+        }
         let max_groups = limits.max_compute_workgroups_per_dimension as usize;
         let dispatch_cap = if method == Method::Pmvc {
             max_groups
