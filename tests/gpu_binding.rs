@@ -404,3 +404,17 @@ fn a_lost_device_is_an_error_not_a_panic() {
     let result = bind_blocking(&input, &Backend::Gpu(context), BindConfig::default());
     assert!(matches!(result, Err(BindError::Gpu(_))), "{result:?}");
 }
+
+#[test]
+fn the_adapters_report_names_the_choice_and_the_limits() {
+    let report = pmvc::gpu::adapters_report();
+    eprintln!("{report}");
+    assert!(report.contains("chosen:"), "{report}");
+    if let Some(context) = test_context("adapters report") {
+        assert!(report.contains(&context.info.name), "{report}");
+        assert!(
+            report.contains("max storage buffer binding size"),
+            "{report}"
+        );
+    }
+}
