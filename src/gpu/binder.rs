@@ -626,11 +626,16 @@ impl<'a> GpuBind<'a> {
         };
         let mut batch_rows = match self.config.batch {
             BatchSize::Fixed(rows) => rows,
-            // Small first batches: the first one also pays for shader compilation.
-            BatchSize::Adaptive { .. } => match self.input.options.method {
-                Method::Pmvc => 8,
-                Method::Mvc => 256,
-            },
+            // A first guess that keeps the first batch short even for large cages:
+            // a row costs about one triangle loop (MVC) or a few hundred per
+            // triangle (PMVC: bounds walks over the cube map).
+            BatchSize::Adaptive { .. } => {
+                let triangles = self.input.cage.triangles.len().max(1);
+                match self.input.options.method {
+                    Method::Pmvc => 2048 / triangles,
+                    Method::Mvc => 65536 / triangles,
+                }
+            }
         }
         .clamp(1, self.capacity);
         let mut start = 0;
