@@ -289,12 +289,9 @@ fn cancel_returns_within_a_batch_without_a_result() {
     };
     let cage = comb();
     let input = input(&cage, points_inside(&cage, 3000, 8, 1e-3), Method::Pmvc);
-    let binder = Binder::new(Backend::Gpu(context)).with_config(BindConfig {
-        batch: BatchSize::Fixed(20),
-        ..BindConfig::default()
-    });
-    let handle = binder.start(input);
-    while handle.progress().0 < 40 && !handle.is_finished() {
+    // Adaptive batches of about 75 ms.
+    let handle = Binder::new(Backend::Gpu(context)).start(input);
+    while handle.progress().0 < 100 && !handle.is_finished() {
         std::thread::sleep(Duration::from_millis(1));
     }
     let cancelled_at = Instant::now();
@@ -308,7 +305,8 @@ fn cancel_returns_within_a_batch_without_a_result() {
     );
     assert!(done_at_cancel < 3000, "the bind finished before the cancel");
     eprintln!("  cancel took {waited:?}");
-    assert!(waited < Duration::from_secs(5), "cancel took {waited:?}");
+    // One batch, with room for other tests' batches queued on the shared device.
+    assert!(waited < Duration::from_secs(2), "cancel took {waited:?}");
 }
 
 #[test]
