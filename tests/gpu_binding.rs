@@ -8,6 +8,7 @@ use pmvc::geometry::procedural::{comb_outline, cube_cage, extrude, points_inside
 use pmvc::geometry::{classify_points, Cage, PointClass};
 use pmvc::gpu::{
     bind_blocking, Backend, BatchSize, BindConfig, BindError, BindInput, Binder, GpuContext,
+    GpuWeights,
 };
 use std::io::Write as _;
 use std::sync::{Arc, OnceLock};
@@ -231,7 +232,12 @@ fn resident_gpu_weights_match_the_readback() {
     let weights = output.weights.expect("CPU weights requested");
     let resident = output.gpu_weights.expect("GPU weights requested");
     assert_eq!((resident.rows, resident.cols), (weights.rows, weights.cols));
-    let bytes = (weights.values.len() * 4) as u64;
+    assert_eq!(read_resident(&context, &resident), weights);
+}
+
+/// Copy a resident weights matrix back to the CPU.
+fn read_resident(context: &GpuContext, resident: &GpuWeights) -> Weights {
+    let bytes = (resident.rows * resident.cols * 4) as u64;
     let staging = context.device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: bytes,
@@ -250,7 +256,44 @@ fn resident_gpu_weights_match_the_readback() {
         .expect("poll");
     let values: Vec<f32> =
         bytemuck::pod_collect_to_vec(&staging.get_mapped_range(..).expect("mapped"));
-    assert_eq!(values, weights.values);
+    Weights {
+        rows: resident.rows,
+        cols: resident.cols,
+        values,
+    }
+}
+
+#[test]
+fn a_handed_in_device_keeps_the_weights_on_the_gpu_only() {
+    let Some(shared) = test_context("handed-in device") else {
+        return;
+    };
+    // As the editor does with eframe's device and queue.
+    let context = Arc::new(GpuContext::from_device(
+        shared.device.clone(),
+        shared.queue.clone(),
+        shared.info.clone(),
+    ));
+    let cage = star();
+    for method in [Method::Pmvc, Method::Mvc] {
+        let input = input(&cage, mixed_points(&cage, 300, 12), method);
+        let config = BindConfig {
+            cpu_weights: false,
+            gpu_buffer: true,
+            batch: BatchSize::default(),
+        };
+        let output =
+            bind_blocking(&input, &Backend::Gpu(Arc::clone(&context)), config).expect("GPU bind");
+        assert!(output.weights.is_none());
+        let resident = output.gpu_weights.expect("GPU weights requested");
+        let name = format!("handed-in {}", method.name());
+        assert_agree(
+            &name,
+            &input,
+            &read_resident(&context, &resident),
+            &cpu(&input),
+        );
+    }
 }
 
 #[test]
