@@ -3,12 +3,14 @@
 // Follows src/coords/cubemap.rs and src/coords/pmvc.rs exactly: one ray per texel
 // centre, first hit at t > 0 on either side of a triangle, weight Ω/r, spread by the
 // hit's barycentrics. A face is rasterised in bands of rows that fit the
-// workgroup-shared depth buffer. Per band and triangle (threads own triangles):
-//   1. keep the largest inverse depth per texel (atomicMax on its bits: q > 0, so
+// workgroup-shared depth buffer; invocations own triangles. Per band:
+//   1. keep the largest inverse depth q per texel (atomicMax on its bits: q > 0, so
 //      the u32 order of the bits is the float order);
-//   2. among the triangles reaching that depth keep the lowest index, as the CPU's
-//      strict `>` does;
-//   3. each owner adds Ω/|d| · E_k / det of the texels it won to its triangle's sums.
+//   2. every triangle reaching that depth claims the texel (atomicMin of its index,
+//      as the CPU's strict `>` keeps the lowest) and adds Ω/|d| · E_k / det to its
+//      corner sums for the band;
+//   3. if two triangles reached the same depth somewhere in the band (rare: a ray
+//      exactly through a shared edge), the band's sums are redone from the claims.
 // Finally each cage vertex gathers its incident triangles' sums and the row is
 // normalised by its total (Σ_k E_k/det · Ω/|d| = w, so the row sum is Σ w).
 
@@ -36,11 +38,12 @@ const FAR: f32 = 1e30;
 // 3 corners per triangle, then incidence offsets (vertex_count + 1), then incident
 // corners as triangle * 3 + corner.
 @group(0) @binding(2) var<storage, read> topology: array<u32>;
-// Ω/|d| per texel of one face (row-major, j is the row), then the R texel centres.
+// Ω/|d| per texel of one face (row-major, j is the row).
 @group(0) @binding(3) var<storage, read> texels: array<f32>;
 // xyz relative to the cage centre; w = output row within the batch.
 @group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
-// Per point and triangle: the three corners' accumulated weights.
+// Per point: the three corner sums of every triangle, then their sums for the
+// current band (6 floats per triangle).
 @group(0) @binding(5) var<storage, read_write> triangle_sums: array<f32>;
 @group(0) @binding(6) var<storage, read_write> weights: array<f32>;
 // Per point: 0, or FALLBACK when too many rays escaped (the CPU redoes the row).
@@ -49,6 +52,8 @@ const FAR: f32 = 1e30;
 var<workgroup> nearest: array<atomic<u32>, BAND_TEXELS>;
 var<workgroup> nearest_triangle: array<atomic<u32>, BAND_TEXELS>;
 var<workgroup> missed: atomic<u32>;
+// Set when two triangles claim a texel of the band.
+var<workgroup> tied: atomic<u32>;
 var<workgroup> partial_totals: array<f32, WORKGROUP_SIZE>;
 
 struct Triangle {
@@ -146,8 +151,10 @@ fn face_setup(tri: Triangle, axes: mat3x3<f32>) -> FaceSetup {
     return setup;
 }
 
+// Computed rather than loaded: storage loads dominate the inner loop on lavapipe.
+// The same expression for every triangle, so shared edges still cancel exactly.
 fn texel_centre(index: u32) -> f32 {
-    return texels[params.resolution * params.resolution + index];
+    return f32(2u * index + 1u) / f32(params.resolution) - 1.0;
 }
 
 // Edge values of texel (i, j); .w is the inverse hit depth, or 0 when the ray misses.
@@ -168,7 +175,8 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let x = points[point].xyz;
     let row = u32(points[point].w);
     let resolution = params.resolution;
-    let sums_base = point * params.triangle_count * 3u;
+    let sums_base = point * params.triangle_count * 6u;
+    let band_base = sums_base + 3u * params.triangle_count;
     for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
         triangle_sums[sums_base + 3u * t] = 0.0;
         triangle_sums[sums_base + 3u * t + 1u] = 0.0;
@@ -187,6 +195,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 atomicStore(&nearest[texel], 0u);
                 atomicStore(&nearest_triangle[texel], NO_TRIANGLE);
             }
+            if lane == 0u {
+                atomicStore(&tied, 0u);
+            }
             workgroupBarrier();
 
             // 1. Nearest inverse depth per texel.
@@ -203,30 +214,44 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             }
             workgroupBarrier();
 
-            // 2. Lowest triangle index at that depth.
-            for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
-                let setup = face_setup(triangle_at(t, x), axes);
-                for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
-                    for (var i = setup.range.x; i < setup.range.y; i++) {
-                        let h = hit(setup, i, j);
-                        let texel = (j - band_start) * resolution + i;
-                        if h.w > 0.0 && bitcast<u32>(h.w) == atomicLoad(&nearest[texel]) {
-                            atomicMin(&nearest_triangle[texel], t);
-                        }
-                    }
-                }
-            }
-            workgroupBarrier();
-
-            // 3. Owners accumulate the texels they won; count the misses.
+            // 2. Claim the texels reached at that depth and sum them, assuming no ties.
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
                 let setup = face_setup(triangle_at(t, x), axes);
                 var sums = vec3<f32>(0.0);
                 for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
                     for (var i = setup.range.x; i < setup.range.y; i++) {
-                        if atomicLoad(&nearest_triangle[(j - band_start) * resolution + i]) == t {
-                            let h = hit(setup, i, j);
+                        let h = hit(setup, i, j);
+                        let texel = (j - band_start) * resolution + i;
+                        if h.w > 0.0 && bitcast<u32>(h.w) == atomicLoad(&nearest[texel]) {
+                            if atomicMin(&nearest_triangle[texel], t) != NO_TRIANGLE {
+                                atomicStore(&tied, 1u);
+                            }
                             sums += (texels[j * resolution + i] * setup.inverse_det) * h.xyz;
+                        }
+                    }
+                }
+                triangle_sums[band_base + 3u * t] = sums.x;
+                triangle_sums[band_base + 3u * t + 1u] = sums.y;
+                triangle_sums[band_base + 3u * t + 2u] = sums.z;
+            }
+            let any_tie = workgroupUniformLoad(&tied) != 0u;
+
+            // 3. Add the band's sums; after a tie, only the lowest claimant's texels.
+            for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
+                var sums = vec3<f32>(
+                    triangle_sums[band_base + 3u * t],
+                    triangle_sums[band_base + 3u * t + 1u],
+                    triangle_sums[band_base + 3u * t + 2u],
+                );
+                if any_tie {
+                    let setup = face_setup(triangle_at(t, x), axes);
+                    sums = vec3<f32>(0.0);
+                    for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
+                        for (var i = setup.range.x; i < setup.range.y; i++) {
+                            if atomicLoad(&nearest_triangle[(j - band_start) * resolution + i]) == t {
+                                let h = hit(setup, i, j);
+                                sums += (texels[j * resolution + i] * setup.inverse_det) * h.xyz;
+                            }
                         }
                     }
                 }

@@ -22,7 +22,6 @@ use rayon::prelude::*;
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
-use wgpu::util::DeviceExt;
 
 /// Wall time per GPU batch that adaptive batching aims for.
 pub const DEFAULT_BATCH_TARGET: Duration = Duration::from_millis(75);
@@ -286,6 +285,9 @@ fn run(
                 },
             })
         }
+        Backend::Gpu(_) if !config.cpu_weights && !config.gpu_buffer => Err(
+            BindError::InvalidInput("the bind keeps neither CPU nor GPU weights".into()),
+        ),
         Backend::Gpu(context) => {
             let mut output = GpuBind::new(context, input, config)?.run(progress)?;
             output.stats.elapsed = started.elapsed();
@@ -436,8 +438,9 @@ impl<'a> GpuBind<'a> {
         let limit = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
+        // Corner sums per triangle, for the whole sphere and for the current band.
         let sums_per_row = if method == Method::Pmvc {
-            triangles * 3
+            6 * triangles
         } else {
             0
         };
@@ -449,6 +452,23 @@ impl<'a> GpuBind<'a> {
                 limit,
             }
             .into());
+        }
+        let cage_bytes = [
+            ("the cage positions", byte_len::<[f32; 4]>(cols)),
+            (
+                "the cage topology",
+                byte_len::<u32>(6 * triangles + cols + 1),
+            ),
+        ];
+        for (what, needed) in cage_bytes {
+            if needed > limit {
+                return Err(GpuError::TooLarge {
+                    what,
+                    needed,
+                    limit,
+                }
+                .into());
+            }
         }
         let max_groups = limits.max_compute_workgroups_per_dimension as usize;
         let dispatch_cap = if method == Method::Pmvc {
@@ -468,12 +488,16 @@ impl<'a> GpuBind<'a> {
 
         scoped(&context.device, || {
             let device = &context.device;
+            // Not `create_buffer_init`: it panics when the device is lost.
             let storage = |label: &str, contents: &[u8]| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
+                    size: contents.len() as u64,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                context.queue.write_buffer(&buffer, 0, contents);
+                buffer
             };
             let positions: Vec<[f32; 4]> = input
                 .cage
@@ -491,7 +515,6 @@ impl<'a> GpuBind<'a> {
                 table
                     .solid_angle_over_length
                     .iter()
-                    .chain(&table.centres)
                     .map(|&v| v as f32)
                     .collect()
             } else {
@@ -603,11 +626,16 @@ impl<'a> GpuBind<'a> {
         };
         let mut batch_rows = match self.config.batch {
             BatchSize::Fixed(rows) => rows,
-            // Small first batches: the first one also pays for shader compilation.
-            BatchSize::Adaptive { .. } => match self.input.options.method {
-                Method::Pmvc => 8,
-                Method::Mvc => 256,
-            },
+            // A first guess that keeps the first batch short even for large cages:
+            // a row costs about one triangle loop (MVC) or a few hundred per
+            // triangle (PMVC: bounds walks over the cube map).
+            BatchSize::Adaptive { .. } => {
+                let triangles = self.input.cage.triangles.len().max(1);
+                match self.input.options.method {
+                    Method::Pmvc => 2048 / triangles,
+                    Method::Mvc => 65536 / triangles,
+                }
+            }
         }
         .clamp(1, self.capacity);
         let mut start = 0;
