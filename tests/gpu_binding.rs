@@ -362,47 +362,6 @@ fn cpu_backend_runs_through_the_binder() {
     assert_eq!(output.weights.expect("weights"), cpu(&input));
 }
 
-/// PMVC R=32 and MVC for 15,000 points (or `PMVC_BENCH_POINTS`) in a 112-vertex
-/// comb, GPU (adaptive batches, or `PMVC_BENCH_BATCH` rows each) against CPU:
-/// `cargo test --release --test gpu_binding -- --ignored --nocapture bench`.
-#[test]
-#[ignore = "benchmark"]
-fn bench_comb_15k() {
-    let Some(context) = test_context("bench") else {
-        return;
-    };
-    let cage = extrude(&comb_outline(14, 1.0, 0.25, 4.0), -0.5, 0.5);
-    let count = std::env::var("PMVC_BENCH_POINTS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(15_000);
-    let points = points_inside(&cage, count, 10, 1e-3);
-    eprintln!(
-        "comb: {} cage vertices, {} triangles, {} points",
-        cage.vertex_count(),
-        cage.triangles.len(),
-        points.len()
-    );
-    for method in [Method::Pmvc, Method::Mvc] {
-        let input = input(&cage, points.clone(), method);
-        let started = Instant::now();
-        let batch = std::env::var("PMVC_BENCH_BATCH")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .map_or(BatchSize::default(), BatchSize::Fixed);
-        let actual = gpu(&context, &input, batch);
-        eprintln!("GPU {} R=32: {:?} wall", method.name(), started.elapsed());
-        let started = Instant::now();
-        let expected = cpu(&input);
-        eprintln!("CPU {} R=32: {:?} wall", method.name(), started.elapsed());
-        assert_agree(
-            &format!("bench {}", method.name()),
-            &input,
-            &actual,
-            &expected,
-        );
-    }
-}
 #[test]
 fn a_resident_matrix_beyond_the_limits_is_an_error() {
     let Some(context) = test_context("too large") else {
