@@ -21,6 +21,7 @@ impl Cage {
     }
 
     /// Corner positions of triangle `t`.
+    #[inline]
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
         self.triangles[t].map(|i| self.positions[i as usize])
     }

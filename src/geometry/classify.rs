@@ -33,9 +33,19 @@ pub struct PointClasses {
 /// Classify every point against the cage (in parallel).
 pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
     let tolerance = SURFACE_TOLERANCE * cage.diagonal();
+    // Unit normal and offset of each triangle's plane: a point farther than the
+    // tolerance from the plane cannot be on the triangle, which spares most
+    // closest-point computations.
+    let planes: Vec<(DVec3, f64)> = (0..cage.triangles.len())
+        .map(|t| {
+            let [a, b, c] = cage.triangle(t);
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            (normal, normal.dot(a))
+        })
+        .collect();
     let classes: Vec<PointClass> = points
         .par_iter()
-        .map(|&x| classify_point(cage, x, tolerance))
+        .map(|&x| classify_point(cage, &planes, x, tolerance))
         .collect();
     let outside = classes
         .iter()
@@ -46,9 +56,12 @@ pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
     PointClasses { classes, outside }
 }
 
-fn classify_point(cage: &Cage, x: DVec3, tolerance: f64) -> PointClass {
+fn classify_point(cage: &Cage, planes: &[(DVec3, f64)], x: DVec3, tolerance: f64) -> PointClass {
     let tolerance_squared = tolerance * tolerance;
-    for t in 0..cage.triangles.len() {
+    for (t, &(normal, offset)) in planes.iter().enumerate() {
+        if (normal.dot(x) - offset).abs() > tolerance && normal != DVec3::ZERO {
+            continue;
+        }
         let [a, b, c] = cage.triangle(t);
         let (closest, barycentric) = closest_point_on_triangle(x, a, b, c);
         if closest.distance_squared(x) <= tolerance_squared {
@@ -69,8 +82,8 @@ fn classify_point(cage: &Cage, x: DVec3, tolerance: f64) -> PointClass {
 /// and Strackee). 1 inside an outward cage, 0 outside.
 pub fn generalized_winding_number(cage: &Cage, x: DVec3) -> f64 {
     let mut total = 0.0;
-    for t in 0..cage.triangles.len() {
-        let [a, b, c] = cage.triangle(t).map(|p| p - x);
+    for corners in &cage.triangles {
+        let [a, b, c] = corners.map(|i| cage.positions[i as usize] - x);
         let (la, lb, lc) = (a.length(), b.length(), c.length());
         let numerator = a.dot(b.cross(c));
         let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;

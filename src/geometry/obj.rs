@@ -110,7 +110,6 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let (models, _materials) = tobj::load_obj_buf(&mut ordinal_text.as_bytes(), &options, |_| {
         Ok((Vec::new(), Default::default()))

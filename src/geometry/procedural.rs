@@ -295,3 +295,92 @@ fn cage_from(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Cage {
         triangle_faces,
     }
 }
+
+/// Split the longest edge of a closed outline at its midpoint until it has `count`
+/// vertices: keeps the shape and hits an exact vertex count.
+pub fn refine_outline(outline: &[DVec2], count: usize) -> Vec<DVec2> {
+    let mut refined = outline.to_vec();
+    while refined.len() < count {
+        let n = refined.len();
+        let longest = (0..n)
+            .max_by(|&a, &b| {
+                let length = |k: usize| refined[k].distance_squared(refined[(k + 1) % n]);
+                length(a).total_cmp(&length(b))
+            })
+            .unwrap_or(0);
+        let midpoint = 0.5 * (refined[longest] + refined[(longest + 1) % n]);
+        refined.insert(longest + 1, midpoint);
+    }
+    refined
+}
+
+/// Like [`extrude`], but the top cap is a low pyramid over the outline's centroid
+/// (one extra vertex). The outline must be star-shaped around its centroid.
+pub fn extrude_with_apex(outline: &[DVec2], z0: f64, z1: f64, apex_height: f64) -> Cage {
+    let n = outline.len() as u32;
+    let mut positions: Vec<DVec3> = outline.iter().map(|p| p.extend(z0)).collect();
+    positions.extend(outline.iter().map(|p| p.extend(z1)));
+    let centroid = outline.iter().copied().sum::<DVec2>() / outline.len() as f64;
+    positions.push(centroid.extend(z1 + apex_height));
+    let apex = 2 * n;
+    let mut triangles = Vec::new();
+    for [a, b, c] in ear_clip(outline) {
+        triangles.push([c, b, a]);
+    }
+    for k in 0..n {
+        let next = (k + 1) % n;
+        triangles.push([k, next, next + n]);
+        triangles.push([k, next + n, k + n]);
+        triangles.push([k + n, next + n, apex]);
+    }
+    cage_from(positions, triangles)
+}
+
+/// A benchmark scene: a non-convex cage and points inside it.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: &'static str,
+    pub cage: Cage,
+    pub points: Vec<DVec3>,
+}
+
+/// Scenes of the sizes in the paper's Table 1, all with non-convex cages:
+/// Armadillo (15,002 vertices, 110 cage vertices), Horse (48,485 in 51),
+/// Hand (24,795 in 252).
+pub fn table1_scenes() -> Vec<Scene> {
+    table1_scene_names()
+        .iter()
+        .map(|name| table1_scene(name).expect("known scene"))
+        .collect()
+}
+
+pub fn table1_scene_names() -> &'static [&'static str] {
+    &["armadillo-size", "horse-size", "hand-size"]
+}
+
+/// One of [`table1_scene_names`], or `None`.
+pub fn table1_scene(name: &str) -> Option<Scene> {
+    let (name, cage, count) = match name {
+        "armadillo-size" => {
+            // A six-prong comb: a body with limbs close together.
+            let outline = refine_outline(&comb_outline(6, 1.0, 0.35, 3.0), 55);
+            ("armadillo-size", extrude(&outline, -0.6, 0.6), 15_002)
+        }
+        "horse-size" => {
+            let outline = refine_outline(&star_outline(5, 0.45, 1.6), 25);
+            (
+                "horse-size",
+                extrude_with_apex(&outline, -0.5, 0.5, 0.3),
+                48_485,
+            )
+        }
+        "hand-size" => {
+            // Five fingers close together, as in the paper's hand.
+            let outline = refine_outline(&comb_outline(5, 0.8, 0.2, 3.5), 126);
+            ("hand-size", extrude(&outline, -0.4, 0.4), 24_795)
+        }
+        _ => return None,
+    };
+    let points = points_inside(&cage, count, 2007, 1e-3);
+    Some(Scene { name, cage, points })
+}

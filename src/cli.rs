@@ -1,5 +1,0 @@
-//! The `pmvc` command line.
-
-pub fn main() -> std::process::ExitCode {
-    std::process::ExitCode::SUCCESS
-}

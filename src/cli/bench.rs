@@ -1,0 +1,255 @@
+//! `pmvc bench`: binding times on scenes of the paper's Table 1 and Table 2 sizes
+//! and on the shared evaluation data, on the CPU and on a GPU adapter. Reports medians over repeated runs, as markdown on
+//! stdout and optionally as JSON.
+
+use crate::coords::{BindOptions, Method};
+use crate::geometry::{self, classify_points, procedural, Cage};
+use crate::gpu::{bind_blocking, Backend, BindConfig, BindInput, GpuContext};
+use anyhow::Result;
+use glam::DVec3;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Timed runs per row; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
+    /// Also write the results as JSON.
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+    /// Folder with X.obj / X_Cage.obj pairs (the shared evaluation data).
+    #[arg(long, default_value = "../shared/data/qmvc")]
+    pub data: PathBuf,
+    /// Skip the shared evaluation data.
+    #[arg(long)]
+    pub no_data: bool,
+    /// Only these scenes (Table 1 names, "table2", or shared-data model names).
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Vec<String>,
+    /// Also time a software GPU adapter (lavapipe/llvmpipe); by default GPU rows
+    /// are run only on a hardware adapter.
+    #[arg(long)]
+    pub software_gpu: bool,
+}
+
+/// One timed configuration.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BenchRow {
+    pub scene: String,
+    pub mesh_vertices: usize,
+    pub cage_vertices: usize,
+    pub method: String,
+    pub backend: String,
+    pub median_seconds: f64,
+    pub runs: Vec<f64>,
+}
+
+/// A backend to time, with the name its rows carry.
+struct Timed {
+    name: String,
+    backend: Backend,
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let threads = rayon::current_num_threads();
+    let mut backends = vec![Timed {
+        name: format!("cpu ({threads} threads)"),
+        backend: Backend::Cpu,
+    }];
+    let adapter = match GpuContext::new() {
+        Ok(context) if !context.is_software() || args.software_gpu => {
+            let name = context.describe();
+            backends.push(Timed {
+                name: name.clone(),
+                backend: Backend::Gpu(Arc::new(context)),
+            });
+            name
+        }
+        Ok(context) => format!(
+            "{} (software; GPU rows skipped, see --software-gpu)",
+            context.describe()
+        ),
+        Err(error) => format!("none ({error})"),
+    };
+    eprintln!(
+        "pmvc bench: {threads} CPU threads, GPU adapter: {adapter}, {} runs per row",
+        args.runs
+    );
+    let wanted = |name: &str| args.scenes.is_empty() || args.scenes.iter().any(|s| s == name);
+
+    let mut rows = Vec::new();
+    let table1 = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Pmvc, 64)];
+    for name in procedural::table1_scene_names() {
+        if let Some(scene) = procedural::table1_scene(name).filter(|_| wanted(name)) {
+            let label = format!("{name} (Table 1)");
+            rows.extend(bench_scene(
+                &label,
+                &scene.cage,
+                &scene.points,
+                &table1,
+                &backends,
+                args.runs,
+            )?);
+        }
+    }
+    if wanted("table2") {
+        // The paper's Table 2: one 24,795-vertex point set in ever finer spherical cages.
+        let finest = procedural::uv_sphere(1.0, 40, 39);
+        let points = procedural::points_inside(&finest, 24_795, 2, 1e-3);
+        for (rings, segments) in [(8, 7), (11, 10), (15, 14), (21, 20), (30, 29), (40, 39)] {
+            let cage = procedural::uv_sphere(1.0, rings, segments);
+            let label = format!("sphere {} (Table 2)", cage.vertex_count());
+            rows.extend(bench_scene(
+                &label,
+                &cage,
+                &points,
+                &[(Method::Pmvc, 32)],
+                &backends,
+                args.runs,
+            )?);
+        }
+    }
+    if !args.no_data {
+        rows.extend(bench_shared_data(args, &wanted, &backends)?);
+    }
+    println!("{}", markdown(&rows));
+    if let Some(path) = &args.json {
+        let json = to_json(&rows, threads, &adapter);
+        geometry::write_atomically(path, |out| out.write_all(json.as_bytes()))?;
+    }
+    Ok(())
+}
+
+fn bench_scene(
+    name: &str,
+    cage: &Cage,
+    points: &[DVec3],
+    configurations: &[(Method, u32)],
+    backends: &[Timed],
+    runs: usize,
+) -> Result<Vec<BenchRow>> {
+    let classes = classify_points(cage, points);
+    let mut rows = Vec::new();
+    for timed in backends {
+        for &(method, resolution) in configurations {
+            let input = BindInput {
+                points: points.to_vec(),
+                classes: classes.classes.clone(),
+                cage: cage.clone(),
+                options: BindOptions { method, resolution },
+            };
+            let mut times = Vec::with_capacity(runs);
+            for _ in 0..runs.max(1) {
+                // Wall time of the whole bind: uploads and readbacks included.
+                let start = Instant::now();
+                bind_blocking(&input, &timed.backend, BindConfig::default())?;
+                times.push(start.elapsed().as_secs_f64());
+            }
+            let label = match method {
+                Method::Mvc => "MVC".to_owned(),
+                Method::Pmvc => format!("PMVC {resolution}²"),
+            };
+            let row = BenchRow {
+                scene: name.to_owned(),
+                mesh_vertices: points.len(),
+                cage_vertices: cage.vertex_count(),
+                method: label,
+                backend: timed.name.clone(),
+                median_seconds: median(&times),
+                runs: times,
+            };
+            eprintln!(
+                "  {} | {} | {}: {:.3} s",
+                row.scene, row.method, row.backend, row.median_seconds
+            );
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+fn bench_shared_data(
+    args: &BenchArgs,
+    wanted: &dyn Fn(&str) -> bool,
+    backends: &[Timed],
+) -> Result<Vec<BenchRow>> {
+    let Ok(entries) = std::fs::read_dir(&args.data) else {
+        eprintln!(
+            "pmvc bench: {} not found; shared-data rows not run",
+            args.data.display()
+        );
+        return Ok(Vec::new());
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(|entry| entry.ok()?.file_name().into_string().ok())
+        .filter_map(|name| name.strip_suffix("_Cage.obj").map(str::to_owned))
+        .filter(|name| wanted(name))
+        .collect();
+    names.sort();
+    let mut rows = Vec::new();
+    for name in names {
+        let mesh = geometry::load_mesh(&args.data.join(format!("{name}.obj")))?;
+        let (cage, _) = geometry::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
+        let configurations = [(Method::Mvc, 0), (Method::Pmvc, 32)];
+        rows.extend(bench_scene(
+            &name,
+            &cage,
+            &mesh.mesh.positions,
+            &configurations,
+            backends,
+            args.runs,
+        )?);
+    }
+    Ok(rows)
+}
+
+fn median(times: &[f64]) -> f64 {
+    let mut sorted = times.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    }
+}
+
+pub fn markdown(rows: &[BenchRow]) -> String {
+    let mut text = String::from("| scene | mesh vertices | cage vertices | method | backend | median (s) |\n|---|---:|---:|---|---|---:|\n");
+    for row in rows {
+        text.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.3} |\n",
+            row.scene,
+            row.mesh_vertices,
+            row.cage_vertices,
+            row.method,
+            row.backend,
+            row.median_seconds
+        ));
+    }
+    text
+}
+
+#[derive(serde::Serialize)]
+struct BenchReport<'a> {
+    command: String,
+    cpu_threads: usize,
+    gpu_adapter: &'a str,
+    rows: &'a [BenchRow],
+}
+
+fn to_json(rows: &[BenchRow], threads: usize, adapter: &str) -> String {
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let report = BenchReport {
+        command,
+        cpu_threads: threads,
+        gpu_adapter: adapter,
+        rows,
+    };
+    serde_json::to_string_pretty(&report).expect("bench rows serialise") + "\n"
+}

@@ -1,0 +1,321 @@
+//! The work behind each subcommand.
+
+use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
+use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
+use crate::geometry::{self, classify_points, Cage, MeshFile, PointClasses};
+use crate::gpu::{Backend, BindInput, Binder, GpuContext};
+use anyhow::{bail, Context, Result};
+use glam::DVec3;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// A mesh, its validated cage, and where each mesh vertex lies.
+pub(super) struct BoundInput {
+    pub mesh: MeshFile,
+    pub cage: Cage,
+    pub classes: PointClasses,
+}
+
+/// Load and validate the inputs, printing the cage's notices and the outside count.
+pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> {
+    let mesh = geometry::load_mesh(&input.mesh)?;
+    let (cage, report) = geometry::load_cage(&input.cage)?;
+    for message in report.messages() {
+        eprintln!("pmvc: {}: {message}", input.cage.display());
+    }
+    let classes = classify_points(&cage, &mesh.mesh.positions);
+    if !classes.outside.is_empty() {
+        let summary = outside_summary(&classes, mesh.mesh.positions.len());
+        if strict {
+            bail!(
+                "{}: {summary} of {} (--strict)",
+                input.mesh.display(),
+                input.cage.display()
+            );
+        }
+        eprintln!(
+            "pmvc: {}: warning: {summary} of {}; they get MVC weights, which are finite, reproduce the rest pose and meet PMVC continuously on the cage",
+            input.mesh.display(),
+            input.cage.display()
+        );
+    }
+    Ok(BoundInput {
+        mesh,
+        cage,
+        classes,
+    })
+}
+
+fn outside_summary(classes: &PointClasses, total: usize) -> String {
+    let first: Vec<String> = classes.outside.iter().take(5).map(u32::to_string).collect();
+    let more = if classes.outside.len() > 5 {
+        ", …"
+    } else {
+        ""
+    };
+    format!(
+        "{} of {total} vertices ({:.2}%) lie outside the cage (first: {}{more})",
+        classes.outside.len(),
+        100.0 * classes.outside.len() as f64 / total.max(1) as f64,
+        first.join(", ")
+    )
+}
+
+/// Compute the weights with the chosen backend, showing progress on a terminal.
+pub(super) fn compute_weights(input: &BoundInput, choice: &MethodChoice) -> Result<Weights> {
+    let options = BindOptions {
+        method: choice.method.into(),
+        resolution: choice.resolution,
+    };
+    let backend = choose_backend(choice.backend)?;
+    let points = &input.mesh.mesh.positions;
+    let bar = progress_bar(points.len() as u64, options.method);
+    let bind_input = BindInput {
+        points: points.clone(),
+        classes: input.classes.classes.clone(),
+        cage: input.cage.clone(),
+        options,
+    };
+    let handle = Binder::new(backend).start(bind_input);
+    while !handle.is_finished() {
+        bar.set_position(handle.progress().0 as u64);
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    bar.finish_and_clear();
+    let output = handle.wait()?;
+    output
+        .weights
+        .context("internal error: the bind returned no CPU weights")
+}
+
+/// `auto` binds on a hardware GPU when there is one. With only a software adapter
+/// (lavapipe, llvmpipe) the CPU path is faster (docs/benchmarks.md), so it uses that.
+pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
+    match choice {
+        BackendArg::Cpu => Ok(Backend::Cpu),
+        BackendArg::Gpu => {
+            let context = GpuContext::new().context("--backend gpu")?;
+            Ok(Backend::Gpu(Arc::new(context)))
+        }
+        BackendArg::Auto => match GpuContext::new() {
+            Ok(context) if !context.is_software() => Ok(Backend::Gpu(Arc::new(context))),
+            _ => Ok(Backend::Cpu),
+        },
+    }
+}
+
+/// A progress bar on stderr when it is a terminal; hidden otherwise.
+pub(super) fn progress_bar(total: u64, method: Method) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(total),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{msg} {wide_bar} {pos}/{len} vertices, {elapsed} (ETA {eta})",
+    ) {
+        bar.set_style(style);
+    }
+    bar.set_message(format!("binding ({})", method.name()));
+    bar
+}
+
+pub(super) fn bind(args: &BindArgs) -> Result<()> {
+    let input = load_input(&args.input, args.method.strict)?;
+    let weights = compute_weights(&input, &args.method)?;
+    write_npy(&args.out, &weights)?;
+    Ok(())
+}
+
+pub(super) fn deform(args: &DeformArgs) -> Result<()> {
+    let input = load_input(&args.input, args.method.strict)?;
+    let pose = geometry::load_mesh(&args.deformed_cage)?;
+    let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
+    if found != expected {
+        bail!(
+            "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
+            args.deformed_cage.display(),
+            args.input.cage.display()
+        );
+    }
+    let weights = match &args.weights {
+        Some(path) => {
+            let weights = read_npy(path)?;
+            let rows = input.mesh.mesh.positions.len();
+            if (weights.rows, weights.cols) != (rows, expected) {
+                bail!(
+                    "{}: weights have shape ({}, {}), but the mesh has {rows} vertices and the cage {expected}",
+                    path.display(),
+                    weights.rows,
+                    weights.cols
+                );
+            }
+            weights
+        }
+        None => compute_weights(&input, &args.method)?,
+    };
+    let deformed: Vec<DVec3> = weights.apply(&pose.mesh.positions);
+    geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+    Ok(())
+}
+
+pub(super) fn check(args: &CheckArgs) -> Result<()> {
+    let mesh = geometry::load_mesh(&args.input.mesh)?;
+    println!(
+        "mesh  {}: {} vertices, {} triangles{}",
+        args.input.mesh.display(),
+        mesh.mesh.positions.len(),
+        mesh.mesh.triangles.len(),
+        if mesh.mesh.triangles.is_empty() {
+            " (a point set)"
+        } else {
+            ""
+        }
+    );
+    let (cage, report) = geometry::load_cage(&args.input.cage)?;
+    println!(
+        "cage  {}: {} vertices, {} triangles, closed, edge-manifold, consistently oriented",
+        args.input.cage.display(),
+        cage.vertex_count(),
+        cage.triangles.len()
+    );
+    println!(
+        "      volume {:.6}, faces point {}, diagonal {:.6}",
+        report.volume,
+        if report.flipped {
+            "inward (flipped to outward)"
+        } else {
+            "outward"
+        },
+        cage.diagonal()
+    );
+    for message in report.messages() {
+        println!("      {message}");
+    }
+    let classes = classify_points(&cage, &mesh.mesh.positions);
+    let on_surface = classes
+        .classes
+        .iter()
+        .filter(|c| matches!(c, geometry::PointClass::OnSurface { .. }))
+        .count();
+    if classes.outside.is_empty() {
+        println!(
+            "inside: all {} mesh vertices ({} on the cage surface)",
+            mesh.mesh.positions.len(),
+            on_surface
+        );
+    } else {
+        println!(
+            "outside: {}",
+            outside_summary(&classes, mesh.mesh.positions.len())
+        );
+    }
+
+    // MVC negativity on an evenly spaced sample of inside vertices.
+    let inside: Vec<usize> = (0..mesh.mesh.positions.len())
+        .filter(|&i| matches!(classes.classes[i], geometry::PointClass::Inside))
+        .collect();
+    let step = (inside.len() / args.sample.max(1)).max(1);
+    let sample: Vec<usize> = inside
+        .iter()
+        .step_by(step)
+        .copied()
+        .take(args.sample)
+        .collect();
+    let points: Vec<DVec3> = sample.iter().map(|&i| mesh.mesh.positions[i]).collect();
+    let sample_classes: Vec<_> = sample.iter().map(|&i| classes.classes[i]).collect();
+    let options = BindOptions {
+        method: Method::Mvc,
+        resolution: 1,
+    };
+    let weights = bind_cpu(
+        &points,
+        &sample_classes,
+        &cage,
+        options,
+        &BindProgress::default(),
+    )?;
+    let negative_rows = (0..weights.rows)
+        .filter(|&r| weights.row(r).iter().any(|&w| w < 0.0))
+        .count();
+    println!(
+        "MVC on {} sampled inside vertices: {:.1}% have a negative weight, most negative {:.4}",
+        weights.rows,
+        100.0 * negative_rows as f64 / weights.rows.max(1) as f64,
+        weights.min().min(0.0)
+    );
+    Ok(())
+}
+
+pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
+    let scene = geometry::procedural::table1_scene(&args.scene).context("unknown scene")?;
+    let points = geometry::TriMesh {
+        positions: scene.points,
+        ..Default::default()
+    };
+    let cage = geometry::TriMesh {
+        positions: scene.cage.positions,
+        triangles: scene.cage.triangles,
+        ..Default::default()
+    };
+    geometry::write_obj(&args.mesh, &points)?;
+    geometry::write_obj(&args.cage, &cage)?;
+    println!(
+        "{}: {} mesh vertices in a {}-vertex cage",
+        scene.name,
+        points.positions.len(),
+        cage.positions.len()
+    );
+    Ok(())
+}
+
+/// Write weights as .npy v1: little-endian float32, C order, shape (rows, cols).
+pub fn write_npy(path: &Path, weights: &Weights) -> Result<()> {
+    use npyz::WriterBuilder;
+    let dtype = npyz::DType::new_scalar("<f4".parse().expect("valid type string"));
+    geometry::write_atomically(path, |out| {
+        let mut writer = npyz::WriteOptions::<f32>::new()
+            .dtype(dtype)
+            .shape(&[weights.rows as u64, weights.cols as u64])
+            .writer(out)
+            .begin_nd()?;
+        writer.extend(weights.values.iter().copied())?;
+        writer.finish()
+    })?;
+    Ok(())
+}
+
+/// Read weights written by [`write_npy`] (or NumPy): float32, C order, two dimensions.
+pub fn read_npy(path: &Path) -> Result<Weights> {
+    let file =
+        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let npy = npyz::NpyFile::new(std::io::BufReader::new(file))
+        .with_context(|| format!("{}: not a .npy file", path.display()))?;
+    let shape = npy.shape().to_vec();
+    let [rows, cols] = shape[..] else {
+        bail!(
+            "{}: expected a 2-D weights array, found shape {shape:?}",
+            path.display()
+        );
+    };
+    if npy.order() != npyz::Order::C {
+        bail!("{}: expected C (row-major) order", path.display());
+    }
+    let dtype = npy.dtype().descr();
+    let values: Vec<f32> = npy.into_vec().with_context(|| {
+        format!(
+            "{}: expected float32 weights, found dtype {dtype}",
+            path.display()
+        )
+    })?;
+    Ok(Weights {
+        rows: rows as usize,
+        cols: cols as usize,
+        values,
+    })
+}
+
+pub(super) fn info() -> Result<()> {
+    print!("{}", crate::gpu::adapters_report());
+    Ok(())
+}

@@ -1,0 +1,165 @@
+//! The `pmvc` command line: `bind`, `deform`, `check`, `bench`, `generate` and `info`.
+//!
+//! Errors are reported as one line on stderr naming the file, with exit status 1.
+//! Outputs are written through a temporary file, so an existing output survives a
+//! failure.
+
+mod bench;
+mod commands;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Cage-based mesh deformation with positive mean value coordinates.
+#[derive(Debug, Parser)]
+#[command(name = "pmvc", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Compute the weights of every mesh vertex with respect to the cage and write them as .npy.
+    Bind(BindArgs),
+    /// Move every mesh vertex to Σ λᵢ c̃ᵢ for a deformed cage and write the mesh as OBJ.
+    Deform(DeformArgs),
+    /// Validate a mesh and its cage and print statistics.
+    Check(CheckArgs),
+    /// Time binding on scenes of the paper's sizes and on the shared evaluation data.
+    Bench(bench::BenchArgs),
+    /// Write one of the procedural benchmark scenes as OBJ files.
+    Generate(GenerateArgs),
+    /// List GPU adapters, the one binding would use, and the limits that matter.
+    Info,
+}
+
+/// Which coordinates to compute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Mean value coordinates, closed form (may be negative in non-convex cages).
+    Mvc,
+    /// Positive mean value coordinates, integrated over a cube map.
+    Pmvc,
+}
+
+impl From<MethodArg> for crate::coords::Method {
+    fn from(method: MethodArg) -> Self {
+        match method {
+            MethodArg::Mvc => Self::Mvc,
+            MethodArg::Pmvc => Self::Pmvc,
+        }
+    }
+}
+
+/// Where binding runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
+    /// The faster path for this machine.
+    Auto,
+    /// Rayon-parallel CPU reference.
+    Cpu,
+    /// wgpu compute kernels.
+    Gpu,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct CageInput {
+    /// The mesh to deform (.obj or .off). A file with vertices and no faces is a point set.
+    #[arg(long, value_name = "MESH")]
+    pub mesh: PathBuf,
+    /// The cage: a closed, consistently oriented triangle or polygon mesh (.obj or .off).
+    #[arg(long, value_name = "CAGE")]
+    pub cage: PathBuf,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct MethodChoice {
+    /// Coordinates to compute.
+    #[arg(long, value_enum, default_value_t = MethodArg::Pmvc)]
+    pub method: MethodArg,
+    /// PMVC cube-map resolution: texels along one face edge (1–1024).
+    #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub resolution: u32,
+    /// Where binding runs.
+    #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
+    pub backend: BackendArg,
+    /// Treat mesh vertices outside the cage as an error instead of giving them MVC weights.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct BindArgs {
+    #[command(flatten)]
+    pub input: CageInput,
+    #[command(flatten)]
+    pub method: MethodChoice,
+    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order.
+    #[arg(long, value_name = "W.npy")]
+    pub out: PathBuf,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct DeformArgs {
+    #[command(flatten)]
+    pub input: CageInput,
+    /// The cage in its new pose: same vertices in the same order as --cage.
+    #[arg(long, value_name = "CAGE2")]
+    pub deformed_cage: PathBuf,
+    #[command(flatten)]
+    pub method: MethodChoice,
+    /// Use weights from `pmvc bind` instead of computing them (--method and --resolution are then ignored).
+    #[arg(long, value_name = "W.npy")]
+    pub weights: Option<PathBuf>,
+    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are dropped.
+    #[arg(long, value_name = "M2.obj")]
+    pub out: PathBuf,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub input: CageInput,
+    /// Mesh vertices sampled for the MVC negativity statistic.
+    #[arg(long, default_value_t = 2000)]
+    pub sample: usize,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct GenerateArgs {
+    /// Scene name.
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(crate::geometry::procedural::table1_scene_names()))]
+    pub scene: String,
+    /// Output mesh (a point set) as OBJ.
+    #[arg(long)]
+    pub mesh: PathBuf,
+    /// Output cage as OBJ.
+    #[arg(long)]
+    pub cage: PathBuf,
+}
+
+/// Entry point of the binary: parse, run, report.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => {
+            use clap::CommandFactory;
+            Cli::command().print_help().map_err(anyhow::Error::from)
+        }
+        Some(Command::Bind(args)) => commands::bind(&args),
+        Some(Command::Deform(args)) => commands::deform(&args),
+        Some(Command::Check(args)) => commands::check(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Generate(args)) => commands::generate(&args),
+        Some(Command::Info) => commands::info(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("pmvc: error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

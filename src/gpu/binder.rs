@@ -1,0 +1,919 @@
+//! A bind as a job: CPU (via [`coords::bind_cpu`]) or GPU, on a background thread,
+//! with monotone progress, cancellation and no partial results.
+//!
+//! GPU binds run in batches of rows sized to about [`DEFAULT_BATCH_TARGET`] each on
+//! the adapter in use (each batch is timed and the next one resized), so progress
+//! moves smoothly and a cancel takes effect within one batch. Every batch is read
+//! back into the CPU matrix and/or copied into a resident GPU matrix, so device
+//! buffers stay within `max_storage_buffer_binding_size` whatever the mesh size.
+//!
+//! The GPU computes the rows of `Inside` points. The CPU (f64, [`coords::weights_at`])
+//! fills the rows of points on the surface or outside, and redoes the rows the
+//! kernels flag: PMVC points whose rays escape, MVC points too close to a cage
+//! vertex, triangle or triangle plane for f32.
+
+use super::context::GpuContext;
+use super::kernels::{Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
+use super::GpuError;
+use crate::coords::{self, cubemap::TexelTable, BindOptions, BindProgress, Method, Weights};
+use crate::geometry::{bounds_of, Cage, PointClass};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Wall time per GPU batch that adaptive batching aims for.
+pub const DEFAULT_BATCH_TARGET: Duration = Duration::from_millis(75);
+/// Largest share of the device limits one batch buffer may take.
+const MAX_BATCH_BUFFER_BYTES: u64 = 64 << 20;
+
+/// Where a bind runs.
+#[derive(Clone, Debug)]
+pub enum Backend {
+    Cpu,
+    Gpu(Arc<GpuContext>),
+}
+
+/// How many rows each GPU batch binds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BatchSize {
+    /// Time each batch and resize the next towards this wall time.
+    Adaptive { target: Duration },
+    /// Exactly this many rows per batch (clamped to the device limits); for tests.
+    Fixed(usize),
+}
+
+impl Default for BatchSize {
+    fn default() -> Self {
+        BatchSize::Adaptive {
+            target: DEFAULT_BATCH_TARGET,
+        }
+    }
+}
+
+/// What a bind keeps, and how it batches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BindConfig {
+    /// Read the weights back into [`BindOutput::weights`].
+    pub cpu_weights: bool,
+    /// Keep the weights in a GPU storage buffer ([`BindOutput::gpu_weights`]); GPU
+    /// backend only.
+    pub gpu_buffer: bool,
+    pub batch: BatchSize,
+}
+
+impl Default for BindConfig {
+    fn default() -> Self {
+        Self {
+            cpu_weights: true,
+            gpu_buffer: false,
+            batch: BatchSize::default(),
+        }
+    }
+}
+
+/// Everything a bind reads; owned so that it can move to the worker thread.
+#[derive(Clone, Debug)]
+pub struct BindInput {
+    pub points: Vec<DVec3>,
+    /// From [`crate::geometry::classify_points`] for the same points and cage.
+    pub classes: Vec<PointClass>,
+    pub cage: Cage,
+    pub options: BindOptions,
+}
+
+/// Dense row-major f32 weights (same layout as [`Weights`]) in a GPU buffer with
+/// `STORAGE | COPY_SRC | COPY_DST` usage.
+#[derive(Clone, Debug)]
+pub struct GpuWeights {
+    pub buffer: wgpu::Buffer,
+    pub rows: usize,
+    pub cols: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BindStats {
+    /// Wall time of the whole bind, uploads and readbacks included.
+    pub elapsed: Duration,
+    pub batches: usize,
+    /// Rows computed by the GPU kernels.
+    pub gpu_rows: usize,
+    /// Rows computed on the CPU: on the surface, outside, or flagged by a kernel.
+    pub cpu_rows: usize,
+    /// Where it ran.
+    pub device: String,
+}
+
+#[derive(Debug)]
+pub struct BindOutput {
+    pub weights: Option<Weights>,
+    pub gpu_weights: Option<GpuWeights>,
+    pub stats: BindStats,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BindError {
+    #[error("binding was cancelled")]
+    Cancelled,
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error("invalid bind input: {0}")]
+    InvalidInput(String),
+    #[error("the binding thread panicked")]
+    Panicked,
+}
+
+impl From<coords::Cancelled> for BindError {
+    fn from(_: coords::Cancelled) -> Self {
+        BindError::Cancelled
+    }
+}
+
+/// Starts binds on a backend.
+#[derive(Clone, Debug)]
+pub struct Binder {
+    pub backend: Backend,
+    pub config: BindConfig,
+}
+
+impl Binder {
+    pub fn new(backend: Backend) -> Self {
+        Self {
+            backend,
+            config: BindConfig::default(),
+        }
+    }
+
+    pub fn with_config(mut self, config: BindConfig) -> Self {
+        self.config = config;
+        self
+    }
+
+    /// Start binding on a background thread.
+    pub fn start(&self, input: BindInput) -> BindHandle {
+        let progress = Arc::new(BindProgress::default());
+        let total = input.points.len();
+        let worker_progress = Arc::clone(&progress);
+        let backend = self.backend.clone();
+        let config = self.config;
+        let thread = std::thread::Builder::new()
+            .name("pmvc-bind".into())
+            .spawn(move || run(&input, &backend, config, &worker_progress));
+        match thread {
+            Ok(thread) => BindHandle {
+                progress,
+                total,
+                thread: Some(thread),
+                early: None,
+            },
+            Err(error) => BindHandle {
+                progress,
+                total,
+                thread: None,
+                early: Some(Err(BindError::InvalidInput(format!(
+                    "could not start the binding thread: {error}"
+                )))),
+            },
+        }
+    }
+
+    /// Bind on the calling thread.
+    pub fn bind_blocking(&self, input: &BindInput) -> Result<BindOutput, BindError> {
+        run(input, &self.backend, self.config, &BindProgress::default())
+    }
+}
+
+/// Bind synchronously; for the command line and `pmvc bench` (the elapsed time in
+/// [`BindStats`] includes uploads and readbacks).
+pub fn bind_blocking(
+    input: &BindInput,
+    backend: &Backend,
+    config: BindConfig,
+) -> Result<BindOutput, BindError> {
+    run(input, backend, config, &BindProgress::default())
+}
+
+/// A running bind. Dropping it cancels the bind.
+#[derive(Debug)]
+pub struct BindHandle {
+    progress: Arc<BindProgress>,
+    total: usize,
+    thread: Option<JoinHandle<Result<BindOutput, BindError>>>,
+    /// A result known before any thread ran.
+    early: Option<Result<BindOutput, BindError>>,
+}
+
+impl BindHandle {
+    /// `(done, total)` mesh vertices; `done` never decreases.
+    pub fn progress(&self) -> (usize, usize) {
+        (self.progress.done().min(self.total), self.total)
+    }
+
+    /// Ask the bind to stop; it ends with [`BindError::Cancelled`] within one batch.
+    pub fn cancel(&self) {
+        self.progress.cancel();
+    }
+
+    pub fn is_finished(&self) -> bool {
+        self.thread.as_ref().is_none_or(JoinHandle::is_finished)
+    }
+
+    /// The result once finished; `None` while running or after it was taken.
+    pub fn try_take(&mut self) -> Option<Result<BindOutput, BindError>> {
+        if let Some(result) = self.early.take() {
+            return Some(result);
+        }
+        if !self.thread.as_ref()?.is_finished() {
+            return None;
+        }
+        self.thread.take().map(join)
+    }
+
+    /// Wait for the result.
+    pub fn wait(mut self) -> Result<BindOutput, BindError> {
+        if let Some(result) = self.early.take() {
+            return result;
+        }
+        match self.thread.take() {
+            Some(thread) => join(thread),
+            None => Err(BindError::InvalidInput(
+                "the result was already taken".into(),
+            )),
+        }
+    }
+}
+
+impl Drop for BindHandle {
+    fn drop(&mut self) {
+        if self.thread.is_some() {
+            self.progress.cancel();
+        }
+    }
+}
+
+fn join(thread: JoinHandle<Result<BindOutput, BindError>>) -> Result<BindOutput, BindError> {
+    thread.join().unwrap_or(Err(BindError::Panicked))
+}
+
+fn run(
+    input: &BindInput,
+    backend: &Backend,
+    config: BindConfig,
+    progress: &BindProgress,
+) -> Result<BindOutput, BindError> {
+    validate(input)?;
+    let started = Instant::now();
+    match backend {
+        Backend::Cpu => {
+            let weights = coords::bind_cpu(
+                &input.points,
+                &input.classes,
+                &input.cage,
+                input.options,
+                progress,
+            )?;
+            Ok(BindOutput {
+                weights: Some(weights),
+                gpu_weights: None,
+                stats: BindStats {
+                    elapsed: started.elapsed(),
+                    batches: 1,
+                    gpu_rows: 0,
+                    cpu_rows: input.points.len(),
+                    device: "CPU".into(),
+                },
+            })
+        }
+        Backend::Gpu(_) if !config.cpu_weights && !config.gpu_buffer => Err(
+            BindError::InvalidInput("the bind keeps neither CPU nor GPU weights".into()),
+        ),
+        Backend::Gpu(context) => {
+            let mut output = GpuBind::new(context, input, config)?.run(progress)?;
+            output.stats.elapsed = started.elapsed();
+            Ok(output)
+        }
+    }
+}
+
+fn validate(input: &BindInput) -> Result<(), BindError> {
+    let invalid = |message: String| Err(BindError::InvalidInput(message));
+    if input.points.len() != input.classes.len() {
+        return invalid(format!(
+            "{} points but {} classes",
+            input.points.len(),
+            input.classes.len()
+        ));
+    }
+    let vertices = input.cage.vertex_count();
+    let triangles = input.cage.triangles.len();
+    if let Some(t) = input
+        .cage
+        .triangles
+        .iter()
+        .position(|corners| corners.iter().any(|&c| c as usize >= vertices))
+    {
+        return invalid(format!("cage triangle {t} has a corner out of range"));
+    }
+    let on_missing_triangle = input.classes.iter().any(
+        |c| matches!(c, PointClass::OnSurface { triangle, .. } if *triangle as usize >= triangles),
+    );
+    if on_missing_triangle {
+        return invalid("a point is classed on a triangle the cage does not have".into());
+    }
+    if input.options.method == Method::Pmvc && input.options.resolution == 0 {
+        return invalid("the cube-map resolution must be positive".into());
+    }
+    if input.points.iter().any(|p| !p.is_finite())
+        || input.cage.positions.iter().any(|p| !p.is_finite())
+    {
+        return invalid("coordinates must be finite".into());
+    }
+    Ok(())
+}
+
+/// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`].
+fn cpu_rows(input: &BindInput, table: &TexelTable, rows: &[usize]) -> Vec<f32> {
+    let cols = input.cage.vertex_count();
+    let mut out = vec![0.0f32; rows.len() * cols];
+    out.par_chunks_mut(cols.max(1))
+        .zip(rows.par_iter())
+        .for_each_init(
+            || {
+                (
+                    vec![0.0f64; cols],
+                    coords::mvc::MvcScratch::default(),
+                    coords::pmvc::PmvcScratch::default(),
+                )
+            },
+            |(row_f64, mvc, pmvc), (out_row, &row)| {
+                coords::weights_at(
+                    input.points[row],
+                    input.classes[row],
+                    &input.cage,
+                    input.options.method,
+                    table,
+                    row_f64,
+                    mvc,
+                    pmvc,
+                );
+                for (out, &value) in out_row.iter_mut().zip(row_f64.iter()) {
+                    *out = value as f32;
+                }
+            },
+        );
+    out
+}
+
+/// Device buffers and state of one GPU bind.
+struct GpuBind<'a> {
+    context: &'a GpuContext,
+    input: &'a BindInput,
+    config: BindConfig,
+    table: TexelTable,
+    centre: DVec3,
+    rows: usize,
+    cols: usize,
+    capacity: usize,
+    params: Params,
+    bind_group: wgpu::BindGroup,
+    params_buffer: wgpu::Buffer,
+    points_buffer: wgpu::Buffer,
+    weights_buffer: wgpu::Buffer,
+    status_buffer: wgpu::Buffer,
+    weights_readback: Option<wgpu::Buffer>,
+    status_readback: wgpu::Buffer,
+    resident: Option<wgpu::Buffer>,
+}
+
+fn byte_len<T>(count: usize) -> u64 {
+    (count * std::mem::size_of::<T>()).max(16) as u64
+}
+
+/// Pop an error scope, turning a captured error into a [`GpuError`].
+fn pop_scope(scope: wgpu::ErrorScopeGuard) -> Result<(), GpuError> {
+    match pollster::block_on(scope.pop()) {
+        Some(error) => Err(error.into()),
+        None => Ok(()),
+    }
+}
+
+/// Run `body` inside out-of-memory and validation error scopes.
+fn scoped<T>(
+    device: &wgpu::Device,
+    body: impl FnOnce() -> Result<T, GpuError>,
+) -> Result<T, GpuError> {
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let result = body();
+    let memory = pop_scope(memory);
+    let validation = pop_scope(validation);
+    let value = result?;
+    memory?;
+    validation?;
+    Ok(value)
+}
+
+impl<'a> GpuBind<'a> {
+    fn new(
+        context: &'a GpuContext,
+        input: &'a BindInput,
+        config: BindConfig,
+    ) -> Result<Self, BindError> {
+        let kernels = context.kernels()?;
+        if let Some(failure) = context.failure() {
+            return Err(failure.into());
+        }
+        let rows = input.points.len();
+        let cols = input.cage.vertex_count();
+        let triangles = input.cage.triangles.len();
+        let method = input.options.method;
+        let resolution = input.options.resolution.max(1);
+        if method == Method::Pmvc && resolution > BAND_TEXELS {
+            return Err(BindError::InvalidInput(format!(
+                "the GPU supports cube-map resolutions up to {BAND_TEXELS}, not {resolution}"
+            )));
+        }
+        let limits = &context.limits;
+        let limit = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        // Corner sums per triangle, for the whole sphere and for the current band.
+        let sums_per_row = if method == Method::Pmvc {
+            6 * triangles
+        } else {
+            0
+        };
+        let widest_row = (cols.max(sums_per_row).max(4) * 4) as u64;
+        if widest_row > limit {
+            return Err(GpuError::TooLarge {
+                what: "one row of the bind",
+                needed: widest_row,
+                limit,
+            }
+            .into());
+        }
+        let cage_bytes = [
+            ("the cage positions", byte_len::<[f32; 4]>(cols)),
+            (
+                "the cage topology",
+                byte_len::<u32>(6 * triangles + cols + 1),
+            ),
+        ];
+        for (what, needed) in cage_bytes {
+            if needed > limit {
+                return Err(GpuError::TooLarge {
+                    what,
+                    needed,
+                    limit,
+                }
+                .into());
+            }
+        }
+        let max_groups = limits.max_compute_workgroups_per_dimension as usize;
+        let dispatch_cap = if method == Method::Pmvc {
+            max_groups
+        } else {
+            max_groups * WORKGROUP_SIZE as usize
+        };
+        let capacity = ((limit.min(MAX_BATCH_BUFFER_BYTES) / widest_row) as usize)
+            .min(dispatch_cap)
+            .min(rows)
+            .max(1);
+
+        let (lo, hi) = bounds_of(&input.cage.positions);
+        // Relative to the cage centre, so f32 keeps the precision of the differences.
+        let centre = 0.5 * (lo + hi);
+        let table = TexelTable::new(resolution);
+
+        scoped(&context.device, || {
+            let device = &context.device;
+            // Not `create_buffer_init`: it panics when the device is lost.
+            let storage = |label: &str, contents: &[u8]| {
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: contents.len() as u64,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                context.queue.write_buffer(&buffer, 0, contents);
+                buffer
+            };
+            let positions: Vec<[f32; 4]> = input
+                .cage
+                .positions
+                .iter()
+                .map(|&p| {
+                    let p = (p - centre).as_vec3();
+                    [p.x, p.y, p.z, 0.0]
+                })
+                .collect();
+            let positions = storage("cage positions", bytemuck::cast_slice(&padded(positions)));
+            let (topology, params) = topology(&input.cage, method, resolution, rows);
+            let topology = storage("cage topology", bytemuck::cast_slice(&padded(topology)));
+            let texels: Vec<f32> = if method == Method::Pmvc {
+                table
+                    .solid_angle_over_length
+                    .iter()
+                    .map(|&v| v as f32)
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let texels = storage("texel table", bytemuck::cast_slice(&padded(texels)));
+            let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            use wgpu::BufferUsages as U;
+            let params_buffer = buffer(
+                "bind params",
+                std::mem::size_of::<Params>() as u64,
+                U::UNIFORM | U::COPY_DST,
+            );
+            let points_buffer = buffer(
+                "bind points",
+                byte_len::<[f32; 4]>(capacity),
+                U::STORAGE | U::COPY_DST,
+            );
+            let sums = buffer(
+                "triangle sums",
+                byte_len::<f32>(capacity * sums_per_row),
+                U::STORAGE,
+            );
+            let weights_bytes = byte_len::<f32>(capacity * cols);
+            let weights_buffer = buffer(
+                "batch weights",
+                weights_bytes,
+                U::STORAGE | U::COPY_SRC | U::COPY_DST,
+            );
+            let status_bytes = byte_len::<u32>(capacity);
+            let status_buffer = buffer("batch status", status_bytes, U::STORAGE | U::COPY_SRC);
+            let weights_readback = config
+                .cpu_weights
+                .then(|| buffer("weights readback", weights_bytes, U::MAP_READ | U::COPY_DST));
+            let status_readback =
+                buffer("status readback", status_bytes, U::MAP_READ | U::COPY_DST);
+            let resident = if config.gpu_buffer {
+                let needed = byte_len::<f32>(rows * cols);
+                let resident_limit = limits
+                    .max_storage_buffer_binding_size
+                    .min(limits.max_buffer_size);
+                if needed > resident_limit {
+                    return Err(GpuError::TooLarge {
+                        what: "the GPU weights matrix",
+                        needed,
+                        limit: resident_limit,
+                    });
+                }
+                Some(buffer(
+                    "weights",
+                    needed,
+                    U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                ))
+            } else {
+                None
+            };
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pmvc bind"),
+                layout: &kernels.layout,
+                entries: &[
+                    entry(0, &params_buffer),
+                    entry(1, &positions),
+                    entry(2, &topology),
+                    entry(3, &texels),
+                    entry(4, &points_buffer),
+                    entry(5, &sums),
+                    entry(6, &weights_buffer),
+                    entry(7, &status_buffer),
+                ],
+            });
+            Ok(Self {
+                context,
+                input,
+                config,
+                table,
+                centre,
+                rows,
+                cols,
+                capacity,
+                params,
+                bind_group,
+                params_buffer,
+                points_buffer,
+                weights_buffer,
+                status_buffer,
+                weights_readback,
+                status_readback,
+                resident,
+            })
+        })
+        .map_err(BindError::from)
+    }
+
+    fn run(self, progress: &BindProgress) -> Result<BindOutput, BindError> {
+        let mut weights = self
+            .config
+            .cpu_weights
+            .then(|| Weights::zeros(self.rows, self.cols));
+        let mut stats = BindStats {
+            device: self.context.describe(),
+            ..BindStats::default()
+        };
+        let mut batch_rows = match self.config.batch {
+            BatchSize::Fixed(rows) => rows,
+            // A first guess that keeps the first batch short even for large cages:
+            // a row costs about one triangle loop (MVC) or a few hundred per
+            // triangle (PMVC: bounds walks over the cube map).
+            BatchSize::Adaptive { .. } => {
+                let triangles = self.input.cage.triangles.len().max(1);
+                match self.input.options.method {
+                    Method::Pmvc => 2048 / triangles,
+                    Method::Mvc => 65536 / triangles,
+                }
+            }
+        }
+        .clamp(1, self.capacity);
+        let mut start = 0;
+        while start < self.rows {
+            if progress.is_cancelled() {
+                return Err(BindError::Cancelled);
+            }
+            let end = (start + batch_rows).min(self.rows);
+            let clock = Instant::now();
+            self.batch(start..end, weights.as_mut(), &mut stats)?;
+            stats.batches += 1;
+            progress.advance(end - start);
+            if let BatchSize::Adaptive { target } = self.config.batch {
+                let elapsed = clock.elapsed().as_secs_f64().max(1e-4);
+                let scale = (target.as_secs_f64() / elapsed).clamp(0.5, 2.0);
+                batch_rows = ((batch_rows as f64 * scale) as usize).clamp(1, self.capacity);
+            }
+            start = end;
+        }
+        if progress.is_cancelled() {
+            return Err(BindError::Cancelled);
+        }
+        if self.resident.is_some() {
+            // Flush the CPU rows written into the resident matrix.
+            scoped(&self.context.device, || {
+                self.context.queue.submit([]);
+                self.wait()
+            })?;
+        }
+        Ok(BindOutput {
+            weights,
+            gpu_weights: self.resident.map(|buffer| GpuWeights {
+                buffer,
+                rows: self.rows,
+                cols: self.cols,
+            }),
+            stats,
+        })
+    }
+
+    fn wait(&self) -> Result<(), GpuError> {
+        self.context
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Internal(e.to_string()))?;
+        match self.context.failure() {
+            Some(failure) => Err(failure),
+            None => Ok(()),
+        }
+    }
+
+    /// Bind rows `range`: CPU rows first, then one dispatch for the inside rows.
+    fn batch(
+        &self,
+        range: std::ops::Range<usize>,
+        mut weights: Option<&mut Weights>,
+        stats: &mut BindStats,
+    ) -> Result<(), GpuError> {
+        let input = self.input;
+        let cols = self.cols;
+        let row_bytes = (cols * 4) as u64;
+        let (inside, cpu): (Vec<usize>, Vec<usize>) = range
+            .clone()
+            .partition(|&row| matches!(input.classes[row], PointClass::Inside));
+        let cpu_values = cpu_rows(input, &self.table, &cpu);
+        stats.cpu_rows += cpu.len();
+        stats.gpu_rows += inside.len();
+        if let Some(weights) = weights.as_deref_mut() {
+            for (k, &row) in cpu.iter().enumerate() {
+                weights.values[row * cols..(row + 1) * cols]
+                    .copy_from_slice(&cpu_values[k * cols..(k + 1) * cols]);
+            }
+        }
+        if inside.is_empty() && self.resident.is_none() {
+            return Ok(());
+        }
+        let queue = &self.context.queue;
+        let flagged = scoped(&self.context.device, || {
+            if self.resident.is_some() {
+                // The batch block is copied whole into the resident matrix.
+                for (k, &row) in cpu.iter().enumerate() {
+                    queue.write_buffer(
+                        &self.weights_buffer,
+                        (row - range.start) as u64 * row_bytes,
+                        bytemuck::cast_slice(&cpu_values[k * cols..(k + 1) * cols]),
+                    );
+                }
+            }
+            let mut encoder =
+                self.context
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("pmvc batch"),
+                    });
+            let status_bytes = (inside.len() * 4) as u64;
+            let block_bytes = range.len() as u64 * row_bytes;
+            if !inside.is_empty() {
+                let points: Vec<[f32; 4]> = inside
+                    .iter()
+                    .map(|&row| {
+                        let p = (input.points[row] - self.centre).as_vec3();
+                        [p.x, p.y, p.z, (row - range.start) as f32]
+                    })
+                    .collect();
+                queue.write_buffer(&self.points_buffer, 0, bytemuck::cast_slice(&points));
+                let params = Params {
+                    point_count: inside.len() as u32,
+                    ..self.params
+                };
+                queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+                let kernels = self.context.kernels()?;
+                {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("pmvc bind"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_bind_group(0, &self.bind_group, &[]);
+                    let groups = match input.options.method {
+                        Method::Pmvc => {
+                            pass.set_pipeline(&kernels.pmvc);
+                            inside.len() as u32
+                        }
+                        Method::Mvc => {
+                            pass.set_pipeline(&kernels.mvc);
+                            (inside.len() as u32).div_ceil(WORKGROUP_SIZE)
+                        }
+                    };
+                    pass.dispatch_workgroups(groups, 1, 1);
+                }
+                encoder.copy_buffer_to_buffer(
+                    &self.status_buffer,
+                    0,
+                    &self.status_readback,
+                    0,
+                    status_bytes,
+                );
+                if let Some(readback) = &self.weights_readback {
+                    encoder.copy_buffer_to_buffer(
+                        &self.weights_buffer,
+                        0,
+                        readback,
+                        0,
+                        block_bytes,
+                    );
+                }
+            }
+            if let Some(resident) = &self.resident {
+                if block_bytes > 0 {
+                    encoder.copy_buffer_to_buffer(
+                        &self.weights_buffer,
+                        0,
+                        resident,
+                        range.start as u64 * row_bytes,
+                        block_bytes,
+                    );
+                }
+            }
+            queue.submit([encoder.finish()]);
+            if inside.is_empty() {
+                return self.wait().map(|()| Vec::new());
+            }
+            let status = read_back(self, &self.status_readback, status_bytes)?;
+            if let (Some(readback), Some(weights)) =
+                (&self.weights_readback, weights.as_deref_mut())
+            {
+                let block = read_back(self, readback, block_bytes)?;
+                for &row in &inside {
+                    let local = row - range.start;
+                    weights.values[row * cols..(row + 1) * cols]
+                        .copy_from_slice(&block[local * cols..(local + 1) * cols]);
+                }
+            }
+            Ok(inside
+                .iter()
+                .zip(&status)
+                .filter(|(_, &s)| s.to_bits() & FALLBACK != 0)
+                .map(|(&row, _)| row)
+                .collect::<Vec<usize>>())
+        })?;
+
+        if !flagged.is_empty() {
+            let values = cpu_rows(input, &self.table, &flagged);
+            stats.cpu_rows += flagged.len();
+            stats.gpu_rows -= flagged.len();
+            for (k, &row) in flagged.iter().enumerate() {
+                let value = &values[k * cols..(k + 1) * cols];
+                if let Some(weights) = weights.as_deref_mut() {
+                    weights.values[row * cols..(row + 1) * cols].copy_from_slice(value);
+                }
+                if let Some(resident) = &self.resident {
+                    queue.write_buffer(
+                        resident,
+                        row as u64 * row_bytes,
+                        bytemuck::cast_slice(value),
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// Non-empty, so that every binding has a size.
+fn padded<T: Default + Clone>(mut values: Vec<T>) -> Vec<T> {
+    if values.is_empty() {
+        values.push(T::default());
+    }
+    values
+}
+
+/// Triangle corners, then the vertex → incident-corner CSR, and the kernel params
+/// that locate them.
+fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u32>, Params) {
+    let triangles = cage.triangles.len();
+    let vertices = cage.vertex_count();
+    let mut topology: Vec<u32> = cage.triangles.iter().flatten().copied().collect();
+    let offsets_at = topology.len();
+    let mut counts = vec![0u32; vertices + 1];
+    for &corner in cage.triangles.iter().flatten() {
+        counts[corner as usize + 1] += 1;
+    }
+    for v in 0..vertices {
+        counts[v + 1] += counts[v];
+    }
+    topology.extend_from_slice(&counts);
+    let entries_at = topology.len();
+    topology.resize(entries_at + 3 * triangles, 0);
+    let mut next = counts;
+    for (t, corners) in cage.triangles.iter().enumerate() {
+        for (k, &corner) in corners.iter().enumerate() {
+            let slot = &mut next[corner as usize];
+            topology[entries_at + *slot as usize] = (3 * t + k) as u32;
+            *slot += 1;
+        }
+    }
+    let texels = f64::from(resolution) * f64::from(resolution);
+    let params = Params {
+        point_count: rows as u32,
+        triangle_count: triangles as u32,
+        vertex_count: vertices as u32,
+        resolution,
+        band_rows: (BAND_TEXELS / resolution).max(1),
+        max_missed: if method == Method::Pmvc {
+            (0.01 * 6.0 * texels).floor() as u32
+        } else {
+            0
+        },
+        incidence_offsets: offsets_at as u32,
+        incidence_entries: entries_at as u32,
+    };
+    (topology, params)
+}
+
+/// Map `buffer`, wait for the device, and copy out its first `bytes` as f32.
+fn read_back(bind: &GpuBind<'_>, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<f32>, GpuError> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, 0..bytes, move |result| {
+        let _ = sender.send(result);
+    });
+    bind.wait()?;
+    match receiver.recv() {
+        Ok(Ok(())) => {}
+        Ok(Err(error)) => return Err(GpuError::Readback(error.to_string())),
+        Err(_) => return Err(GpuError::Readback("the map callback never ran".into())),
+    }
+    let values = {
+        let view = buffer
+            .get_mapped_range(0..bytes)
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        bytemuck::pod_collect_to_vec::<u8, f32>(&view)
+    };
+    buffer.unmap();
+    Ok(values)
+}

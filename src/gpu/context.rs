@@ -1,0 +1,243 @@
+//! The device a bind runs on: chosen here by the adapter policy, or handed in by the
+//! editor so that the weights stay in its GPU memory.
+
+use super::kernels::Kernels;
+use super::GpuError;
+use std::fmt::Write as _;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// A wgpu device and queue with the facts a bind needs about them.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+    /// Set by the device-lost callback and by uncaptured errors on devices made here.
+    failure: Arc<Mutex<Option<GpuError>>>,
+    kernels: OnceLock<Result<Kernels, GpuError>>,
+}
+
+impl std::fmt::Debug for GpuContext {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuContext")
+            .field("adapter", &self.info.name)
+            .field("backend", &self.info.backend)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GpuContext {
+    /// Open a device by the adapter policy of [`choose_adapter`]: `WGPU_BACKEND`
+    /// limits the backends, `WGPU_ADAPTER_NAME` picks by name, otherwise the best
+    /// hardware adapter, and a software one (`DeviceType::Cpu`) only when there is none.
+    pub fn new() -> Result<Self, GpuError> {
+        let instance = make_instance();
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let adapter = choose_adapter(adapters)?;
+        let info = adapter.get_info();
+        let wanted = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("pmvc"),
+            required_limits: wanted,
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::RequestDevice(e.to_string()))?;
+        let failure: Arc<Mutex<Option<GpuError>>> = Arc::default();
+        // The default handlers panic; record the failure instead and report it from
+        // the next operation.
+        let lost = Arc::clone(&failure);
+        device.set_device_lost_callback(move |reason, message| {
+            record(
+                &lost,
+                GpuError::DeviceLost(format!("{reason:?}: {message}")),
+            );
+        });
+        let uncaptured = Arc::clone(&failure);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            record(&uncaptured, GpuError::from(error));
+        }));
+        let limits = device.limits();
+        Ok(Self {
+            device,
+            queue,
+            info,
+            limits,
+            failure,
+            kernels: OnceLock::new(),
+        })
+    }
+
+    /// Wrap a device made elsewhere (the editor's). Its error and device-lost
+    /// handlers are left alone; binds catch their own errors with error scopes.
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let limits = device.limits();
+        Self {
+            device,
+            queue,
+            info,
+            limits,
+            failure: Arc::default(),
+            kernels: OnceLock::new(),
+        }
+    }
+
+    /// The failure recorded by the device's callbacks, if any.
+    pub fn failure(&self) -> Option<GpuError> {
+        self.failure.lock().ok().and_then(|slot| slot.clone())
+    }
+
+    /// Whether this is a software rasteriser (lavapipe, llvmpipe, WARP).
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// One line naming the adapter.
+    pub fn describe(&self) -> String {
+        describe(&self.info)
+    }
+
+    pub(super) fn kernels(&self) -> Result<&Kernels, GpuError> {
+        self.kernels
+            .get_or_init(|| Kernels::new(&self.device))
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+}
+
+fn record(slot: &Mutex<Option<GpuError>>, error: GpuError) {
+    if let Ok(mut slot) = slot.lock() {
+        slot.get_or_insert(error);
+    }
+}
+
+fn make_instance() -> wgpu::Instance {
+    // Reads WGPU_BACKEND (and the other WGPU_* instance variables).
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+/// Lower is better: discrete, integrated, virtual, unknown, then software.
+fn device_rank(device_type: wgpu::DeviceType) -> u8 {
+    match device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+/// Lower is better among adapters of the same kind: native APIs before GL.
+fn backend_rank(backend: wgpu::Backend) -> u8 {
+    match backend {
+        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
+        wgpu::Backend::Gl => 1,
+        _ => 2,
+    }
+}
+
+fn can_compute(adapter: &wgpu::Adapter) -> bool {
+    adapter
+        .get_downlevel_capabilities()
+        .flags
+        .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+}
+
+/// The adapter policy: `WGPU_ADAPTER_NAME` (case-insensitive substring) when set,
+/// else the best compute-capable adapter by kind (high performance first), software
+/// adapters last.
+fn choose_adapter(adapters: Vec<wgpu::Adapter>) -> Result<wgpu::Adapter, GpuError> {
+    let usable: Vec<wgpu::Adapter> = adapters.into_iter().filter(can_compute).collect();
+    if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
+        let wanted = name.to_lowercase();
+        return usable
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+            .ok_or_else(|| {
+                GpuError::NoAdapter(format!("none matches WGPU_ADAPTER_NAME={name:?}"))
+            });
+    }
+    usable
+        .into_iter()
+        .min_by_key(|a| {
+            let info = a.get_info();
+            (device_rank(info.device_type), backend_rank(info.backend))
+        })
+        .ok_or_else(|| GpuError::NoAdapter("no compute-capable adapter found".into()))
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!(
+        "{} ({:?}, {:?}, driver {} {})",
+        info.name, info.device_type, info.backend, info.driver, info.driver_info
+    )
+}
+
+/// Every adapter, the one [`GpuContext::new`] would choose, and the limits that
+/// bound a bind, for `pmvc info`.
+pub fn adapters_report() -> String {
+    let instance = make_instance();
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    let mut report = String::new();
+    let backend_env = std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "(unset)".into());
+    let name_env = std::env::var("WGPU_ADAPTER_NAME").unwrap_or_else(|_| "(unset)".into());
+    let _ = writeln!(
+        report,
+        "GPU adapters (WGPU_BACKEND={backend_env}, WGPU_ADAPTER_NAME={name_env}):"
+    );
+    if adapters.is_empty() {
+        let _ = writeln!(report, "  none");
+    }
+    for adapter in &adapters {
+        let compute = if can_compute(adapter) {
+            ""
+        } else {
+            " [no compute shaders]"
+        };
+        let _ = writeln!(report, "  - {}{compute}", describe(&adapter.get_info()));
+    }
+    match choose_adapter(adapters) {
+        Ok(adapter) => {
+            let limits = adapter.limits();
+            let _ = writeln!(report, "chosen: {}", describe(&adapter.get_info()));
+            let _ = writeln!(
+                report,
+                "  max storage buffer binding size: {} bytes ({} MiB)",
+                limits.max_storage_buffer_binding_size,
+                limits.max_storage_buffer_binding_size >> 20
+            );
+            let _ = writeln!(
+                report,
+                "  max buffer size: {} bytes ({} MiB)",
+                limits.max_buffer_size,
+                limits.max_buffer_size >> 20
+            );
+            let _ = writeln!(
+                report,
+                "  max storage buffers per shader stage: {}",
+                limits.max_storage_buffers_per_shader_stage
+            );
+            let _ = writeln!(
+                report,
+                "  max compute workgroup size: {} x {} x {}, {} invocations",
+                limits.max_compute_workgroup_size_x,
+                limits.max_compute_workgroup_size_y,
+                limits.max_compute_workgroup_size_z,
+                limits.max_compute_invocations_per_workgroup
+            );
+            let _ = writeln!(
+                report,
+                "  max compute workgroups per dimension: {}",
+                limits.max_compute_workgroups_per_dimension
+            );
+            let _ = writeln!(
+                report,
+                "  max compute workgroup storage: {} bytes",
+                limits.max_compute_workgroup_storage_size
+            );
+        }
+        Err(error) => {
+            let _ = writeln!(report, "chosen: none ({error})");
+        }
+    }
+    report
+}

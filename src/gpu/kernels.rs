@@ -1,0 +1,103 @@
+//! Compute pipelines for the binding kernels and the bind group layout they share.
+
+use super::GpuError;
+
+pub(super) const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
+pub(super) const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");
+
+/// Invocations per workgroup in both kernels (`WORKGROUP_SIZE` in the WGSL).
+pub(super) const WORKGROUP_SIZE: u32 = 64;
+/// Texels of the PMVC kernel's shared depth buffer (`BAND_TEXELS` in the WGSL).
+pub(super) const BAND_TEXELS: u32 = 1024;
+/// Status bit the kernels set for rows the CPU must redo.
+pub(super) const FALLBACK: u32 = 1;
+
+/// Uniform block of both kernels (`Params` in the WGSL).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct Params {
+    pub point_count: u32,
+    pub triangle_count: u32,
+    pub vertex_count: u32,
+    pub resolution: u32,
+    pub band_rows: u32,
+    pub max_missed: u32,
+    pub incidence_offsets: u32,
+    pub incidence_entries: u32,
+}
+
+pub(crate) struct Kernels {
+    pub layout: wgpu::BindGroupLayout,
+    pub pmvc: wgpu::ComputePipeline,
+    pub mvc: wgpu::ComputePipeline,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl Kernels {
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pmvc bind"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage_entry(1, true),
+                storage_entry(2, true),
+                storage_entry(3, true),
+                storage_entry(4, true),
+                storage_entry(5, false),
+                storage_entry(6, false),
+                storage_entry(7, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pmvc bind"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |label: &str, source: &str| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let pmvc = pipeline("bind_pmvc", PMVC_SOURCE);
+        let mvc = pipeline("bind_mvc", MVC_SOURCE);
+        if let Some(error) = pollster::block_on(memory.pop()) {
+            return Err(error.into());
+        }
+        if let Some(error) = pollster::block_on(validation.pop()) {
+            return Err(error.into());
+        }
+        Ok(Self { layout, pmvc, mvc })
+    }
+}

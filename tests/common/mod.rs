@@ -1,0 +1,78 @@
+//! Helpers shared by the integration tests: writing scenes to files and running the binary.
+#![allow(dead_code)]
+
+use pmvc::geometry::{procedural, Cage};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+pub fn cage_obj(cage: &Cage) -> String {
+    let mut text = String::new();
+    for p in &cage.positions {
+        text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for [a, b, c] in &cage.triangles {
+        text.push_str(&format!("f {} {} {}\n", a + 1, b + 1, c + 1));
+    }
+    text
+}
+
+pub fn points_obj(points: &[glam::DVec3]) -> String {
+    points
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p.x, p.y, p.z))
+        .collect()
+}
+
+/// A comb cage and points inside it, written to `dir` as cage.obj and mesh.obj.
+pub fn comb_scene(dir: &Path, points: usize) -> (PathBuf, PathBuf, Cage, Vec<glam::DVec3>) {
+    let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
+    let inside = procedural::points_inside(&cage, points, 5, 1e-3);
+    let mesh = write(dir, "mesh.obj", &points_obj(&inside));
+    let cage_path = write(dir, "cage.obj", &cage_obj(&cage));
+    (mesh, cage_path, cage, inside)
+}
+
+pub fn pmvc(args: &[&str]) -> Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
+        .args(args)
+        .output()
+        .expect("run pmvc")
+}
+
+pub fn path_str(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+pub fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// The command failed cleanly: exit status 1, no panic, and an error line naming `file`.
+pub fn assert_clean_failure(output: &Output, file: &str, what: &str) {
+    let text = stderr(output);
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "expected exit 1, stderr: {text}"
+    );
+    assert!(!text.contains("panicked"), "panic: {text}");
+    let error_lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("pmvc: error:"))
+        .collect();
+    assert_eq!(error_lines.len(), 1, "expected one error line: {text}");
+    assert!(
+        error_lines[0].contains(file),
+        "error should name {file}: {text}"
+    );
+    assert!(
+        error_lines[0].contains(what),
+        "error should say '{what}': {text}"
+    );
+}

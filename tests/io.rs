@@ -1,0 +1,123 @@
+//! Reading meshes and cages: file vertex order, polygon triangulation, point sets,
+//! OFF, and inward-facing cages.
+
+mod common;
+use common::*;
+use glam::DVec3;
+use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method};
+use pmvc::geometry::{classify_points, load_cage, load_mesh, procedural};
+
+#[test]
+fn rows_follow_the_files_v_order_across_shuffled_groups() {
+    let dir = tempfile::tempdir().unwrap();
+    // Groups reference vertices out of order, and two vertices share a position:
+    // tobj would renumber each group from 0 in first-use order.
+    let text = "v 0 0 0\nv 1 0 0\no second\nv 0 1 0\nv 0 0 1\nf 4 3 2\ng again\nv 1 0 0\nf 5/1 4/1 1/1\no first\nf 1 2 4\nvt 0 0\n";
+    let path = write(dir.path(), "groups.obj", text);
+    let file = load_mesh(&path).unwrap();
+    let expected_positions = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::X];
+    assert_eq!(file.mesh.positions, expected_positions);
+    assert_eq!(file.mesh.triangles, vec![[3, 2, 1], [4, 3, 0], [0, 1, 3]]);
+    assert_eq!(file.mesh.triangle_faces, vec![0, 1, 2]);
+}
+
+#[test]
+fn quads_are_cut_along_the_shorter_diagonal() {
+    let dir = tempfile::tempdir().unwrap();
+    // Non-planar quad: diagonal 1–3 (√6) is longer than 2–4 (√5).
+    let path = write(
+        dir.path(),
+        "quad.obj",
+        "v 0 0 0\nv 2 0 0\nv 2 1 1\nv 0 1 0\nf 1 2 3 4\n",
+    );
+    let file = load_mesh(&path).unwrap();
+    assert_eq!(file.mesh.triangles, vec![[0, 1, 3], [1, 2, 3]]);
+    // A cube of quads makes a valid cage of 12 triangles.
+    let cube =
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+                f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    let (cage, report) = load_cage(&write(dir.path(), "cube.obj", cube)).unwrap();
+    assert_eq!(cage.triangles.len(), 12);
+    assert!(!report.flipped);
+    assert!((report.volume - 8.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_file_without_faces_is_a_point_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let cage = procedural::cube_cage(1.0);
+    let points = [DVec3::ZERO, DVec3::new(0.5, -0.2, 0.1)];
+    let path = write(dir.path(), "points.obj", &points_obj(&points));
+    let file = load_mesh(&path).unwrap();
+    assert_eq!(file.mesh.positions, points);
+    assert!(file.mesh.triangles.is_empty());
+    let classes = classify_points(&cage, &file.mesh.positions);
+    let weights = bind_cpu(
+        &file.mesh.positions,
+        &classes.classes,
+        &cage,
+        BindOptions::default(),
+        &BindProgress::default(),
+    )
+    .unwrap();
+    assert_eq!((weights.rows, weights.cols), (2, 8));
+}
+
+#[test]
+fn off_and_obj_give_the_same_cage() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = "OFF\n# a tetrahedron\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2 255 0 0\n3 1 2 3\n";
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let (from_off, _) = load_cage(&write(dir.path(), "t.off", off)).unwrap();
+    let (from_obj, _) = load_cage(&write(dir.path(), "t.obj", obj)).unwrap();
+    assert_eq!(from_off, from_obj);
+}
+
+#[test]
+fn an_inward_facing_cage_is_flipped_and_binds_exactly_like_its_outward_twin() {
+    let dir = tempfile::tempdir().unwrap();
+    let outward = procedural::extrude(&procedural::star_outline(5, 0.4, 1.0), -0.3, 0.3);
+    let mut inward = outward.clone();
+    for triangle in &mut inward.triangles {
+        triangle.reverse();
+    }
+    let (outward_cage, outward_report) =
+        load_cage(&write(dir.path(), "out.obj", &cage_obj(&outward))).unwrap();
+    let (inward_cage, inward_report) =
+        load_cage(&write(dir.path(), "in.obj", &cage_obj(&inward))).unwrap();
+    assert!(!outward_report.flipped);
+    assert!(inward_report.flipped);
+    assert!(inward_report.messages()[0].contains("flipped"));
+    assert!(inward_cage.signed_volume() > 0.0);
+    let points = procedural::points_inside(&outward_cage, 50, 1, 1e-3);
+    for method in [Method::Mvc, Method::Pmvc] {
+        let bind = |cage: &pmvc::geometry::Cage| {
+            let classes = classify_points(cage, &points);
+            bind_cpu(
+                &points,
+                &classes.classes,
+                cage,
+                BindOptions {
+                    method,
+                    resolution: 16,
+                },
+                &BindProgress::default(),
+            )
+            .unwrap()
+        };
+        assert_eq!(
+            bind(&inward_cage),
+            bind(&outward_cage),
+            "{method:?} weights differ"
+        );
+    }
+}
+
+#[test]
+fn unreferenced_cage_vertices_are_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 7 7 7\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let (_, report) = load_cage(&write(dir.path(), "t.obj", text)).unwrap();
+    assert_eq!(report.unreferenced, vec![4]);
+    assert!(report.messages()[0].starts_with("warning"));
+}
