@@ -2,12 +2,13 @@
 //! mouse and keyboard handling. GPU work goes through [`crate::render`]; binding
 //! through [`super::jobs`].
 
-use super::jobs::BindJob;
+use super::jobs::{BindJob, BindOutcome, JobError};
 use super::scene::{PoseHistory, Scene};
 use super::scenes::BundledScene;
 use super::EditorOptions;
 use crate::coords::{BindOptions, Method, DEFAULT_RESOLUTION};
 use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
+use crate::gpu::{Backend, GpuContext};
 use crate::render::{
     FrameParams, OrbitCamera, RenderError, SceneUpload, ScreenProjection, ViewportCallback,
     ViewportRenderer,
@@ -94,6 +95,10 @@ pub struct EditorApp {
     screenshot: Option<ScreenshotState>,
     /// Vertices done / total reported by the last bind when it ended.
     pub last_bind_progress: Option<(usize, usize)>,
+    /// Where binds run: the editor's GPU when it is a hardware one, else the CPU.
+    bind_backend: Backend,
+    /// Set when a failed GPU bind should be retried on the CPU next frame.
+    retry_bind: bool,
 }
 
 /// `--screenshot`: wait for the bind, let a few frames settle, capture, quit.
@@ -141,6 +146,11 @@ impl EditorApp {
             projection: None,
             path_input: String::new(),
             last_bind_progress: None,
+            retry_bind: false,
+            bind_backend: cc
+                .wgpu_render_state
+                .as_ref()
+                .map_or(Backend::Cpu, bind_backend_for),
             screenshot: options.screenshot.map(|path| ScreenshotState {
                 path,
                 frames_after_bind: 0,
@@ -251,6 +261,7 @@ impl EditorApp {
             points,
             Arc::clone(&self.scene.cage),
             self.bind_options,
+            self.bind_backend.clone(),
             move || ctx.request_repaint(),
         ));
     }
@@ -291,14 +302,24 @@ impl EditorApp {
         }
     }
 
-    fn finish_bind(&mut self, result: Result<super::jobs::BindOutcome, crate::coords::Cancelled>) {
+    fn finish_bind(&mut self, result: Result<BindOutcome, JobError>) {
         if let Some(job) = self.job.take() {
             self.last_bind_progress = Some((job.done(), job.total()));
         }
         let outcome = match result {
             Ok(outcome) => outcome,
-            Err(_) => {
+            Err(JobError::Cancelled) => {
                 self.info("binding cancelled; the previous weights (if any) stay in use");
+                return;
+            }
+            Err(JobError::Failed(reason)) => {
+                self.error(reason);
+                if matches!(self.bind_backend, Backend::Gpu(_)) {
+                    // The CPU path always works; use it from now on.
+                    self.bind_backend = Backend::Cpu;
+                    self.info("retrying the bind on the CPU");
+                    self.retry_bind = true;
+                }
                 return;
             }
         };
@@ -324,6 +345,7 @@ impl EditorApp {
         self.scene.weights = Some(outcome.weights);
         self.scene.bound_with = Some(outcome.options);
         self.scene.bind_time = Some(outcome.elapsed);
+        self.scene.bind_device = outcome.device;
         self.scene.outside = outcome.outside;
         self.pose_dirty = true;
     }
@@ -1050,10 +1072,11 @@ impl EditorApp {
             ctx.request_repaint_after(Duration::from_millis(100));
         } else if let (Some(time), Some(options)) = (self.scene.bind_time, self.scene.bound_with) {
             ui.label(format!(
-                "Bound with {} (resolution {}) in {:.2} s",
+                "Bound with {} (resolution {}) in {:.2} s on {}",
                 options.method.name(),
                 options.resolution,
-                time.as_secs_f32()
+                time.as_secs_f32(),
+                self.scene.bind_device
             ));
         } else if ui.button("Bind").clicked() {
             self.start_bind(&ctx);
@@ -1213,6 +1236,9 @@ impl eframe::App for EditorApp {
         let ctx = ui.ctx().clone();
         self.record_frame_time();
         self.poll_bind();
+        if std::mem::take(&mut self.retry_bind) {
+            self.start_bind(&ctx);
+        }
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
@@ -1255,4 +1281,26 @@ fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageErr
         height as u32,
         image::ColorType::Rgba8,
     )
+}
+
+/// Bind on the editor's own device when it is a hardware GPU; a software adapter
+/// binds faster on the CPU path (docs/gpu-binding.md).
+/// `PMVC_EDITOR_BIND=gpu` or `cpu` overrides the choice (to test the GPU path on
+/// a software adapter).
+fn bind_backend_for(state: &egui_wgpu::RenderState) -> Backend {
+    let info = state.adapter.get_info();
+    let forced = std::env::var("PMVC_EDITOR_BIND").ok();
+    let use_gpu = match forced.as_deref() {
+        Some("gpu") => true,
+        Some("cpu") => false,
+        _ => info.device_type != wgpu::DeviceType::Cpu,
+    };
+    if !use_gpu {
+        return Backend::Cpu;
+    }
+    Backend::Gpu(Arc::new(GpuContext::from_device(
+        state.device.clone(),
+        state.queue.clone(),
+        info,
+    )))
 }

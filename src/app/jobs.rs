@@ -1,15 +1,23 @@
 //! Background jobs. Binding runs on its own thread so the viewport stays
 //! interactive; the UI polls a [`BindJob`] each frame for progress and the result.
 //!
-//! This is the seam where the GPU binder will plug in: the UI only uses
-//! `start`, `done`, `total`, `elapsed`, `estimated_remaining`, `cancel` and `poll`.
+//! The bind itself goes through [`crate::gpu::Binder`]: on the editor's own wgpu
+//! device when that is a hardware GPU, on the CPU otherwise (a software adapter
+//! such as lavapipe binds several times slower than the CPU path, see
+//! docs/gpu-binding.md). The job's thread first classifies the points, then
+//! forwards the binder's progress and the editor's cancel.
 
-use crate::coords::{bind_cpu, BindOptions, BindProgress, Cancelled, Weights};
+use crate::coords::{BindOptions, Weights};
 use crate::geometry::{classify_points, Cage};
+use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder};
 use glam::DVec3;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// How often the job's thread forwards progress and cancel requests.
+const POLL_INTERVAL: Duration = Duration::from_millis(15);
 
 /// What a finished bind hands back.
 #[derive(Debug)]
@@ -20,49 +28,71 @@ pub struct BindOutcome {
     pub options: BindOptions,
     /// Wall-clock time of classification and binding.
     pub elapsed: Duration,
+    /// Where it ran, e.g. "CPU" or the GPU's name.
+    pub device: String,
 }
 
-/// A bind running on a background thread.
+/// Why a bind produced no weights.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    #[error("binding was cancelled")]
+    Cancelled,
+    #[error("binding failed: {0}")]
+    Failed(String),
+}
+
+/// Progress and cancel shared between the UI and the job's thread.
+#[derive(Debug, Default)]
+struct Shared {
+    done: AtomicUsize,
+    cancel: AtomicBool,
+}
+
+/// A bind running on a background thread. Dropping it cancels the bind.
 pub struct BindJob {
-    progress: Arc<BindProgress>,
+    shared: Arc<Shared>,
     total: usize,
     started: Instant,
     options: BindOptions,
-    receiver: mpsc::Receiver<Result<BindOutcome, Cancelled>>,
+    receiver: mpsc::Receiver<Result<BindOutcome, JobError>>,
 }
 
 impl BindJob {
-    /// Start binding `points` to `cage`. `wake` is called from the worker when it
-    /// finishes (the UI passes `request_repaint`, so an idle window notices).
+    /// Start binding `points` to `cage` on `backend`. `wake` is called from the
+    /// worker when it finishes (the UI passes `request_repaint`, so an idle window
+    /// notices).
     pub fn start(
         points: Arc<Vec<DVec3>>,
         cage: Arc<Cage>,
         options: BindOptions,
+        backend: Backend,
         wake: impl Fn() + Send + 'static,
     ) -> Self {
-        let progress = Arc::new(BindProgress::default());
+        let shared = Arc::new(Shared::default());
         let (sender, receiver) = mpsc::channel();
         let total = points.len();
-        let worker_progress = Arc::clone(&progress);
+        let worker = Arc::clone(&shared);
         let started = Instant::now();
-        std::thread::Builder::new()
-            .name("pmvc-bind".into())
+        let spawned = std::thread::Builder::new()
+            .name("pmvc-bind-job".into())
             .spawn(move || {
-                let classes = classify_points(&cage, &points);
-                let result = bind_cpu(&points, &classes.classes, &cage, options, &worker_progress)
-                    .map(|weights| BindOutcome {
-                        weights: Arc::new(weights),
-                        outside: classes.outside,
-                        options,
-                        elapsed: started.elapsed(),
-                    });
+                let result = run(&points, &cage, options, backend, &worker, started);
                 // The receiver is gone when the editor dropped the job; nothing to do.
                 let _ = sender.send(result);
                 wake();
-            })
-            .expect("the OS can spawn a thread");
+            });
+        let (fallback_sender, fallback_receiver) = mpsc::channel();
+        let receiver = match spawned {
+            Ok(_) => receiver,
+            Err(error) => {
+                let _ = fallback_sender.send(Err(JobError::Failed(format!(
+                    "could not start the binding thread: {error}"
+                ))));
+                fallback_receiver
+            }
+        };
         Self {
-            progress,
+            shared,
             total,
             started,
             options,
@@ -76,7 +106,7 @@ impl BindJob {
 
     /// Mesh vertices bound so far.
     pub fn done(&self) -> usize {
-        self.progress.done().min(self.total)
+        self.shared.done.load(Ordering::Relaxed).min(self.total)
     }
 
     pub fn total(&self) -> usize {
@@ -110,32 +140,85 @@ impl BindJob {
 
     /// Ask the worker to stop; `poll` then reports `Err(Cancelled)`.
     pub fn cancel(&self) {
-        self.progress.cancel();
+        self.shared.cancel.store(true, Ordering::Relaxed);
     }
 
     pub fn is_cancelling(&self) -> bool {
-        self.progress.is_cancelled()
+        self.shared.cancel.load(Ordering::Relaxed)
     }
 
     /// The result, once the worker has finished.
-    pub fn poll(&mut self) -> Option<Result<BindOutcome, Cancelled>> {
+    pub fn poll(&mut self) -> Option<Result<BindOutcome, JobError>> {
         match self.receiver.try_recv() {
             Ok(result) => Some(result),
             Err(mpsc::TryRecvError::Empty) => None,
-            // The worker panicked: report it as a cancel so the editor stays usable.
-            Err(mpsc::TryRecvError::Disconnected) => Some(Err(Cancelled)),
+            Err(mpsc::TryRecvError::Disconnected) => {
+                Some(Err(JobError::Failed("the binding thread stopped".into())))
+            }
         }
     }
 
     /// Block until the worker finishes (for tests and `--screenshot`).
-    pub fn wait(&mut self, timeout: Duration) -> Option<Result<BindOutcome, Cancelled>> {
+    pub fn wait(&mut self, timeout: Duration) -> Option<Result<BindOutcome, JobError>> {
         self.receiver.recv_timeout(timeout).ok()
     }
 }
 
 impl Drop for BindJob {
     fn drop(&mut self) {
-        // A replaced job must not keep the CPU busy.
-        self.progress.cancel();
+        // A replaced job must not keep the CPU or GPU busy.
+        self.cancel();
+    }
+}
+
+fn run(
+    points: &[DVec3],
+    cage: &Cage,
+    options: BindOptions,
+    backend: Backend,
+    shared: &Shared,
+    started: Instant,
+) -> Result<BindOutcome, JobError> {
+    let classes = classify_points(cage, points);
+    if shared.cancel.load(Ordering::Relaxed) {
+        return Err(JobError::Cancelled);
+    }
+    let binder = Binder::new(backend).with_config(BindConfig {
+        cpu_weights: true,
+        gpu_buffer: false,
+        ..Default::default()
+    });
+    let mut handle = binder.start(BindInput {
+        points: points.to_vec(),
+        classes: classes.classes,
+        cage: cage.clone(),
+        options,
+    });
+    let result = loop {
+        if shared.cancel.load(Ordering::Relaxed) {
+            handle.cancel();
+        }
+        shared.done.store(handle.progress().0, Ordering::Relaxed);
+        if let Some(result) = handle.try_take() {
+            break result;
+        }
+        std::thread::sleep(POLL_INTERVAL);
+    };
+    match result {
+        Ok(output) => {
+            shared.done.store(points.len(), Ordering::Relaxed);
+            let weights = output
+                .weights
+                .ok_or_else(|| JobError::Failed("the binder returned no weights".into()))?;
+            Ok(BindOutcome {
+                weights: Arc::new(weights),
+                outside: classes.outside,
+                options,
+                elapsed: started.elapsed(),
+                device: output.stats.device,
+            })
+        }
+        Err(BindError::Cancelled) => Err(JobError::Cancelled),
+        Err(error) => Err(JobError::Failed(error.to_string())),
     }
 }

@@ -24,6 +24,8 @@ pub struct Scene {
     pub weights: Option<Arc<Weights>>,
     pub bound_with: Option<BindOptions>,
     pub bind_time: Option<Duration>,
+    /// Where the last bind ran ("CPU" or the GPU's description).
+    pub bind_device: String,
     /// Mesh vertices outside the cage, known once bound.
     pub outside: Vec<u32>,
 }
@@ -40,6 +42,7 @@ impl Scene {
             weights: None,
             bound_with: None,
             bind_time: None,
+            bind_device: String::new(),
             outside: Vec::new(),
         }
     }
