@@ -9,6 +9,7 @@ use super::EditorOptions;
 use crate::coords::{BindOptions, Method, DEFAULT_RESOLUTION};
 use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
 use crate::gpu::{Backend, GpuContext};
+use crate::render::viewport::MSAA_SAMPLES;
 use crate::render::{
     FrameParams, OrbitCamera, RenderError, SceneUpload, ScreenProjection, ViewportCallback,
     ViewportRenderer,
@@ -113,7 +114,9 @@ impl EditorApp {
     /// Create the app from eframe's creation context and start binding.
     pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> Self {
         let gpu = cc.wgpu_render_state.as_ref().map(|state| {
-            let renderer = ViewportRenderer::new(&state.device, state.target_format);
+            let software = state.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+            let samples = if software { 1 } else { MSAA_SAMPLES };
+            let renderer = ViewportRenderer::new(&state.device, state.target_format, samples);
             state.renderer.write().callback_resources.insert(renderer);
             Gpu {
                 device: state.device.clone(),
@@ -1010,6 +1013,18 @@ impl EditorApp {
             ui.menu_button("View", |ui| {
                 ui.checkbox(&mut self.show_statistics, "Statistics");
                 ui.checkbox(&mut self.highlight_outside, "Highlight outside vertices");
+                let mut antialiased = self
+                    .with_renderer(|renderer, _, _| renderer.sample_count() > 1)
+                    .unwrap_or(false);
+                if ui
+                    .checkbox(&mut antialiased, "Anti-aliasing (4x MSAA)")
+                    .changed()
+                {
+                    let samples = if antialiased { MSAA_SAMPLES } else { 1 };
+                    self.with_renderer(|renderer, device, _| {
+                        renderer.set_sample_count(device, samples)
+                    });
+                }
                 if ui.button("Frame scene (F)").clicked() {
                     self.frame_scene();
                 }

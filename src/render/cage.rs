@@ -1,7 +1,7 @@
 //! The cage overlay: wire edges and vertex handles, each drawn dimmed where the
 //! mesh hides it and bright where visible. Paired with `shaders/render_cage.wgsl`.
 
-use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT, SAMPLE_COUNT};
+use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
 
 const SHADER: &str = include_str!("../../shaders/render_cage.wgsl");
 
@@ -13,7 +13,11 @@ pub struct CageRenderer {
 }
 
 impl CageRenderer {
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        sample_count: u32,
+    ) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render_cage.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -51,7 +55,7 @@ impl CageRenderer {
                     bias: Default::default(),
                 }),
                 multisample: wgpu::MultisampleState {
-                    count: SAMPLE_COUNT,
+                    count: sample_count,
                     ..Default::default()
                 },
                 fragment: Some(wgpu::FragmentState {

@@ -2,7 +2,7 @@
 //! the weights and the deformed cage, and a compute pipeline doing the same sums
 //! into a buffer for readback. Paired with `shaders/render_mesh.wgsl`.
 
-use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT, SAMPLE_COUNT};
+use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
 use glam::Vec3;
 
 const SHADER: &str = include_str!("../../shaders/render_mesh.wgsl");
@@ -14,7 +14,11 @@ pub struct MeshRenderer {
 }
 
 impl MeshRenderer {
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        sample_count: u32,
+    ) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render_mesh.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -46,7 +50,7 @@ impl MeshRenderer {
                 bias: Default::default(),
             }),
             multisample: wgpu::MultisampleState {
-                count: SAMPLE_COUNT,
+                count: sample_count,
                 ..Default::default()
             },
             fragment: Some(wgpu::FragmentState {

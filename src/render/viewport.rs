@@ -11,8 +11,9 @@ use glam::{Mat4, Vec3};
 
 pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Multisampling smooths the one-pixel cage lines and the mesh silhouette.
-pub const SAMPLE_COUNT: u32 = 4;
+/// Multisampling smooths the one-pixel cage lines and the mesh silhouette. It
+/// costs about 16 ms a frame on lavapipe, so software adapters default to 1.
+pub const MSAA_SAMPLES: u32 = 4;
 const COMPOSITE_SHADER: &str = include_str!("../../shaders/render_composite.wgsl");
 const BACKGROUND: wgpu::Color = wgpu::Color {
     r: 0.13,
@@ -81,7 +82,8 @@ pub struct SceneGpu {
 
 struct OffscreenTarget {
     size: [u32; 2],
-    multisampled: wgpu::TextureView,
+    /// `None` without multisampling: then the pass draws straight into `resolved`.
+    multisampled: Option<wgpu::TextureView>,
     depth: wgpu::TextureView,
     resolved: wgpu::TextureView,
     composite_group: wgpu::BindGroup,
@@ -100,6 +102,7 @@ pub struct ViewportRenderer {
     target: Option<OffscreenTarget>,
     scene: Option<SceneGpu>,
     max_storage_binding: u64,
+    sample_count: u32,
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -119,7 +122,12 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 
 impl ViewportRenderer {
     /// `target_format` is the format of egui's render pass.
-    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
+    /// `sample_count` is 1 or [`MSAA_SAMPLES`].
+    pub fn new(
+        device: &wgpu::Device,
+        target_format: wgpu::TextureFormat,
+        sample_count: u32,
+    ) -> Self {
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
             entries: &[
@@ -205,8 +213,9 @@ impl ViewportRenderer {
         });
         let limits = device.limits();
         Self {
-            mesh: MeshRenderer::new(device, &scene_layout),
-            cage: CageRenderer::new(device, &scene_layout),
+            mesh: MeshRenderer::new(device, &scene_layout, sample_count),
+            cage: CageRenderer::new(device, &scene_layout, sample_count),
+            sample_count,
             scene_layout,
             frame,
             last_frame: FrameUniform::default(),
@@ -219,6 +228,21 @@ impl ViewportRenderer {
                 .max_storage_buffer_binding_size
                 .min(limits.max_buffer_size),
         }
+    }
+
+    pub fn sample_count(&self) -> u32 {
+        self.sample_count
+    }
+
+    /// Switch multisampling (1 or [`MSAA_SAMPLES`]); rebuilds the pipelines.
+    pub fn set_sample_count(&mut self, device: &wgpu::Device, sample_count: u32) {
+        if sample_count == self.sample_count {
+            return;
+        }
+        self.sample_count = sample_count;
+        self.mesh = MeshRenderer::new(device, &self.scene_layout, sample_count);
+        self.cage = CageRenderer::new(device, &self.scene_layout, sample_count);
+        self.target = None;
     }
 
     /// Replace the scene. Weights start unbound: the mesh shows at rest.
@@ -412,6 +436,7 @@ impl ViewportRenderer {
     }
 
     fn ensure_target(&mut self, device: &wgpu::Device, size: [u32; 2]) {
+        let samples = self.sample_count;
         if self.target.as_ref().is_some_and(|t| t.size == size) {
             return;
         }
@@ -457,8 +482,9 @@ impl ViewportRenderer {
         });
         self.target = Some(OffscreenTarget {
             size,
-            multisampled: texture("viewport msaa", OFFSCREEN_FORMAT, SAMPLE_COUNT, attachment),
-            depth: texture("viewport depth", DEPTH_FORMAT, SAMPLE_COUNT, attachment),
+            multisampled: (samples > 1)
+                .then(|| texture("viewport msaa", OFFSCREEN_FORMAT, samples, attachment)),
+            depth: texture("viewport depth", DEPTH_FORMAT, samples, attachment),
             composite_group,
             resolved,
         });
@@ -536,9 +562,9 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("viewport"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.multisampled,
+                view: target.multisampled.as_ref().unwrap_or(&target.resolved),
                 depth_slice: None,
-                resolve_target: Some(&target.resolved),
+                resolve_target: target.multisampled.as_ref().map(|_| &target.resolved),
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(BACKGROUND),
                     store: wgpu::StoreOp::Discard,
