@@ -115,6 +115,29 @@ fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, modifie
     harness.event(Event::ModifiersChanged(Modifiers::NONE));
 }
 
+/// The rendered viewport (left of the side panel) is mostly not background: the
+/// paint callback drew the mesh.
+fn assert_viewport_shows_the_mesh(harness: &mut Harness<'static, EditorApp>) {
+    let image = harness.render().expect("the harness renders");
+    let (width, height) = image.dimensions();
+    let mut mesh_pixels = 0;
+    let mut total = 0;
+    for y in (40..height - 10).step_by(4) {
+        for x in (10..width * 2 / 3).step_by(4) {
+            let [r, g, b, _] = image.get_pixel(x, y).0;
+            total += 1;
+            // The mesh is a warm beige, the background a dark blue-grey.
+            if r > 90 && r > b + 15 && g > 60 {
+                mesh_pixels += 1;
+            }
+        }
+    }
+    assert!(
+        mesh_pixels * 20 > total,
+        "only {mesh_pixels} of {total} viewport samples show the mesh"
+    );
+}
+
 fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
     a.iter()
         .zip(b)
@@ -156,6 +179,7 @@ fn default_scene_binds_with_progress_to_completion() {
         .map(|p| p.as_vec3())
         .collect();
     assert!(max_distance(&deformed, &rest) < 1e-3);
+    assert_viewport_shows_the_mesh(&mut harness);
     harness.snapshot_options(
         "editor_default_scene",
         &SnapshotOptions::new()
@@ -222,6 +246,7 @@ fn click_selects_drag_moves_and_undo_restores() {
         max_distance(&moved_gpu, &cpu) < 1e-3,
         "GPU and CPU deformations agree"
     );
+    assert_viewport_shows_the_mesh(&mut harness);
     harness.snapshot_options(
         "editor_after_drag",
         &SnapshotOptions::new()

@@ -567,7 +567,13 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
                 resolve_target: target.multisampled.as_ref().map(|_| &target.resolved),
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(BACKGROUND),
-                    store: wgpu::StoreOp::Discard,
+                    // With MSAA only the resolved image is needed; without, the
+                    // attachment is that image.
+                    store: if target.multisampled.is_some() {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
