@@ -124,7 +124,7 @@ fn assert_viewport_shows_the_mesh(harness: &mut Harness<'static, EditorApp>) {
     let mut total = 0;
     for y in (40..height - 10).step_by(4) {
         for x in (10..width * 2 / 3).step_by(4) {
-            let [r, g, b, _] = image.get_pixel(x, y).0;
+            let [r, g, b, _] = image.get_pixel(x, y).0.map(i32::from);
             total += 1;
             // The mesh is a warm beige, the background a dark blue-grey.
             if r > 90 && r > b + 15 && g > 60 {
