@@ -362,3 +362,46 @@ fn cancelling_a_bind_keeps_the_previous_state_usable() {
     ));
     assert!(app.read_back_deformed().unwrap().is_ok());
 }
+
+#[test]
+fn poses_save_load_reset_and_the_deformed_mesh_exports() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let directory = tempfile::tempdir().unwrap();
+    let pose_path = directory.path().join("pose.obj");
+    let export_path = directory.path().join("deformed.obj");
+    let app = harness.state_mut();
+    let rest = app.scene.cage.positions.clone();
+    let moved = rest[5] + glam::DVec3::new(0.5, 0.25, 0.0);
+    app.set_handle_position(5, moved);
+    app.save_pose(&pose_path);
+    app.export_deformed(&export_path);
+    assert!(app.last_error().is_none(), "{:?}", app.last_error());
+
+    let exported = pmvc::geometry::load_mesh(&export_path)
+        .unwrap()
+        .mesh
+        .positions;
+    let expected = app.scene.deformed_positions();
+    assert_eq!(exported.len(), expected.len());
+    let worst = exported
+        .iter()
+        .zip(&expected)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-5, "export matches the deformation ({worst})");
+
+    app.reset_pose();
+    assert_eq!(app.scene.pose, rest);
+    assert!(app.load_pose(&pose_path));
+    assert!(app.scene.pose[5].distance(moved) < 1e-5);
+    app.undo();
+    assert_eq!(app.scene.pose, rest);
+
+    // A pose with the wrong vertex count is refused and changes nothing.
+    let wrong = directory.path().join("wrong.obj");
+    std::fs::write(&wrong, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert!(!app.load_pose(&wrong));
+    assert!(app.last_error().unwrap().contains("wrong.obj"));
+    assert_eq!(app.scene.pose, rest);
+}

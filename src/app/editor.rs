@@ -100,6 +100,8 @@ pub struct EditorApp {
     bind_backend: Backend,
     /// Set when a failed GPU bind should be retried on the CPU next frame.
     retry_bind: bool,
+    /// The pose when a drag on a numeric position field began.
+    numeric_drag_start: Option<Vec<DVec3>>,
 }
 
 /// `--screenshot`: wait for the bind, let a few frames settle, capture, quit.
@@ -150,6 +152,7 @@ impl EditorApp {
             path_input: String::new(),
             last_bind_progress: None,
             retry_bind: false,
+            numeric_drag_start: None,
             bind_backend: cc
                 .wgpu_render_state
                 .as_ref()
@@ -1108,7 +1111,7 @@ impl EditorApp {
         if self.selection.len() == 1 {
             if let Some(&handle) = self.selection.iter().next() {
                 let mut position = self.scene.pose[handle];
-                let mut changed = false;
+                let (mut changed, mut drag_started, mut drag_stopped) = (false, false, false);
                 ui.horizontal(|ui| {
                     ui.label(format!("Handle {handle}"));
                     for (label, value) in [
@@ -1117,14 +1120,31 @@ impl EditorApp {
                         ("z", &mut position.z),
                     ] {
                         let label = ui.label(label);
-                        changed |= ui
+                        let field = ui
                             .add(egui::DragValue::new(value).speed(0.01).max_decimals(4))
-                            .labelled_by(label.id)
-                            .changed();
+                            .labelled_by(label.id);
+                        changed |= field.changed();
+                        drag_started |= field.drag_started();
+                        drag_stopped |= field.drag_stopped();
                     }
                 });
-                if changed {
+                // Dragging a field is one undo step; typing a value is one each.
+                if drag_started {
+                    self.numeric_drag_start = Some(self.scene.pose.clone());
+                }
+                if changed && self.numeric_drag_start.is_some() {
+                    let mut pose = self.scene.pose.clone();
+                    pose[handle] = position;
+                    self.set_pose(pose);
+                } else if changed {
                     self.set_handle_position(handle, position);
+                }
+                if drag_stopped {
+                    if let Some(start) = self.numeric_drag_start.take() {
+                        if start != self.scene.pose {
+                            self.history.record(start);
+                        }
+                    }
                 }
             }
         }

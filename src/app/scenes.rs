@@ -30,7 +30,7 @@ const PALM_HALF_DEPTH: f64 = 0.4;
 pub enum BundledScene {
     /// Five close fingers in a comb cage: the default, and the MVC/PMVC showcase.
     Comb,
-    /// A scanned model (CGAL's Stanford-bunny-like sample) in a coarse box cage.
+    /// A scanned elephant figurine (CGAL's sample data, CC0) in a coarse star-shaped cage.
     Scan,
 }
 
