@@ -6,6 +6,7 @@ if [[ -z "${PMVC_EDITOR:-}" ]]; then
   cargo build --release --example editor
   PMVC_EDITOR="${CARGO_TARGET_DIR:-target}/release/examples/editor"
 fi
+export PMVC_EDITOR_MSAA=4  # smoother lines than the software-adapter default
 shoot() { # NAME ARGS...
   local name="$1"; shift
   xvfb-run -a -s "-screen 0 1280x800x24" "$PMVC_EDITOR" "$@" --screenshot "docs/images/$name.png" 2>&1 \

@@ -44,6 +44,8 @@ if [[ -z "$window" ]]; then
 fi
 sleep 3
 xdotool mousemove --window "$window" 400 400
+sleep 1
+import -window root "$out/before-drag.png"
 xdotool mousedown 1
 for step in $(seq 1 20); do
   xdotool mousemove --window "$window" $((400 + step * 8)) $((400 - step * 3))
@@ -56,4 +58,9 @@ kill "$editor_pid" 2>/dev/null || true
 wait "$editor_pid" 2>/dev/null || true
 test -s "$out/after-drag.png"
 echo "   saved $out/after-drag.png"
+# The drag must have changed the picture (orbited the view or moved a handle).
+changed=$(compare -metric AE "$out/before-drag.png" "$out/after-drag.png" null: 2>&1 || true)
+echo "   pixels changed by the drag: $changed"
+[[ "${changed%% *}" =~ ^[0-9.e+]+$ ]] && awk "BEGIN { exit !(${changed%% *} > 1000) }" || {
+  echo "the drag did not change the view"; exit 1; }
 echo "smoke test passed"

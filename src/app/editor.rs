@@ -117,7 +117,13 @@ impl EditorApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> Self {
         let gpu = cc.wgpu_render_state.as_ref().map(|state| {
             let software = state.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-            let samples = if software { 1 } else { MSAA_SAMPLES };
+            // PMVC_EDITOR_MSAA=1 or 4 overrides the default (for screenshots).
+            let samples = match std::env::var("PMVC_EDITOR_MSAA").as_deref() {
+                Ok("1") => 1,
+                Ok("4") => MSAA_SAMPLES,
+                _ if software => 1,
+                _ => MSAA_SAMPLES,
+            };
             let renderer = ViewportRenderer::new(&state.device, state.target_format, samples);
             state.renderer.write().callback_resources.insert(renderer);
             Gpu {
