@@ -728,10 +728,15 @@ impl EditorApp {
             }
         }
         if self.scene.weights.is_none() {
+            let message = if self.job.is_some() {
+                "Binding… the mesh is shown at rest until the weights are ready"
+            } else {
+                "Not bound: the mesh is shown at rest (Bind in the side panel)"
+            };
             ui.painter().text(
                 rect.left_top() + egui::vec2(10.0, 10.0),
                 egui::Align2::LEFT_TOP,
-                "Binding… the mesh is shown at rest until the weights are ready",
+                message,
                 egui::FontId::proportional(14.0),
                 Color32::from_gray(200),
             );
