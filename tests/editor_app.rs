@@ -405,3 +405,98 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
     assert!(app.last_error().unwrap().contains("wrong.obj"));
     assert_eq!(app.scene.pose, rest);
 }
+
+fn button_drag(
+    harness: &mut Harness<'static, EditorApp>,
+    button: PointerButton,
+    from: Pos2,
+    to: Pos2,
+) {
+    harness.hover_at(from);
+    harness.step();
+    harness.event(Event::PointerButton {
+        pos: from,
+        button,
+        pressed: true,
+        modifiers: Modifiers::NONE,
+    });
+    harness.step();
+    for k in 1..=8 {
+        harness.hover_at(from + (to - from) * (k as f32 / 8.0));
+        harness.step();
+    }
+    harness.event(Event::PointerButton {
+        pos: to,
+        button,
+        pressed: false,
+        modifiers: Modifiers::NONE,
+    });
+    harness.run_steps(2);
+}
+
+#[test]
+fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
+    let Some(mut harness) = editor() else { return };
+    harness.run_steps(2);
+    let empty = Pos2::new(40.0, 80.0);
+    let framed = harness.state().camera;
+
+    button_drag(
+        &mut harness,
+        PointerButton::Primary,
+        empty,
+        empty + egui::vec2(80.0, 20.0),
+    );
+    let orbited = harness.state().camera;
+    assert_ne!(orbited.yaw, framed.yaw, "left-drag on empty space orbits");
+    button_drag(
+        &mut harness,
+        PointerButton::Middle,
+        empty,
+        empty + egui::vec2(0.0, 40.0),
+    );
+    assert_ne!(
+        harness.state().camera.pitch,
+        orbited.pitch,
+        "middle-drag orbits"
+    );
+    let orbited = harness.state().camera;
+
+    button_drag(
+        &mut harness,
+        PointerButton::Secondary,
+        empty,
+        empty + egui::vec2(50.0, 0.0),
+    );
+    assert_ne!(
+        harness.state().camera.target,
+        orbited.target,
+        "right-drag pans"
+    );
+
+    harness.hover_at(Pos2::new(300.0, 300.0));
+    harness.event(Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Wheel,
+        modifiers: Modifiers::NONE,
+    });
+    harness.run_steps(20);
+    assert!(
+        harness.state().camera.distance < framed.distance,
+        "wheel up zooms in"
+    );
+
+    harness.key_press(Key::F);
+    harness.run_steps(2);
+    let refocused = harness.state().camera;
+    assert_eq!(refocused.target, framed.target);
+    assert_eq!(refocused.distance, framed.distance);
+    let app = harness.state();
+    assert_eq!(
+        app.scene.pose, app.scene.cage.positions,
+        "the cage never moved"
+    );
+    assert!(app.selection.is_empty());
+}
