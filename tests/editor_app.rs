@@ -500,3 +500,27 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
     );
     assert!(app.selection.is_empty());
 }
+
+#[test]
+fn holding_x_constrains_a_drag_to_the_x_axis() {
+    let Some(mut harness) = editor() else { return };
+    harness.run_steps(2);
+    let (handle, at) = isolated_handle(&harness);
+    let before = harness.state().scene.pose[handle];
+    harness.key_down(Key::X);
+    harness.step();
+    drag(
+        &mut harness,
+        at,
+        at + egui::vec2(50.0, -40.0),
+        Modifiers::NONE,
+    );
+    harness.key_up(Key::X);
+    harness.step();
+    let delta = harness.state().scene.pose[handle] - before;
+    assert!(delta.x.abs() > 1e-3, "moved along x: {delta}");
+    assert!(
+        delta.y.abs() < 1e-9 && delta.z.abs() < 1e-9,
+        "only along x: {delta}"
+    );
+}
