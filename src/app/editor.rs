@@ -753,8 +753,10 @@ impl EditorApp {
             )
         });
 
-        // Hover highlight (not while dragging, so the highlight does not flicker).
-        if self.drag.is_none() {
+        // Hover highlight (not while dragging, so the highlight does not flicker, and
+        // not in `--screenshot` runs, where the pointer rests wherever the display
+        // server put it).
+        if self.drag.is_none() && self.screenshot.is_none() {
             let hovered = response.hover_pos().and_then(|p| self.pick(p));
             if hovered != self.hovered {
                 self.hovered = hovered;
