@@ -275,11 +275,11 @@ fn check_reports_topology_and_mvc_negativity() {
 }
 
 #[test]
-fn no_subcommand_prints_help() {
-    let output = pmvc(&[]);
+fn help_lists_every_subcommand() {
+    let output = pmvc(&["--help"]);
     assert!(output.status.success());
     let text = String::from_utf8_lossy(&output.stdout);
-    for command in ["bind", "deform", "check", "bench"] {
+    for command in ["edit", "bind", "deform", "check", "bench", "info"] {
         assert!(text.contains(command), "{text}");
     }
 }

@@ -33,7 +33,12 @@ pub struct EditorOptions {
 }
 
 /// Open the editor window and run until it is closed.
-pub fn run_editor(options: EditorOptions) -> anyhow::Result<()> {
+/// The editor window could not run.
+#[derive(Debug, thiserror::Error)]
+#[error("the editor window failed: {0}")]
+pub struct EditorError(String);
+
+pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
     let native_options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("pmvc editor")
@@ -47,5 +52,5 @@ pub fn run_editor(options: EditorOptions) -> anyhow::Result<()> {
         native_options,
         Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, options)))),
     )
-    .map_err(|error| anyhow::anyhow!("the editor window failed: {error}"))
+    .map_err(|error| EditorError(error.to_string()))
 }

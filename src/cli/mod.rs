@@ -1,4 +1,5 @@
-//! The `pmvc` command line: `bind`, `deform`, `check`, `bench`, `generate` and `info`.
+//! The `pmvc` command line: `edit` (the default), `bind`, `deform`, `check`, `bench`,
+//! `generate` and `info`.
 //!
 //! Errors are reported as one line on stderr naming the file, with exit status 1.
 //! Outputs are written through a temporary file, so an existing output survives a
@@ -21,6 +22,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Open the editor (the default with no subcommand) on the bundled scene or on MESH and CAGE.
+    Edit(EditArgs),
     /// Compute the weights of every mesh vertex with respect to the cage and write them as .npy.
     Bind(BindArgs),
     /// Move every mesh vertex to Σ λᵢ c̃ᵢ for a deformed cage and write the mesh as OBJ.
@@ -128,6 +131,27 @@ pub struct CheckArgs {
 }
 
 #[derive(Debug, clap::Args)]
+pub struct EditArgs {
+    /// Mesh to open instead of the bundled scene (.obj or .off).
+    #[arg(requires = "cage")]
+    pub mesh: Option<PathBuf>,
+    /// Its cage.
+    pub cage: Option<PathBuf>,
+    /// A deformed cage with the same vertex count, applied after binding.
+    #[arg(long, value_name = "POSE.obj")]
+    pub pose: Option<PathBuf>,
+    /// PMVC cube-map resolution (1–1024).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub resolution: Option<u32>,
+    /// Coordinates to bind first.
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
+    /// Wait for the bind, render, save the window as PNG and exit.
+    #[arg(long, value_name = "PATH")]
+    pub screenshot: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
 pub struct GenerateArgs {
     /// Scene name.
     #[arg(value_parser = clap::builder::PossibleValuesParser::new(crate::geometry::procedural::table1_scene_names()))]
@@ -144,10 +168,17 @@ pub struct GenerateArgs {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => {
-            use clap::CommandFactory;
-            Cli::command().print_help().map_err(anyhow::Error::from)
-        }
+        None => crate::app::run_editor(crate::app::EditorOptions::default())
+            .map_err(anyhow::Error::from),
+        Some(Command::Edit(args)) => crate::app::run_editor(crate::app::EditorOptions {
+            mesh: args.mesh,
+            cage: args.cage,
+            pose: args.pose,
+            resolution: args.resolution,
+            method: args.method.map(Into::into),
+            screenshot: args.screenshot,
+        })
+        .map_err(anyhow::Error::from),
         Some(Command::Bind(args)) => commands::bind(&args),
         Some(Command::Deform(args)) => commands::deform(&args),
         Some(Command::Check(args)) => commands::check(&args),

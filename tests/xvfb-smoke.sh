@@ -4,15 +4,15 @@
 #  2. an interactive run: xdotool drags across the viewport (orbiting the view, or
 #     moving a handle if one is under the cursor), and the screen is captured.
 # Needs: xvfb, xdotool, imagemagick (import), mesa-vulkan-drivers.
-# Usage: scripts/xvfb-smoke.sh [OUT_DIR]   (default: target/smoke)
-# Set PMVC_EDITOR to the binary (default: the `editor` example, built here).
+# Usage: tests/xvfb-smoke.sh [OUT_DIR]   (default: target/smoke)
+# Set PMVC_EDITOR to the pmvc binary (default: built here in release mode).
 set -euo pipefail
 
 out="${1:-target/smoke}"
 mkdir -p "$out"
 if [[ -z "${PMVC_EDITOR:-}" ]]; then
-  cargo build --release --example editor
-  PMVC_EDITOR="${CARGO_TARGET_DIR:-target}/release/examples/editor"
+  cargo build --release
+  PMVC_EDITOR="${CARGO_TARGET_DIR:-target}/release/pmvc"
 fi
 display=":${PMVC_DISPLAY:-93}"
 
@@ -24,14 +24,14 @@ export DISPLAY="$display" WAYLAND_DISPLAY=
 
 echo "== screenshot run"
 start=$(date +%s)
-timeout 300 "$PMVC_EDITOR" --screenshot "$out/default-scene.png" 2>"$out/screenshot-run.log" || {
+timeout 300 "$PMVC_EDITOR" edit --screenshot "$out/default-scene.png" 2>"$out/screenshot-run.log" || {
   cat "$out/screenshot-run.log"; exit 1; }
 echo "   saved $out/default-scene.png in $(( $(date +%s) - start )) s"
 grep "frame time" "$out/screenshot-run.log" || true
 test -s "$out/default-scene.png"
 
 echo "== interactive run with an xdotool drag"
-"$PMVC_EDITOR" >"$out/interactive-run.log" 2>&1 &
+"$PMVC_EDITOR" edit >"$out/interactive-run.log" 2>&1 &
 editor_pid=$!
 window=""
 for _ in $(seq 1 60); do
