@@ -6,7 +6,7 @@
 use egui::{Event, Key, Modifiers, PointerButton, Pos2};
 use egui_kittest::{Harness, SnapshotOptions};
 use pmvc::app::editor::FileRole;
-use pmvc::app::{EditorApp, EditorOptions};
+use pmvc::app::{BindOn, EditorApp, EditorOptions};
 use std::time::{Duration, Instant};
 
 /// A fast resolution keeps the binds in these tests short.
@@ -40,6 +40,10 @@ fn render_state() -> Option<eframe::egui_wgpu::RenderState> {
 }
 
 fn editor() -> Option<Harness<'static, EditorApp>> {
+    editor_binding_on(BindOn::Auto)
+}
+
+fn editor_binding_on(bind_on: BindOn) -> Option<Harness<'static, EditorApp>> {
     let state = render_state()?;
     let harness = Harness::builder()
         .with_size(egui::vec2(1100.0, 700.0))
@@ -51,6 +55,7 @@ fn editor() -> Option<Harness<'static, EditorApp>> {
                 cc,
                 EditorOptions {
                     resolution: Some(TEST_RESOLUTION),
+                    bind_on,
                     ..Default::default()
                 },
             )
@@ -596,4 +601,53 @@ fn shift_click_toggles_and_the_scenes_menu_switches_scenes() {
     assert_eq!(app.scene.mesh.positions.len(), 2775);
     assert!(app.scene.weights.is_some());
     assert!(app.scene.outside.is_empty());
+}
+
+/// Bound on the editor's own device, the vertex shader reads the weights where the
+/// bind left them; a drag must still move the mesh exactly as the CPU weights say.
+#[test]
+fn weights_bound_on_the_editors_device_deform_the_mesh() {
+    let Some(mut harness) = editor_binding_on(BindOn::Gpu) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    assert!(
+        !harness
+            .state()
+            .scene
+            .bind_device
+            .eq_ignore_ascii_case("cpu"),
+        "bound on {}",
+        harness.state().scene.bind_device
+    );
+    let rest_gpu = harness.state().read_back_deformed().unwrap().unwrap();
+    let (_, at) = isolated_handle(&harness);
+    harness.hover_at(at);
+    harness.run_steps(2);
+    harness.drag_at(at);
+    harness.step();
+    harness.drop_at(at);
+    harness.run_steps(2);
+    drag(
+        &mut harness,
+        at,
+        at + egui::vec2(50.0, 40.0),
+        Modifiers::NONE,
+    );
+    let app = harness.state();
+    let moved_gpu = app.read_back_deformed().unwrap().unwrap();
+    assert!(
+        max_distance(&moved_gpu, &rest_gpu) > 1e-3,
+        "the GPU mesh moved"
+    );
+    let cpu: Vec<glam::Vec3> = app
+        .scene
+        .deformed_positions()
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect();
+    assert!(
+        max_distance(&moved_gpu, &cpu) < 1e-3,
+        "GPU-resident and CPU weights agree"
+    );
 }

@@ -5,7 +5,7 @@
 use super::jobs::{BindJob, BindOutcome, JobError};
 use super::scene::{PoseHistory, Scene};
 use super::scenes::BundledScene;
-use super::EditorOptions;
+use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, DEFAULT_RESOLUTION};
 use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
 use crate::gpu::{Backend, GpuContext};
@@ -159,10 +159,9 @@ impl EditorApp {
             last_bind_progress: None,
             retry_bind: false,
             numeric_drag_start: None,
-            bind_backend: cc
-                .wgpu_render_state
-                .as_ref()
-                .map_or(Backend::Cpu, bind_backend_for),
+            bind_backend: cc.wgpu_render_state.as_ref().map_or(Backend::Cpu, |state| {
+                bind_backend_for(state, options.bind_on)
+            }),
             screenshot: options.screenshot.map(|path| ScreenshotState {
                 path,
                 frames_after_bind: 0,
@@ -349,7 +348,7 @@ impl EditorApp {
                 .map(|p| p.as_vec3())
                 .collect();
             renderer.set_outside(queue, &rest, &outcome.outside);
-            renderer.set_weights(device, Some(&outcome.weights))
+            renderer.set_weights(device, Some(&outcome.weights), outcome.resident.as_ref())
         });
         if let Some(Err(error)) = uploaded {
             self.error(error.to_string());
@@ -1331,17 +1330,14 @@ fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageErr
     )
 }
 
-/// Bind on the editor's own device when it is a hardware GPU; a software adapter
-/// binds faster on the CPU path (docs/gpu-binding.md).
-/// `PMVC_EDITOR_BIND=gpu` or `cpu` overrides the choice (to test the GPU path on
-/// a software adapter).
-fn bind_backend_for(state: &egui_wgpu::RenderState) -> Backend {
+/// With [`BindOn::Auto`], bind on the editor's own device when it is a hardware
+/// GPU; a software adapter binds faster on the CPU path (docs/benchmarks.md).
+fn bind_backend_for(state: &egui_wgpu::RenderState, bind_on: BindOn) -> Backend {
     let info = state.adapter.get_info();
-    let forced = std::env::var("PMVC_EDITOR_BIND").ok();
-    let use_gpu = match forced.as_deref() {
-        Some("gpu") => true,
-        Some("cpu") => false,
-        _ => info.device_type != wgpu::DeviceType::Cpu,
+    let use_gpu = match bind_on {
+        BindOn::Gpu => true,
+        BindOn::Cpu => false,
+        BindOn::Auto => info.device_type != wgpu::DeviceType::Cpu,
     };
     if !use_gpu {
         return Backend::Cpu;

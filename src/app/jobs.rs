@@ -30,6 +30,9 @@ pub struct BindOutcome {
     pub elapsed: Duration,
     /// Where it ran, e.g. "CPU" or the GPU's name.
     pub device: String,
+    /// The same weights left in GPU memory by a bind on the editor's own device,
+    /// for the vertex shader to read without a round trip through the CPU.
+    pub resident: Option<wgpu::Buffer>,
 }
 
 /// Why a bind produced no weights.
@@ -183,9 +186,12 @@ fn run(
     if shared.cancel.load(Ordering::Relaxed) {
         return Err(JobError::Cancelled);
     }
+    // CPU weights serve export and hover read-outs; on a GPU the renderer reads the
+    // resident copy.
+    let gpu_buffer = matches!(backend, Backend::Gpu(_));
     let binder = Binder::new(backend).with_config(BindConfig {
         cpu_weights: true,
-        gpu_buffer: false,
+        gpu_buffer,
         ..Default::default()
     });
     let mut handle = binder.start(BindInput {
@@ -216,6 +222,7 @@ fn run(
                 options,
                 elapsed: started.elapsed(),
                 device: output.stats.device,
+                resident: output.gpu_weights.map(|resident| resident.buffer),
             })
         }
         Err(BindError::Cancelled) => Err(JobError::Cancelled),

@@ -30,6 +30,19 @@ pub struct EditorOptions {
     pub method: Option<crate::coords::Method>,
     /// Save a PNG of the window once the first bind finishes, then quit.
     pub screenshot: Option<PathBuf>,
+    /// Where binding runs.
+    pub bind_on: BindOn,
+}
+
+/// Where the editor binds. On a GPU it binds on the editor's own device, and the
+/// vertex shader reads the weights where the bind left them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BindOn {
+    /// A hardware GPU if the editor runs on one, else the CPU.
+    #[default]
+    Auto,
+    Cpu,
+    Gpu,
 }
 
 /// Open the editor window and run until it is closed.

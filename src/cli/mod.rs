@@ -149,6 +149,9 @@ pub struct EditArgs {
     /// Wait for the bind, render, save the window as PNG and exit.
     #[arg(long, value_name = "PATH")]
     pub screenshot: Option<PathBuf>,
+    /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
+    #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
+    pub backend: BackendArg,
 }
 
 #[derive(Debug, clap::Args)]
@@ -177,6 +180,11 @@ pub fn main() -> ExitCode {
             resolution: args.resolution,
             method: args.method.map(Into::into),
             screenshot: args.screenshot,
+            bind_on: match args.backend {
+                BackendArg::Auto => crate::app::BindOn::Auto,
+                BackendArg::Cpu => crate::app::BindOn::Cpu,
+                BackendArg::Gpu => crate::app::BindOn::Gpu,
+            },
         })
         .map_err(anyhow::Error::from),
         Some(Command::Bind(args)) => commands::bind(&args),

@@ -311,12 +311,15 @@ impl ViewportRenderer {
         })
     }
 
-    /// Bind weights (or unbind them with `None`, showing the mesh at rest).
-    /// Fails, leaving the weights unbound, when the matrix exceeds the GPU's limit.
+    /// Bind weights (or unbind them with `None`, showing the mesh at rest). A
+    /// `resident` buffer already holding them on this device is used as it is;
+    /// otherwise they are uploaded. Fails, leaving the weights unbound, when the
+    /// matrix exceeds the GPU's limit.
     pub fn set_weights(
         &mut self,
         device: &wgpu::Device,
         weights: Option<&Weights>,
+        resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
         let limit = self.max_storage_binding;
         let Some(mut scene) = self.scene.take() else {
@@ -331,12 +334,15 @@ impl ViewportRenderer {
                 });
                 None
             }
-            Some(weights) if !weights.values.is_empty() => Some(buffer_with(
-                device,
-                "weights",
-                &weights.values,
-                wgpu::BufferUsages::STORAGE,
-            )),
+            Some(weights) if !weights.values.is_empty() => Some(match resident {
+                Some(buffer) => buffer.clone(),
+                None => buffer_with(
+                    device,
+                    "weights",
+                    &weights.values,
+                    wgpu::BufferUsages::STORAGE,
+                ),
+            }),
             _ => None,
         };
         let weights_buffer = scene.weights.as_ref().unwrap_or(&scene.placeholder);
