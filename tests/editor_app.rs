@@ -120,6 +120,26 @@ fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, modifie
     harness.event(Event::ModifiersChanged(Modifiers::NONE));
 }
 
+/// The mesh the GPU draws has moved away from `rest_gpu`, to where the CPU-side
+/// weights put it.
+fn assert_gpu_mesh_moved_as_on_the_cpu(app: &EditorApp, rest_gpu: &[glam::Vec3]) {
+    let moved_gpu = app.read_back_deformed().unwrap().unwrap();
+    assert!(
+        max_distance(&moved_gpu, rest_gpu) > 1e-3,
+        "the GPU mesh moved"
+    );
+    let cpu: Vec<glam::Vec3> = app
+        .scene
+        .deformed_positions()
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect();
+    assert!(
+        max_distance(&moved_gpu, &cpu) < 1e-3,
+        "GPU and CPU deformations agree"
+    );
+}
+
 /// The rendered viewport (left of the side panel) is mostly not background: the
 /// paint callback drew the mesh.
 fn assert_viewport_shows_the_mesh(harness: &mut Harness<'static, EditorApp>) {
@@ -236,21 +256,7 @@ fn click_selects_drag_moves_and_undo_restores() {
         .enumerate()
         .all(|(i, (p, r))| i == handle || p == r);
     assert!(others_still, "only the selected handle moved");
-    let moved_gpu = app.read_back_deformed().unwrap().unwrap();
-    assert!(
-        max_distance(&moved_gpu, &rest_gpu) > 1e-3,
-        "the GPU mesh moved"
-    );
-    let cpu: Vec<glam::Vec3> = app
-        .scene
-        .deformed_positions()
-        .iter()
-        .map(|p| p.as_vec3())
-        .collect();
-    assert!(
-        max_distance(&moved_gpu, &cpu) < 1e-3,
-        "GPU and CPU deformations agree"
-    );
+    assert_gpu_mesh_moved_as_on_the_cpu(app, &rest_gpu);
     assert_viewport_shows_the_mesh(&mut harness);
     harness.snapshot_options(
         "editor_after_drag",
@@ -634,20 +640,5 @@ fn weights_bound_on_the_editors_device_deform_the_mesh() {
         at + egui::vec2(50.0, 40.0),
         Modifiers::NONE,
     );
-    let app = harness.state();
-    let moved_gpu = app.read_back_deformed().unwrap().unwrap();
-    assert!(
-        max_distance(&moved_gpu, &rest_gpu) > 1e-3,
-        "the GPU mesh moved"
-    );
-    let cpu: Vec<glam::Vec3> = app
-        .scene
-        .deformed_positions()
-        .iter()
-        .map(|p| p.as_vec3())
-        .collect();
-    assert!(
-        max_distance(&moved_gpu, &cpu) < 1e-3,
-        "GPU-resident and CPU weights agree"
-    );
+    assert_gpu_mesh_moved_as_on_the_cpu(harness.state(), &rest_gpu);
 }
