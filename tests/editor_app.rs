@@ -94,6 +94,16 @@ fn isolated_handle(harness: &Harness<'static, EditorApp>) -> (usize, Pos2) {
         .expect("some handle stands alone on screen")
 }
 
+/// A plain left click at `at`, as a press and release without movement.
+fn click(harness: &mut Harness<'static, EditorApp>, at: Pos2) {
+    harness.hover_at(at);
+    harness.run_steps(2);
+    harness.drag_at(at);
+    harness.step();
+    harness.drop_at(at);
+    harness.run_steps(2);
+}
+
 fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
     // Held modifier keys, as the window system reports them with every event.
     harness.event(Event::ModifiersChanged(modifiers));
@@ -221,12 +231,7 @@ fn click_selects_drag_moves_and_undo_restores() {
     let (handle, at) = isolated_handle(&harness);
 
     // Click selects.
-    harness.hover_at(at);
-    harness.run_steps(2);
-    harness.drag_at(at);
-    harness.step();
-    harness.drop_at(at);
-    harness.run_steps(2);
+    click(&mut harness, at);
     assert_eq!(
         harness
             .state()
@@ -628,12 +633,7 @@ fn weights_bound_on_the_editors_device_deform_the_mesh() {
     );
     let rest_gpu = harness.state().read_back_deformed().unwrap().unwrap();
     let (_, at) = isolated_handle(&harness);
-    harness.hover_at(at);
-    harness.run_steps(2);
-    harness.drag_at(at);
-    harness.step();
-    harness.drop_at(at);
-    harness.run_steps(2);
+    click(&mut harness, at);
     drag(
         &mut harness,
         at,

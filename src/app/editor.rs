@@ -231,20 +231,8 @@ impl EditorApp {
         self.hovered = None;
         self.history.clear();
         self.drag = None;
-        let rest: Vec<Vec3> = self
-            .scene
-            .mesh
-            .positions
-            .iter()
-            .map(|p| p.as_vec3())
-            .collect();
-        let cage_rest: Vec<Vec3> = self
-            .scene
-            .cage
-            .positions
-            .iter()
-            .map(|p| p.as_vec3())
-            .collect();
+        let rest = to_f32(&self.scene.mesh.positions);
+        let cage_rest = to_f32(&self.scene.cage.positions);
         let triangles = self.scene.mesh.triangles.clone();
         let cage_triangles = self.scene.cage.triangles.clone();
         self.with_renderer(|renderer, device, _| {
@@ -340,13 +328,7 @@ impl EditorApp {
             return; // A bind for a scene that has since been replaced.
         }
         let uploaded = self.with_renderer(|renderer, device, queue| {
-            let rest: Vec<Vec3> = self
-                .scene
-                .mesh
-                .positions
-                .iter()
-                .map(|p| p.as_vec3())
-                .collect();
+            let rest = to_f32(&self.scene.mesh.positions);
             renderer.set_outside(queue, &rest, &outcome.outside);
             renderer.set_weights(device, Some(&outcome.weights), outcome.resident.as_ref())
         });
@@ -370,7 +352,7 @@ impl EditorApp {
     /// Push pending pose and selection changes to the GPU.
     pub fn sync_gpu(&mut self) {
         if self.pose_dirty {
-            let pose: Vec<Vec3> = self.scene.pose.iter().map(|p| p.as_vec3()).collect();
+            let pose = to_f32(&self.scene.pose);
             self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
             self.pose_dirty = false;
         }
@@ -1328,6 +1310,11 @@ fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageErr
         height as u32,
         image::ColorType::Rgba8,
     )
+}
+
+/// Points in the renderer's f32.
+fn to_f32(points: &[glam::DVec3]) -> Vec<Vec3> {
+    points.iter().map(|p| p.as_vec3()).collect()
 }
 
 /// With [`BindOn::Auto`], bind on the editor's own device when it is a hardware

@@ -344,16 +344,9 @@ pub struct Scene {
     pub points: Vec<DVec3>,
 }
 
-/// Scenes of the sizes in the paper's Table 1, all with non-convex cages:
-/// Armadillo (15,002 vertices, 110 cage vertices), Horse (48,485 in 51),
+/// Names of the scenes of the sizes in the paper's Table 1, all with non-convex
+/// cages: Armadillo (15,002 vertices, 110 cage vertices), Horse (48,485 in 51),
 /// Hand (24,795 in 252).
-pub fn table1_scenes() -> Vec<Scene> {
-    table1_scene_names()
-        .iter()
-        .map(|name| table1_scene(name).expect("known scene"))
-        .collect()
-}
-
 pub fn table1_scene_names() -> &'static [&'static str] {
     &["armadillo-size", "horse-size", "hand-size"]
 }
