@@ -15,9 +15,11 @@
 pub mod cubemap;
 pub mod mvc;
 pub mod pmvc;
+pub mod quality;
 
 use crate::geometry::{Cage, PointClass};
 use glam::DVec3;
+pub use quality::WeightQuality;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 

@@ -10,6 +10,7 @@ mod io;
 mod obj;
 mod off;
 pub mod procedural;
+pub mod subdivide;
 
 pub use cage::{validate_cage, Cage, CageReport};
 pub use classify::{
@@ -18,6 +19,7 @@ pub use classify::{
 };
 pub use error::{CageError, CageLoadError, LoadError, WriteError};
 pub use io::{load_cage, load_mesh, write_atomically, write_deformed_mesh, write_obj};
+pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;
 use std::path::PathBuf;
