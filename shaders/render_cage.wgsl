@@ -7,6 +7,8 @@ struct Frame {
     eye: vec4<f32>,
     viewport: vec4<f32>,
     counts: vec4<u32>,
+    colouring: vec4<u32>,
+    colour_scale: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -3,132 +3,14 @@
 //! and pass, unless `PMVC_REQUIRE_GPU=1`, which turns a missing adapter into a
 //! failure.
 
+mod common;
+
+use common::editor::*;
 use egui::{Event, Key, Modifiers, PointerButton, Pos2};
 use egui_kittest::{Harness, SnapshotOptions};
 use pmvc::app::editor::FileRole;
-use pmvc::app::{BindOn, EditorApp, EditorOptions};
-use std::time::{Duration, Instant};
-
-/// A fast resolution keeps the binds in these tests short.
-const TEST_RESOLUTION: u32 = 8;
-
-fn render_state() -> Option<eframe::egui_wgpu::RenderState> {
-    let setup = egui_kittest::wgpu::default_wgpu_setup();
-    let created = pollster::block_on(async {
-        let instance = setup.new_instance().await;
-        eframe::egui_wgpu::RenderState::create(
-            &eframe::egui_wgpu::WgpuConfiguration {
-                wgpu_setup: setup,
-                ..Default::default()
-            },
-            &instance,
-            None,
-            eframe::egui_wgpu::RendererOptions::PREDICTABLE,
-        )
-        .await
-    });
-    match created {
-        Ok(state) => Some(state),
-        Err(error) if std::env::var("PMVC_REQUIRE_GPU").as_deref() == Ok("1") => {
-            panic!("PMVC_REQUIRE_GPU=1 but no wgpu adapter: {error}")
-        }
-        Err(error) => {
-            eprintln!("not run: no wgpu adapter ({error})");
-            None
-        }
-    }
-}
-
-fn editor() -> Option<Harness<'static, EditorApp>> {
-    editor_binding_on(BindOn::Auto)
-}
-
-fn editor_binding_on(bind_on: BindOn) -> Option<Harness<'static, EditorApp>> {
-    let state = render_state()?;
-    let harness = Harness::builder()
-        .with_size(egui::vec2(1100.0, 700.0))
-        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
-            state,
-        ))
-        .build_eframe(|cc| {
-            EditorApp::new(
-                cc,
-                EditorOptions {
-                    resolution: Some(TEST_RESOLUTION),
-                    bind_on,
-                    ..Default::default()
-                },
-            )
-        });
-    Some(harness)
-}
-
-/// Step the app until the bind finishes, checking that progress is reported.
-fn run_until_bound(harness: &mut Harness<'static, EditorApp>) {
-    let deadline = Instant::now() + Duration::from_secs(300);
-    while harness.state().is_binding() {
-        assert!(Instant::now() < deadline, "the bind did not finish in time");
-        harness.step();
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    harness.run_steps(3);
-}
-
-/// A cage handle with no other handle near it on screen, and its position.
-fn isolated_handle(harness: &Harness<'static, EditorApp>) -> (usize, Pos2) {
-    let app = harness.state();
-    let screen: Vec<Option<Pos2>> = (0..app.scene.pose.len())
-        .map(|i| app.handle_screen_position(i))
-        .collect();
-    screen
-        .iter()
-        .enumerate()
-        .filter_map(|(i, p)| Some((i, (*p)?)))
-        .filter(|(_, p)| p.x > 50.0 && p.x < 700.0 && p.y > 80.0 && p.y < 650.0)
-        .find(|(i, p)| {
-            screen
-                .iter()
-                .enumerate()
-                .all(|(j, q)| j == *i || q.is_none_or(|q| q.distance(*p) > 25.0))
-        })
-        .expect("some handle stands alone on screen")
-}
-
-/// A plain left click at `at`, as a press and release without movement.
-fn click(harness: &mut Harness<'static, EditorApp>, at: Pos2) {
-    harness.hover_at(at);
-    harness.run_steps(2);
-    harness.drag_at(at);
-    harness.step();
-    harness.drop_at(at);
-    harness.run_steps(2);
-}
-
-fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
-    // Held modifier keys, as the window system reports them with every event.
-    harness.event(Event::ModifiersChanged(modifiers));
-    harness.hover_at(from);
-    harness.run_steps(2);
-    harness.event(Event::PointerButton {
-        pos: from,
-        button: PointerButton::Primary,
-        pressed: true,
-        modifiers,
-    });
-    harness.step();
-    for k in 1..=10 {
-        harness.hover_at(from + (to - from) * (k as f32 / 10.0));
-        harness.step();
-    }
-    harness.event(Event::PointerButton {
-        pos: to,
-        button: PointerButton::Primary,
-        pressed: false,
-        modifiers,
-    });
-    harness.run_steps(2);
-    harness.event(Event::ModifiersChanged(Modifiers::NONE));
-}
+use pmvc::app::{BindOn, EditorApp};
+use pmvc::coords::Method;
 
 /// The mesh the GPU draws has moved away from `rest_gpu`, to where the CPU-side
 /// weights put it.
@@ -140,7 +22,7 @@ fn assert_gpu_mesh_moved_as_on_the_cpu(app: &EditorApp, rest_gpu: &[glam::Vec3])
     );
     let cpu: Vec<glam::Vec3> = app
         .scene
-        .deformed_positions()
+        .deformed_positions(app.active_method())
         .iter()
         .map(|p| p.as_vec3())
         .collect();
@@ -173,13 +55,6 @@ fn assert_viewport_shows_the_mesh(harness: &mut Harness<'static, EditorApp>) {
     );
 }
 
-fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max)
-}
-
 #[test]
 fn default_scene_binds_with_progress_to_completion() {
     let Some(mut harness) = editor() else { return };
@@ -198,11 +73,12 @@ fn default_scene_binds_with_progress_to_completion() {
     );
     let weights = app
         .scene
-        .weights
-        .as_ref()
+        .weights(Method::Pmvc)
         .expect("weights exist after the bind");
     assert_eq!(weights.rows, total);
-    assert!(app.scene.bind_time.is_some());
+    // Both methods are bound, each once.
+    assert_eq!(app.scene.weights(Method::Mvc).unwrap().rows, total);
+    assert_eq!(app.bind_count, 2);
     assert!(app.scene.outside.is_empty());
     // At rest the GPU deformation reproduces the mesh (linear precision).
     let deformed = app.read_back_deformed().unwrap().unwrap();
@@ -346,7 +222,7 @@ fn malformed_files_show_an_error_and_keep_the_scene() {
     assert_eq!(harness.state().scene.mesh.positions.len(), vertices);
     run_until_bound(&mut harness);
     assert!(
-        harness.state().scene.weights.is_some(),
+        harness.state().scene.weights(Method::Pmvc).is_some(),
         "the scene still binds"
     );
 }
@@ -357,7 +233,8 @@ fn cancelling_a_bind_keeps_the_previous_state_usable() {
     // Cancel the very first bind: the mesh stays at rest and editable.
     harness.state_mut().cancel_bind();
     run_until_bound(&mut harness);
-    assert!(harness.state().scene.weights.is_none());
+    assert!(harness.state().scene.weights(Method::Pmvc).is_none());
+    assert!(harness.state().scene.weights(Method::Mvc).is_none());
     let rest = harness.state().read_back_deformed().unwrap().unwrap();
     assert_eq!(rest.len(), harness.state().scene.mesh.positions.len());
 
@@ -365,15 +242,20 @@ fn cancelling_a_bind_keeps_the_previous_state_usable() {
     let ctx = harness.ctx.clone();
     harness.state_mut().start_bind(&ctx);
     run_until_bound(&mut harness);
-    let weights = harness.state().scene.weights.clone().expect("bound");
-    harness.state_mut().bind_options.resolution = 24;
-    harness.state_mut().start_bind(&ctx);
+    let weights = harness
+        .state()
+        .scene
+        .weights(Method::Pmvc)
+        .cloned()
+        .expect("bound");
+    harness.state_mut().set_resolution(24);
+    assert!(harness.state().is_binding());
     harness.step();
     harness.state_mut().cancel_bind();
     run_until_bound(&mut harness);
     let app = harness.state();
     assert!(std::sync::Arc::ptr_eq(
-        app.scene.weights.as_ref().unwrap(),
+        app.scene.weights(Method::Pmvc).unwrap(),
         &weights
     ));
     assert!(app.read_back_deformed().unwrap().is_ok());
@@ -398,7 +280,7 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
         .unwrap()
         .mesh
         .positions;
-    let expected = app.scene.deformed_positions();
+    let expected = app.scene.deformed_positions(app.active_method());
     assert_eq!(exported.len(), expected.len());
     let worst = exported
         .iter()
@@ -573,7 +455,7 @@ fn dropped_mesh_rebinds_and_reports_outside_vertices() {
     let app = harness.state();
     assert_eq!(app.scene.mesh.positions.len(), 3);
     assert_eq!(app.scene.outside, vec![2]);
-    assert_eq!(app.scene.weights.as_ref().unwrap().rows, 3);
+    assert_eq!(app.scene.weights(Method::Pmvc).unwrap().rows, 3);
 }
 
 #[test]
@@ -610,7 +492,7 @@ fn shift_click_toggles_and_the_scenes_menu_switches_scenes() {
     run_until_bound(&mut harness);
     let app = harness.state();
     assert_eq!(app.scene.mesh.positions.len(), 2775);
-    assert!(app.scene.weights.is_some());
+    assert!(app.scene.weights(Method::Pmvc).is_some());
     assert!(app.scene.outside.is_empty());
 }
 
@@ -622,15 +504,14 @@ fn weights_bound_on_the_editors_device_deform_the_mesh() {
         return;
     };
     run_until_bound(&mut harness);
-    assert!(
-        !harness
-            .state()
-            .scene
-            .bind_device
-            .eq_ignore_ascii_case("cpu"),
-        "bound on {}",
-        harness.state().scene.bind_device
-    );
+    let device = harness
+        .state()
+        .scene
+        .bound(Method::Pmvc)
+        .expect("bound")
+        .device
+        .clone();
+    assert!(!device.eq_ignore_ascii_case("cpu"), "bound on {device}");
     let rest_gpu = harness.state().read_back_deformed().unwrap().unwrap();
     let (_, at) = isolated_handle(&harness);
     click(&mut harness, at);

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use pmvc::app::scenes::{comb_cage, comb_mesh};
-use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
+use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method, WeightQuality, Weights};
 use pmvc::geometry::classify_points;
 
 /// Largest displacement of `points` when the middle prong's tip moves sideways.
@@ -61,4 +61,38 @@ fn mvc_drags_the_neighbouring_fingers_and_pmvc_does_not() {
         pmvc < 0.2 * mvc,
         "PMVC keeps them (nearly) still ({pmvc} vs {mvc})"
     );
+}
+
+/// The whole default scene at the editor's default resolution: MVC has clearly
+/// negative weights, PMVC none.
+#[test]
+fn on_the_default_scene_mvc_is_negative_and_pmvc_is_not() {
+    let mesh = comb_mesh();
+    let cage = comb_cage();
+    let classes = classify_points(&cage, &mesh.positions);
+    let quality = |method| {
+        let options = BindOptions {
+            method,
+            resolution: pmvc::coords::DEFAULT_RESOLUTION,
+        };
+        let weights = bind_cpu(
+            &mesh.positions,
+            &classes.classes,
+            &cage,
+            options,
+            &BindProgress::default(),
+        )
+        .expect("not cancelled");
+        WeightQuality::measure(&weights, &mesh.positions, &cage.positions)
+    };
+    let mvc = quality(Method::Mvc);
+    let pmvc = quality(Method::Pmvc);
+    assert!(mvc.negative_share > 0.5, "{mvc:?}");
+    assert!(mvc.most_negative < -0.05, "{mvc:?}");
+    assert_eq!(pmvc.negative_vertices, 0, "{pmvc:?}");
+    assert!(pmvc.most_negative >= 0.0);
+    for quality in [mvc, pmvc] {
+        assert!(quality.max_partition_error < 1e-5, "{quality:?}");
+        assert!(quality.max_linear_precision_error < 1e-5, "{quality:?}");
+    }
 }

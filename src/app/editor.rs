@@ -1,18 +1,28 @@
-//! The editor application: menus, side panel, status bar, and the viewport's
-//! mouse and keyboard handling. GPU work goes through [`crate::render`]; binding
-//! through [`super::jobs`].
+//! The editor application: menus, toolbar, side panel, and the viewports' mouse
+//! and keyboard handling. GPU work goes through [`crate::render`]; binding
+//! through [`super::jobs`]; what the views compare is [`super::compare`].
+//!
+//! Both methods are bound for every scene (the active one first) and both weight
+//! sets stay on the GPU, so switching between MVC and PMVC, or showing them side
+//! by side, never rebinds.
 
+use super::compare::{
+    self, HoverReadout, Layout, Overlay, Pane, ValueRange, ViewSettings, HOVER_TOP_WEIGHTS,
+};
 use super::jobs::{BindJob, BindOutcome, JobError};
-use super::scene::{PoseHistory, Scene};
+use super::scene::{Bound, PoseHistory, Scene};
 use super::scenes::BundledScene;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, DEFAULT_RESOLUTION};
-use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
+use crate::geometry::{
+    load_cage, load_mesh, subdivide_midpoint, write_deformed_mesh, write_obj, TriMesh,
+};
 use crate::gpu::{Backend, GpuContext};
+use crate::render::colormap::{self, Scale};
 use crate::render::viewport::MSAA_SAMPLES;
 use crate::render::{
-    FrameParams, OrbitCamera, RenderError, SceneUpload, ScreenProjection, ViewportCallback,
-    ViewportRenderer,
+    Colouring, FrameParams, OrbitCamera, ReadBack, RenderError, SceneUpload, ScreenProjection,
+    Shading, ViewportCallback, ViewportRenderer, MAX_VIEWS,
 };
 use eframe::egui_wgpu;
 use egui::{Color32, Key, KeyboardShortcut, Modifiers, PointerButton, Pos2, Rect, Sense, Stroke};
@@ -31,6 +41,12 @@ const RECENT_LIMIT: usize = 8;
 const FRAME_SAMPLES: usize = 120;
 /// Frames drawn after the bind before `--screenshot` captures.
 const SCREENSHOT_FRAMES: u32 = 90;
+/// The resolutions the PMVC selector offers.
+pub const RESOLUTION_CHOICES: [u32; 4] = [16, 32, 64, 128];
+/// The hover read-out picks mesh vertices within this many points of the cursor.
+const HOVER_RADIUS: f32 = 6.0;
+/// Gap between side-by-side views, in points.
+const PANE_GAP: f32 = 2.0;
 
 /// What a mouse drag in the viewport is doing.
 #[derive(Clone, Debug)]
@@ -73,14 +89,25 @@ pub enum FileRole {
 
 pub struct EditorApp {
     gpu: Option<Gpu>,
+    /// For waking the UI from bind threads started outside a frame.
+    egui_ctx: egui::Context,
     pub scene: Scene,
+    /// The camera of the first view, and of every view while they are locked.
     pub camera: OrbitCamera,
+    /// Cameras of the other views while unlocked (index = view).
+    pane_cameras: [OrbitCamera; MAX_VIEWS],
+    /// What the viewport compares and how the mesh is coloured.
+    pub view: ViewSettings,
     pub selection: BTreeSet<usize>,
     hovered: Option<usize>,
     history: PoseHistory,
     drag: Option<Drag>,
     job: Option<BindJob>,
-    /// Method and resolution for the next bind.
+    /// Binds to run after the current one, in order.
+    pending_binds: VecDeque<BindOptions>,
+    /// Binds started so far (a method switch must not add one).
+    pub bind_count: usize,
+    /// The method shown in a single view (and bound first), and the PMVC resolution.
     pub bind_options: BindOptions,
     pub notices: Vec<Notice>,
     pub show_statistics: bool,
@@ -91,7 +118,16 @@ pub struct EditorApp {
     /// Set when the pose or selection changed and the GPU copy is stale.
     pose_dirty: bool,
     handles_dirty: bool,
-    projection: Option<ScreenProjection>,
+    /// The views drawn last frame, each with its screen rectangle and projection.
+    panes: Vec<(Pane, Rect, ScreenProjection)>,
+    /// The mesh deformed on the CPU per method for the current pose (hover picking
+    /// and the difference's colour bar); cleared when the pose or weights change.
+    deformed_cache: [Option<Arc<Vec<Vec3>>>; 2],
+    /// The weights under the cursor, and the view they were read in.
+    pub hover_readout: Option<(usize, HoverReadout)>,
+    /// Colour-bar ranges already computed (a row-minimum scan of a large matrix
+    /// is too slow to repeat every frame); cleared when what they depend on changes.
+    range_cache: Vec<((Colouring, Method), Option<ValueRange>)>,
     path_input: String,
     screenshot: Option<ScreenshotState>,
     /// Vertices done / total reported by the last bind when it ended.
@@ -135,13 +171,18 @@ impl EditorApp {
         let (mesh, cage) = BundledScene::Comb.build();
         let mut app = Self {
             gpu,
+            egui_ctx: cc.egui_ctx.clone(),
             scene: Scene::new(BundledScene::Comb.title(), mesh, cage),
             camera: OrbitCamera::default(),
+            pane_cameras: [OrbitCamera::default(); MAX_VIEWS],
+            view: options.view,
             selection: BTreeSet::new(),
             hovered: None,
             history: PoseHistory::default(),
             drag: None,
             job: None,
+            pending_binds: VecDeque::new(),
+            bind_count: 0,
             bind_options: BindOptions {
                 method: options.method.unwrap_or(Method::Pmvc),
                 resolution: options.resolution.unwrap_or(DEFAULT_RESOLUTION).max(1),
@@ -154,7 +195,10 @@ impl EditorApp {
             last_frame: None,
             pose_dirty: true,
             handles_dirty: true,
-            projection: None,
+            panes: Vec::new(),
+            deformed_cache: [None, None],
+            hover_readout: None,
+            range_cache: Vec::new(),
             path_input: String::new(),
             last_bind_progress: None,
             retry_bind: false,
@@ -183,6 +227,15 @@ impl EditorApp {
         }
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
+        }
+        let cage_vertices = app.scene.pose.len();
+        if options.view.heat_vertex >= cage_vertices {
+            app.error(format!(
+                "--heatmap {}: the cage has {cage_vertices} vertices (0 to {}); showing vertex {}",
+                options.view.heat_vertex,
+                cage_vertices.saturating_sub(1),
+                app.view.heat_vertex
+            ));
         }
         app.start_bind(&cc.egui_ctx);
         app
@@ -226,7 +279,13 @@ impl EditorApp {
     /// Make `scene` current: upload it, reset selection and history, frame it.
     fn install_scene(&mut self, scene: Scene) {
         self.job = None;
+        self.pending_binds.clear();
+        self.deformed_cache = [None, None];
+        self.hover_readout = None;
+        self.range_cache.clear();
         self.scene = scene;
+        let cage_vertices = self.scene.pose.len();
+        self.view.heat_vertex = self.view.heat_vertex.min(cage_vertices.saturating_sub(1));
         self.selection.clear();
         self.hovered = None;
         self.history.clear();
@@ -251,22 +310,127 @@ impl EditorApp {
         self.frame_scene();
     }
 
-    /// Start binding the current mesh and cage with `bind_options`, replacing any
-    /// running bind. Existing weights stay in use until the new ones arrive.
+    /// Bind the current mesh and cage with both methods, the active one first,
+    /// replacing any running bind. Existing weights stay in use until new ones arrive.
     pub fn start_bind(&mut self, ctx: &egui::Context) {
+        let active = self.bind_options.method;
+        self.bind_methods(ctx, &[active, other_method(active)]);
+    }
+
+    /// Bind `methods` in order (PMVC at `bind_options.resolution`), replacing any
+    /// running or queued bind.
+    fn bind_methods(&mut self, ctx: &egui::Context, methods: &[Method]) {
+        self.job = None;
+        self.pending_binds = methods
+            .iter()
+            .map(|&method| BindOptions {
+                method,
+                resolution: self.bind_options.resolution,
+            })
+            .collect();
+        self.launch_next_bind(ctx);
+    }
+
+    fn launch_next_bind(&mut self, ctx: &egui::Context) {
+        let Some(options) = self.pending_binds.pop_front() else {
+            return;
+        };
         let ctx = ctx.clone();
         let points = Arc::new(self.scene.mesh.positions.clone());
+        self.bind_count += 1;
         self.job = Some(BindJob::start(
             points,
             Arc::clone(&self.scene.cage),
-            self.bind_options,
+            options,
             self.bind_backend.clone(),
             move || ctx.request_repaint(),
         ));
     }
 
+    /// A bind is running or queued.
     pub fn is_binding(&self) -> bool {
-        self.job.is_some()
+        self.job.is_some() || !self.pending_binds.is_empty()
+    }
+
+    /// The method a single view shows.
+    pub fn active_method(&self) -> Method {
+        self.bind_options.method
+    }
+
+    /// Show `method`: instant, from the weights already bound. Only a method that
+    /// has no weights and none on the way is bound.
+    pub fn set_active_method(&mut self, method: Method) {
+        if method == self.bind_options.method {
+            return;
+        }
+        self.bind_options.method = method;
+        self.hover_readout = None;
+        let on_the_way = self
+            .job
+            .as_ref()
+            .is_some_and(|j| j.options().method == method)
+            || self.pending_binds.iter().any(|o| o.method == method);
+        if self.scene.bound(method).is_none() && !on_the_way {
+            let ctx = self.egui_ctx.clone();
+            self.pending_binds.push_back(BindOptions {
+                method,
+                resolution: self.bind_options.resolution,
+            });
+            if self.job.is_none() {
+                self.launch_next_bind(&ctx);
+            }
+        }
+    }
+
+    /// Switch between MVC and PMVC (the M key).
+    pub fn toggle_method(&mut self) {
+        self.set_active_method(other_method(self.bind_options.method));
+    }
+
+    /// Rebind PMVC at `resolution` (MVC does not depend on it).
+    pub fn set_resolution(&mut self, resolution: u32) {
+        let resolution = resolution.max(1);
+        if resolution == self.bind_options.resolution {
+            return;
+        }
+        self.bind_options.resolution = resolution;
+        let ctx = self.egui_ctx.clone();
+        let mut methods = vec![Method::Pmvc];
+        // A queued MVC bind still has to happen.
+        if self.scene.bound(Method::Mvc).is_none() {
+            methods.push(Method::Mvc);
+        }
+        self.bind_methods(&ctx, &methods);
+    }
+
+    /// Subdivide the cage 1-to-4 at edge midpoints, keeping the current pose
+    /// (smoother coordinates near reflex edges, the paper's Figure 4), and rebind.
+    pub fn subdivide_cage(&mut self) -> bool {
+        let subdivided = match subdivide_midpoint(&self.scene.cage, &self.scene.pose) {
+            Ok(subdivided) => subdivided,
+            Err(error) => {
+                self.error(format!("cannot subdivide the cage: {error}"));
+                return false;
+            }
+        };
+        let (before, after) = (self.scene.pose.len(), subdivided.cage.vertex_count());
+        let mut scene = Scene::new(
+            self.scene.title.clone(),
+            (*self.scene.mesh).clone(),
+            subdivided.cage,
+        );
+        scene.mesh_file = self.scene.mesh_file.clone();
+        scene.pose = subdivided.pose;
+        let camera = self.camera;
+        self.install_scene(scene);
+        self.camera = camera;
+        self.pose_dirty = true;
+        self.info(format!(
+            "subdivided the cage: {before} -> {after} vertices; rebinding"
+        ));
+        let ctx = self.egui_ctx.clone();
+        self.start_bind(&ctx);
+        true
     }
 
     /// Bind progress as (done, total), while binding.
@@ -274,24 +438,24 @@ impl EditorApp {
         self.job.as_ref().map(|job| (job.done(), job.total()))
     }
 
+    /// Cancel the running bind and those queued after it.
     pub fn cancel_bind(&mut self) {
+        self.pending_binds.clear();
         if let Some(job) = &self.job {
             job.cancel();
         }
     }
 
-    /// Wait for the running bind (tests and `--screenshot`); true if it finished.
+    /// Wait for the running and queued binds (tests); true if they finished.
     pub fn wait_for_bind(&mut self, timeout: Duration) -> bool {
-        let Some(job) = &mut self.job else {
-            return true;
-        };
-        match job.wait(timeout) {
-            Some(result) => {
-                self.finish_bind(result);
-                true
+        let deadline = Instant::now() + timeout;
+        while let Some(job) = &mut self.job {
+            match job.wait(deadline.saturating_duration_since(Instant::now())) {
+                Some(result) => self.finish_bind(result),
+                None => return false,
             }
-            None => false,
         }
+        true
     }
 
     fn poll_bind(&mut self) {
@@ -302,12 +466,15 @@ impl EditorApp {
     }
 
     fn finish_bind(&mut self, result: Result<BindOutcome, JobError>) {
+        let mut failed_options = None;
         if let Some(job) = self.job.take() {
             self.last_bind_progress = Some((job.done(), job.total()));
+            failed_options = Some(job.options());
         }
         let outcome = match result {
             Ok(outcome) => outcome,
             Err(JobError::Cancelled) => {
+                self.pending_binds.clear();
                 self.info("binding cancelled; the previous weights (if any) stay in use");
                 return;
             }
@@ -317,36 +484,141 @@ impl EditorApp {
                     // The CPU path always works; use it from now on.
                     self.bind_backend = Backend::Cpu;
                     self.info("retrying the bind on the CPU");
+                    if let Some(options) = failed_options {
+                        self.pending_binds.push_front(options);
+                    }
                     self.retry_bind = true;
+                } else {
+                    let ctx = self.egui_ctx.clone();
+                    self.launch_next_bind(&ctx);
                 }
                 return;
             }
         };
+        let ctx = self.egui_ctx.clone();
+        self.install_weights(outcome);
+        self.launch_next_bind(&ctx);
+    }
+
+    /// Put a finished bind's weights in the scene and on the GPU.
+    fn install_weights(&mut self, outcome: BindOutcome) {
         if outcome.weights.rows != self.scene.mesh.positions.len()
             || outcome.weights.cols != self.scene.cage.vertex_count()
         {
             return; // A bind for a scene that has since been replaced.
         }
+        let method = outcome.options.method;
         let uploaded = self.with_renderer(|renderer, device, queue| {
             let rest = to_f32(&self.scene.mesh.positions);
             renderer.set_outside(queue, &rest, &outcome.outside);
-            renderer.set_weights(device, Some(&outcome.weights), outcome.resident.as_ref())
+            renderer.set_weights(
+                device,
+                method,
+                Some(&outcome.weights),
+                outcome.resident.as_ref(),
+            )
         });
         if let Some(Err(error)) = uploaded {
             self.error(error.to_string());
         }
-        self.scene.weights = Some(outcome.weights);
-        self.scene.bound_with = Some(outcome.options);
-        self.scene.bind_time = Some(outcome.elapsed);
-        self.scene.bind_device = outcome.device;
+        self.scene.set_bound(
+            method,
+            Bound {
+                weights: outcome.weights,
+                options: outcome.options,
+                bind_time: outcome.elapsed,
+                device: outcome.device,
+                quality: outcome.quality,
+            },
+        );
         self.scene.outside = outcome.outside;
+        self.deformed_cache[method_slot(method)] = None;
+        self.hover_readout = None;
+        self.range_cache.clear();
         self.pose_dirty = true;
     }
 
-    /// Deformed mesh positions as the vertex shader computes them, read back from
-    /// the GPU.
+    /// Deformed mesh positions of the active method as the vertex shader computes
+    /// them, read back from the GPU.
     pub fn read_back_deformed(&self) -> Option<Result<Vec<Vec3>, RenderError>> {
-        self.with_renderer(|renderer, device, queue| renderer.read_back_deformed(device, queue))
+        let shading = Shading {
+            method: self.active_method(),
+            ..Default::default()
+        };
+        self.read_back(&shading)
+            .map(|result| result.map(|read_back| read_back.positions))
+    }
+
+    /// Positions, colouring values and colours as the shaders compute them.
+    pub fn read_back(&self, shading: &Shading) -> Option<Result<ReadBack, RenderError>> {
+        self.with_renderer(|renderer, device, queue| renderer.read_back(device, queue, shading))
+    }
+
+    /// How view `pane` is shaded this frame (method, colouring and colour scale).
+    pub fn shading_of(&mut self, pane: Pane) -> Shading {
+        let colouring = self.view.colouring(pane);
+        Shading {
+            method: pane.method(),
+            colouring,
+            scale: self.view.scale,
+            colour_limit: self.colour_limit(colouring),
+            cage_size: compare::cage_size(&self.scene.cage.positions) as f32,
+        }
+    }
+
+    /// The mesh deformed with `method` on the CPU for the current pose (cached).
+    fn deformed_on_cpu(&mut self, method: Method) -> Option<Arc<Vec<Vec3>>> {
+        let slot = method_slot(method);
+        if self.deformed_cache[slot].is_none() {
+            let weights = self.scene.weights(method)?;
+            self.deformed_cache[slot] = Some(Arc::new(compare::deform(weights, &self.scene.pose)));
+        }
+        self.deformed_cache[slot].clone()
+    }
+
+    /// The range of the values `colouring` shows with `method`'s weights.
+    pub fn value_range(&mut self, colouring: Colouring, method: Method) -> Option<ValueRange> {
+        let key = (colouring, method);
+        if let Some((_, range)) = self.range_cache.iter().find(|(k, _)| *k == key) {
+            return *range;
+        }
+        let range = self.compute_value_range(colouring, method);
+        self.range_cache.push((key, range));
+        range
+    }
+
+    fn compute_value_range(&mut self, colouring: Colouring, method: Method) -> Option<ValueRange> {
+        match colouring {
+            Colouring::Shaded => None,
+            Colouring::CageVertexWeight(vertex) => {
+                compare::column_range(self.scene.weights(method)?, vertex as usize)
+            }
+            Colouring::MostNegativeWeight => {
+                compare::row_minimum_range(self.scene.weights(method)?)
+            }
+            Colouring::MethodDistance => {
+                let mvc = self.deformed_on_cpu(Method::Mvc)?;
+                let pmvc = self.deformed_on_cpu(Method::Pmvc)?;
+                let size = compare::cage_size(&self.scene.cage.positions) as f32;
+                compare::distance_range(&pmvc, &mvc, size)
+            }
+        }
+    }
+
+    /// The magnitude at which `colouring`'s colours saturate: the same for both
+    /// methods, so that MVC and PMVC are compared on one scale, side by side or
+    /// when toggling.
+    fn colour_limit(&mut self, colouring: Colouring) -> f32 {
+        let limit = [Method::Mvc, Method::Pmvc]
+            .into_iter()
+            .filter_map(|method| self.value_range(colouring, method))
+            .map(|range| range.magnitude())
+            .fold(0.0f32, f32::max);
+        if limit > 0.0 {
+            limit
+        } else {
+            1.0
+        }
     }
 
     /// Push pending pose and selection changes to the GPU.
@@ -377,6 +649,9 @@ impl EditorApp {
         if pose.len() == self.scene.pose.len() {
             self.scene.pose = pose;
             self.pose_dirty = true;
+            self.deformed_cache = [None, None];
+            self.range_cache
+                .retain(|((colouring, _), _)| *colouring != Colouring::MethodDistance);
         }
     }
 
@@ -418,6 +693,32 @@ impl EditorApp {
     pub fn frame_scene(&mut self) {
         let (centre, radius) = self.scene.bounding_sphere();
         self.camera.frame(centre.as_vec3(), radius as f32);
+        self.pane_cameras = [self.camera; MAX_VIEWS];
+    }
+
+    /// Lock all views to one camera (the first view's) or give each its own.
+    pub fn set_cameras_locked(&mut self, locked: bool) {
+        if locked != self.view.cameras_locked {
+            self.view.cameras_locked = locked;
+            self.pane_cameras = [self.camera; MAX_VIEWS];
+        }
+    }
+
+    /// The camera view `pane` is drawn with.
+    pub fn camera_of(&self, pane: usize) -> OrbitCamera {
+        if self.view.cameras_locked || pane == 0 {
+            self.camera
+        } else {
+            self.pane_cameras[pane.min(MAX_VIEWS - 1)]
+        }
+    }
+
+    fn camera_mut(&mut self, pane: usize) -> &mut OrbitCamera {
+        if self.view.cameras_locked || pane == 0 {
+            &mut self.camera
+        } else {
+            &mut self.pane_cameras[pane.min(MAX_VIEWS - 1)]
+        }
     }
 
     fn remember(&mut self, role: FileRole, path: &Path) {
@@ -461,7 +762,7 @@ impl EditorApp {
     /// Replace the mesh (keeping the cage) or the cage (keeping the mesh), then
     /// rebind. A file that fails to load or validate changes nothing.
     pub fn open_file(&mut self, ctx: &egui::Context, role: FileRole, path: &Path) -> bool {
-        let mut scene = match role {
+        let scene = match role {
             FileRole::Mesh => match load_mesh(path) {
                 Ok(file) => {
                     let mut scene = Scene::new(
@@ -496,7 +797,6 @@ impl EditorApp {
                 }
             },
         };
-        scene.weights = None;
         self.install_scene(scene);
         self.remember(role, path);
         self.info(format!("opened {}", path.display()));
@@ -548,7 +848,7 @@ impl EditorApp {
     }
 
     pub fn export_deformed(&mut self, path: &Path) {
-        let positions = self.scene.deformed_positions();
+        let positions = self.scene.deformed_positions(self.active_method());
         let result = match &self.scene.mesh_file {
             Some(file) => write_deformed_mesh(file, &positions, path),
             None => write_obj(
@@ -604,14 +904,18 @@ impl EditorApp {
         let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
         let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
         let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
-        let (redo, undo, escape, frame) = ctx.input_mut(|i| {
+        let (redo, undo, escape, frame, toggle_method) = ctx.input_mut(|i| {
             (
                 i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y),
                 i.consume_shortcut(&undo),
                 i.key_pressed(Key::Escape),
                 i.key_pressed(Key::F) && i.modifiers.is_none(),
+                i.key_pressed(Key::M) && i.modifiers.is_none(),
             )
         });
+        if toggle_method {
+            self.toggle_method();
+        }
         if redo {
             self.redo();
         }
@@ -626,9 +930,21 @@ impl EditorApp {
         }
     }
 
-    /// The handle nearest to `pointer` within the pick radius.
+    /// The projection of view `pane` as drawn last frame.
+    fn projection(&self, pane: usize) -> Option<ScreenProjection> {
+        self.panes.get(pane).map(|(_, _, projection)| *projection)
+    }
+
+    /// The view under `pointer`.
+    fn pane_at(&self, pointer: Pos2) -> Option<usize> {
+        self.panes
+            .iter()
+            .position(|(_, rect, _)| rect.contains(pointer))
+    }
+
+    /// The handle nearest to `pointer` within the pick radius, in the view under it.
     fn pick(&self, pointer: Pos2) -> Option<usize> {
-        let projection = self.projection?;
+        let projection = self.projection(self.pane_at(pointer)?)?;
         let pointer = Vec2::new(pointer.x, pointer.y);
         self.scene
             .pose
@@ -643,60 +959,79 @@ impl EditorApp {
             .map(|(i, _)| i)
     }
 
-    /// Screen position (in points) of a cage handle, for tests and tools.
+    /// Screen position (in points) of a cage handle in the first view.
     pub fn handle_screen_position(&self, handle: usize) -> Option<Pos2> {
+        self.handle_screen_position_in(0, handle)
+    }
+
+    /// Screen position (in points) of a cage handle in view `pane`.
+    pub fn handle_screen_position_in(&self, pane: usize, handle: usize) -> Option<Pos2> {
         let screen = self
-            .projection?
+            .projection(pane)?
             .project(self.scene.pose.get(handle)?.as_vec3())?;
         Some(Pos2::new(screen.x, screen.y))
     }
 
-    fn viewport(&mut self, ui: &mut egui::Ui) {
-        let rect = ui.available_rect_before_wrap();
-        let response = ui.allocate_rect(rect, Sense::click_and_drag());
-        let aspect = rect.width() / rect.height().max(1.0);
-        let projection = ScreenProjection {
-            view_projection: self.camera.view_projection(aspect),
-            origin: Vec2::new(rect.min.x, rect.min.y),
-            size: Vec2::new(rect.width(), rect.height()),
-        };
-        self.projection = Some(projection);
-        self.viewport_input(ui, &response, rect);
-        // The input may have moved the camera; draw with the final one.
-        let projection = ScreenProjection {
-            view_projection: self.camera.view_projection(aspect),
-            ..projection
-        };
-        self.projection = Some(projection);
-        self.sync_gpu();
+    /// The views drawn last frame and their screen rectangles.
+    pub fn pane_rects(&self) -> Vec<(Pane, Rect)> {
+        self.panes
+            .iter()
+            .map(|(pane, rect, _)| (*pane, *rect))
+            .collect()
+    }
 
-        let pixels_per_point = ui.ctx().pixels_per_point();
-        if self.gpu.is_some() {
-            let params = FrameParams {
-                view_projection: projection.view_projection,
-                eye: self.camera.eye(),
-                size_px: [
-                    (rect.width() * pixels_per_point).round().max(1.0) as u32,
-                    (rect.height() * pixels_per_point).round().max(1.0) as u32,
-                ],
-                handle_radius_px: HANDLE_RADIUS * pixels_per_point,
-                highlight_outside: self.highlight_outside,
-            };
-            ui.painter().add(egui_wgpu::Callback::new_paint_callback(
+    /// Screen position of mesh vertex `vertex` as drawn in view `pane`.
+    pub fn mesh_vertex_screen_position(&mut self, pane: usize, vertex: usize) -> Option<Pos2> {
+        let (kind, _, projection) = *self.panes.get(pane)?;
+        let positions = self.deformed_on_cpu(kind.method())?;
+        let screen = projection.project(*positions.get(vertex)?)?;
+        Some(Pos2::new(screen.x, screen.y))
+    }
+
+    fn viewport(&mut self, ui: &mut egui::Ui) {
+        let full = ui.available_rect_before_wrap();
+        let kinds = self.view.panes(self.active_method());
+        let width = (full.width() - PANE_GAP * (kinds.len() as f32 - 1.0)) / kinds.len() as f32;
+        let rects: Vec<Rect> = (0..kinds.len())
+            .map(|i| {
+                let left = full.left() + i as f32 * (width + PANE_GAP);
+                Rect::from_min_max(
+                    Pos2::new(left, full.top()),
+                    Pos2::new(left + width, full.bottom()),
+                )
+            })
+            .collect();
+        // Projections first, so that picking sees every view with this frame's layout.
+        self.panes = kinds
+            .iter()
+            .zip(&rects)
+            .enumerate()
+            .map(|(i, (&kind, &rect))| (kind, rect, self.pane_projection(i, rect)))
+            .collect();
+        let mut hovered_pane = None;
+        for (index, (&kind, &rect)) in kinds.iter().zip(&rects).enumerate() {
+            let response = ui.interact(
                 rect,
-                ViewportCallback { params },
-            ));
-        } else {
-            ui.painter().text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "No wgpu device: the viewport is unavailable",
-                egui::FontId::proportional(16.0),
-                Color32::LIGHT_RED,
+                ui.scope_id().with(("view", index)),
+                Sense::click_and_drag(),
             );
+            self.viewport_input(ui, index, &response, rect);
+            // The input may have moved the camera; draw with the final one.
+            let projection = self.pane_projection(index, rect);
+            self.panes[index].2 = projection;
+            if response.hovered() {
+                hovered_pane = Some((index, response.hover_pos()));
+            }
+            self.draw_pane(ui, index, kind, rect, projection);
         }
+        ui.advance_cursor_after_rect(full);
+        if hovered_pane.is_none() && self.hovered.is_some() && self.drag.is_none() {
+            self.hovered = None;
+            self.handles_dirty = true;
+        }
+        self.update_hover(ui, hovered_pane);
         if let Some(Drag::Box { origin, .. }) = &self.drag {
-            if let Some(current) = response.interact_pointer_pos() {
+            if let Some(current) = ui.input(|i| i.pointer.interact_pos()) {
                 let band = Rect::from_two_pos(*origin, current);
                 ui.painter()
                     .rect_filled(band, 0.0, Color32::from_white_alpha(20));
@@ -708,23 +1043,161 @@ impl EditorApp {
                 );
             }
         }
-        if self.scene.weights.is_none() {
-            let message = if self.job.is_some() {
+    }
+
+    fn pane_projection(&self, pane: usize, rect: Rect) -> ScreenProjection {
+        let aspect = rect.width() / rect.height().max(1.0);
+        ScreenProjection {
+            view_projection: self.camera_of(pane).view_projection(aspect),
+            origin: Vec2::new(rect.min.x, rect.min.y),
+            size: Vec2::new(rect.width(), rect.height()),
+        }
+    }
+
+    /// One view: the 3D image, its label, its colour bar and any notice.
+    fn draw_pane(
+        &mut self,
+        ui: &egui::Ui,
+        index: usize,
+        kind: Pane,
+        rect: Rect,
+        projection: ScreenProjection,
+    ) {
+        self.sync_gpu();
+        let shading = self.shading_of(kind);
+        let painter = ui.painter_at(rect);
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        if self.gpu.is_some() {
+            let params = FrameParams {
+                view: index,
+                shading,
+                view_projection: projection.view_projection,
+                eye: self.camera_of(index).eye(),
+                size_px: [
+                    (rect.width() * pixels_per_point).round().max(1.0) as u32,
+                    (rect.height() * pixels_per_point).round().max(1.0) as u32,
+                ],
+                handle_radius_px: HANDLE_RADIUS * pixels_per_point,
+                highlight_outside: self.highlight_outside,
+            };
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                ViewportCallback { params },
+            ));
+        } else {
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "No wgpu device: the viewport is unavailable",
+                egui::FontId::proportional(16.0),
+                Color32::LIGHT_RED,
+            );
+        }
+        let font = egui::FontId::proportional(14.0);
+        painter.text(
+            rect.left_top() + egui::vec2(10.0, 8.0),
+            egui::Align2::LEFT_TOP,
+            self.pane_title(kind),
+            font.clone(),
+            Color32::from_gray(230),
+        );
+        let needed: &[Method] = match kind {
+            Pane::Method(method) => &[method][..],
+            Pane::Difference => &[Method::Mvc, Method::Pmvc][..],
+        };
+        if needed.iter().any(|&m| self.scene.bound(m).is_none()) {
+            let message = if self.is_binding() {
                 "Binding… the mesh is shown at rest until the weights are ready"
             } else {
                 "Not bound: the mesh is shown at rest (Bind in the side panel)"
             };
-            ui.painter().text(
-                rect.left_top() + egui::vec2(10.0, 10.0),
+            painter.text(
+                rect.left_top() + egui::vec2(10.0, 28.0),
                 egui::Align2::LEFT_TOP,
                 message,
-                egui::FontId::proportional(14.0),
+                font,
                 Color32::from_gray(200),
             );
         }
+        if shading.colouring != Colouring::Shaded {
+            if let Some(range) = self.value_range(shading.colouring, kind.method()) {
+                draw_colour_bar(&painter, rect, &shading, range, self.colour_bar_title(kind));
+            }
+        }
     }
 
-    fn viewport_input(&mut self, ui: &egui::Ui, response: &egui::Response, rect: Rect) {
+    /// "PMVC · 32² · bound in 0.41 s" and the like.
+    fn pane_title(&self, kind: Pane) -> String {
+        let describe = |method: Method| match self.scene.bound(method) {
+            Some(bound) => match method {
+                Method::Pmvc => format!(
+                    "PMVC · {}² · bound in {:.2} s",
+                    bound.options.resolution,
+                    bound.bind_time.as_secs_f32()
+                ),
+                Method::Mvc => format!("MVC · bound in {:.2} s", bound.bind_time.as_secs_f32()),
+            },
+            None => format!("{} · not bound", method.name()),
+        };
+        match kind {
+            Pane::Method(method) => describe(method),
+            Pane::Difference => "MVC vs PMVC: distance / cage size".into(),
+        }
+    }
+
+    fn colour_bar_title(&self, kind: Pane) -> String {
+        let method = kind.method().name();
+        match self.view.colouring(kind) {
+            Colouring::CageVertexWeight(vertex) => format!("λ{} ({method})", vertex),
+            Colouring::MostNegativeWeight => format!("min λ ({method})"),
+            Colouring::MethodDistance => "|p'(MVC) - p'(PMVC)| / cage size".into(),
+            Colouring::Shaded => String::new(),
+        }
+    }
+
+    /// Find the mesh vertex under the cursor and read out its weights.
+    fn update_hover(&mut self, ui: &egui::Ui, hovered: Option<(usize, Option<Pos2>)>) {
+        let target = match hovered {
+            Some((pane, Some(pointer))) if self.drag.is_none() => Some((pane, pointer)),
+            _ => None,
+        };
+        let readout = target.and_then(|(pane, pointer)| {
+            let (kind, _, projection) = *self.panes.get(pane)?;
+            if !self.view.shows_hover(kind) {
+                return None;
+            }
+            let method = kind.method();
+            let positions = self.deformed_on_cpu(method)?;
+            let vertex = compare::vertex_under_pointer(
+                &positions,
+                projection.view_projection,
+                projection.origin,
+                projection.size,
+                Vec2::new(pointer.x, pointer.y),
+                HOVER_RADIUS,
+            )?;
+            let readout = HoverReadout::new(self.scene.weights(method)?, method, vertex)?;
+            Some((pane, pointer, readout))
+        });
+        self.hover_readout = readout.as_ref().map(|(pane, _, r)| (*pane, r.clone()));
+        if let Some((_, pointer, readout)) = readout {
+            egui::Area::new(egui::Id::unique("hover weights"))
+                .order(egui::Order::Tooltip)
+                .fixed_pos(pointer + egui::vec2(16.0, 16.0))
+                .interactable(false)
+                .show(ui.ctx(), |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| hover_box(ui, &readout));
+                });
+        }
+    }
+
+    fn viewport_input(
+        &mut self,
+        ui: &egui::Ui,
+        pane: usize,
+        response: &egui::Response,
+        rect: Rect,
+    ) {
         let (modifiers, press_origin, scroll, hover) = ui.input(|i| {
             (
                 i.modifiers,
@@ -737,7 +1210,7 @@ impl EditorApp {
         // Hover highlight (not while dragging, so the highlight does not flicker, and
         // not in `--screenshot` runs, where the pointer rests wherever the display
         // server put it).
-        if self.drag.is_none() && self.screenshot.is_none() {
+        if self.drag.is_none() && self.screenshot.is_none() && response.hovered() {
             let hovered = response.hover_pos().and_then(|p| self.pick(p));
             if hovered != self.hovered {
                 self.hovered = hovered;
@@ -746,16 +1219,23 @@ impl EditorApp {
         }
 
         if response.hovered() && scroll != 0.0 {
-            if let (Some(pointer), Some(projection)) = (hover, self.projection) {
+            if let (Some(pointer), Some(projection)) = (hover, self.projection(pane)) {
                 let ndc = projection.to_ndc(Vec2::new(pointer.x, pointer.y));
                 let factor = (-scroll * 0.0015).exp();
-                self.camera
-                    .zoom_towards(factor, ndc, rect.width() / rect.height().max(1.0));
+                self.camera_mut(pane).zoom_towards(
+                    factor,
+                    ndc,
+                    rect.width() / rect.height().max(1.0),
+                );
             }
         }
 
         if response.clicked_by(PointerButton::Primary) {
             let picked = response.interact_pointer_pos().and_then(|p| self.pick(p));
+            // In heatmap mode a click on a handle shows that vertex's coordinate.
+            if let (Some(handle), Overlay::Heatmap) = (picked, self.view.overlay) {
+                self.view.heat_vertex = handle;
+            }
             match (picked, modifiers.shift) {
                 (Some(handle), true) => self.toggle(handle),
                 (Some(handle), false) => self.select_only([handle]),
@@ -813,16 +1293,17 @@ impl EditorApp {
             });
             match self.drag.take() {
                 Some(Drag::Orbit) => {
-                    self.camera.orbit(Vec2::new(delta.x, delta.y));
+                    self.camera_mut(pane).orbit(Vec2::new(delta.x, delta.y));
                     self.drag = Some(Drag::Orbit);
                 }
                 Some(Drag::Pan) => {
-                    self.camera.pan(Vec2::new(delta.x, delta.y), rect.height());
+                    self.camera_mut(pane)
+                        .pan(Vec2::new(delta.x, delta.y), rect.height().min(rect.width()));
                     self.drag = Some(Drag::Pan);
                 }
                 Some(Drag::Move { start_pose, motion }) => {
                     let motion = motion + delta;
-                    let pose = self.moved_pose(&start_pose, motion, axis, rect);
+                    let pose = self.moved_pose(pane, &start_pose, motion, axis, rect);
                     self.set_pose(pose);
                     self.drag = Some(Drag::Move { start_pose, motion });
                 }
@@ -837,7 +1318,7 @@ impl EditorApp {
                 }
                 Some(Drag::Box { origin, additive }) => {
                     let end = response.interact_pointer_pos().unwrap_or(origin);
-                    self.box_select(Rect::from_two_pos(origin, end), additive);
+                    self.box_select(pane, Rect::from_two_pos(origin, end), additive);
                 }
                 _ => {}
             }
@@ -851,8 +1332,8 @@ impl EditorApp {
         self.handles_dirty = true;
     }
 
-    fn box_select(&mut self, band: Rect, additive: bool) {
-        let Some(projection) = self.projection else {
+    fn box_select(&mut self, pane: usize, band: Rect, additive: bool) {
+        let Some(projection) = self.projection(pane) else {
             return;
         };
         if !additive {
@@ -873,6 +1354,7 @@ impl EditorApp {
     /// screen direction.
     fn moved_pose(
         &self,
+        pane: usize,
         start_pose: &[DVec3],
         motion: egui::Vec2,
         axis: Option<DVec3>,
@@ -888,12 +1370,12 @@ impl EditorApp {
             .filter_map(|&i| start_pose.get(i))
             .sum::<DVec3>()
             / self.selection.len() as f64;
-        let scale = self
-            .camera
-            .units_per_pixel(self.camera.depth_of(centre.as_vec3()), rect.height());
-        let (right, up) = self.camera.right_up();
+        let camera = self.camera_of(pane);
+        let short_side = rect.height().min(rect.width());
+        let scale = camera.units_per_pixel(camera.depth_of(centre.as_vec3()), short_side);
+        let (right, up) = camera.right_up();
         let in_plane = (right * motion.x - up * motion.y) * scale;
-        let offset = match (axis, self.projection) {
+        let offset = match (axis, self.projection(pane)) {
             (Some(axis), Some(projection)) => {
                 let from = projection.project(centre.as_vec3());
                 let to = projection.project((centre + axis).as_vec3());
@@ -1009,6 +1491,10 @@ impl EditorApp {
             });
             ui.menu_button("View", |ui| {
                 ui.checkbox(&mut self.show_statistics, "Statistics");
+                ui.checkbox(
+                    &mut self.view.hover_in_shaded,
+                    "Weights under the cursor (always)",
+                );
                 ui.checkbox(&mut self.highlight_outside, "Highlight outside vertices");
                 let mut antialiased = self
                     .with_renderer(|renderer, _, _| renderer.sample_count() > 1)
@@ -1046,19 +1532,25 @@ impl EditorApp {
         ));
         ui.separator();
         ui.label("Binding");
-        let mut options = self.bind_options;
-        ui.horizontal(|ui| {
-            ui.radio_value(&mut options.method, Method::Pmvc, "PMVC");
-            ui.radio_value(&mut options.method, Method::Mvc, "MVC");
-        });
-        ui.horizontal(|ui| {
-            let label = ui.label("Resolution");
-            ui.add(egui::DragValue::new(&mut options.resolution).range(4..=128))
-                .labelled_by(label.id);
-        });
-        if options != self.bind_options {
-            self.bind_options = options;
-            self.start_bind(&ctx);
+        let mut resolution = self.bind_options.resolution;
+        egui::ComboBox::from_label("PMVC resolution")
+            .selected_text(format!("{resolution}²"))
+            .show_ui(ui, |ui| {
+                for choice in RESOLUTION_CHOICES {
+                    ui.selectable_value(&mut resolution, choice, format!("{choice}²"));
+                }
+            });
+        if resolution != self.bind_options.resolution {
+            self.set_resolution(resolution);
+        }
+        if ui
+            .button("Subdivide cage")
+            .on_hover_text(
+                "1-to-4 midpoint subdivision, keeping the pose; smooths the coordinates near sharp reflex edges. Rebinds.",
+            )
+            .clicked()
+        {
+            self.subdivide_cage();
         }
         if let Some(job) = &self.job {
             let (done, total) = (job.done(), job.total());
@@ -1082,24 +1574,24 @@ impl EditorApp {
                 job.cancel();
             }
             ctx.request_repaint_after(Duration::from_millis(100));
-        } else if let (Some(time), Some(options)) = (self.scene.bind_time, self.scene.bound_with) {
-            ui.label(format!(
-                "Bound with {} (resolution {}) in {:.2} s on {}",
-                options.method.name(),
-                options.resolution,
-                time.as_secs_f32(),
-                self.scene.bind_device
-            ));
-        } else if ui.button("Bind").clicked() {
+        } else if (self.scene.bound(Method::Mvc).is_none()
+            || self.scene.bound(Method::Pmvc).is_none())
+            && ui.button("Bind").clicked()
+        {
             self.start_bind(&ctx);
         }
-        if self.scene.weights.is_some() {
+        if let Some(bound) = self.scene.bound(self.active_method()) {
+            ui.label(format!("Bound on {}", bound.device));
+        }
+        if self.scene.bound(Method::Mvc).is_some() || self.scene.bound(Method::Pmvc).is_some() {
             let outside = self.scene.outside.len();
             ui.label(format!("{outside} mesh vertices outside the cage"));
             if outside > 0 {
                 ui.checkbox(&mut self.highlight_outside, "Highlight them");
             }
         }
+        ui.separator();
+        self.quality_panel(ui);
         ui.separator();
         ui.label(format!("Selection: {} handle(s)", self.selection.len()));
         if self.selection.len() == 1 {
@@ -1160,7 +1652,7 @@ impl EditorApp {
             }
         });
         ui.separator();
-        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · F: frame · Esc: deselect");
+        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · F: frame · M: MVC/PMVC · Esc: deselect");
         if self.show_statistics {
             ui.separator();
             self.statistics(ui);
@@ -1183,6 +1675,96 @@ impl EditorApp {
         if let Some(index) = dismiss {
             self.notices.remove(index);
         }
+    }
+
+    /// Per-method quality: negativity, partition of unity, linear precision.
+    fn quality_panel(&self, ui: &mut egui::Ui) {
+        ui.label("Quality");
+        let outside = self.scene.outside.len();
+        egui::Grid::new("quality")
+            .num_columns(3)
+            .striped(true)
+            .show(ui, |ui| {
+                ui.label("");
+                ui.strong("MVC");
+                ui.strong("PMVC");
+                ui.end_row();
+                let rows: [QualityRow; 5] = [
+                    ("vertices with λ < 0", |b| {
+                        format!("{:.1} %", 100.0 * b.quality.negative_share)
+                    }),
+                    ("most negative λ", |b| {
+                        format!("{:.4}", b.quality.most_negative)
+                    }),
+                    ("max |Σλ - 1|", |b| {
+                        format!("{:.1e}", b.quality.max_partition_error)
+                    }),
+                    ("max |Σλc - x| / size", |b| {
+                        format!("{:.1e}", b.quality.max_linear_precision_error)
+                    }),
+                    ("bind time", |b| {
+                        format!("{:.2} s", b.bind_time.as_secs_f32())
+                    }),
+                ];
+                for (name, value) in rows {
+                    ui.label(name);
+                    for method in [Method::Mvc, Method::Pmvc] {
+                        ui.label(self.scene.bound(method).map_or("—".into(), value));
+                    }
+                    ui.end_row();
+                }
+                ui.label("outside vertices");
+                for method in [Method::Mvc, Method::Pmvc] {
+                    let bound = self.scene.bound(method).is_some();
+                    ui.label(if bound {
+                        outside.to_string()
+                    } else {
+                        "—".into()
+                    });
+                }
+                ui.end_row();
+            });
+    }
+
+    /// The comparison controls above the viewport.
+    fn toolbar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Method (M):");
+            let mut method = self.active_method();
+            ui.selectable_value(&mut method, Method::Mvc, "MVC");
+            ui.selectable_value(&mut method, Method::Pmvc, "PMVC");
+            self.set_active_method(method);
+            ui.separator();
+            ui.label("View:");
+            let layout = &mut self.view.layout;
+            ui.selectable_value(layout, Layout::Single, "Single");
+            ui.selectable_value(layout, Layout::SideBySide, "Side by side");
+            ui.selectable_value(layout, Layout::Difference, "Difference");
+            if self.view.layout == Layout::SideBySide {
+                ui.checkbox(&mut self.view.difference_pane, "+ difference");
+                let mut locked = self.view.cameras_locked;
+                if ui.checkbox(&mut locked, "Lock cameras").changed() {
+                    self.set_cameras_locked(locked);
+                }
+            }
+            ui.separator();
+            ui.label("Colour:");
+            let overlay = &mut self.view.overlay;
+            ui.selectable_value(overlay, Overlay::Shaded, "Shaded");
+            ui.selectable_value(overlay, Overlay::Heatmap, "Heatmap λi");
+            ui.selectable_value(overlay, Overlay::Negativity, "Negativity");
+            if self.view.overlay == Overlay::Heatmap {
+                let last = self.scene.pose.len().saturating_sub(1);
+                let label = ui.label("i =");
+                ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
+                    .labelled_by(label.id)
+                    .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+            }
+            if self.view.overlay != Overlay::Shaded || self.view.layout != Layout::Single {
+                ui.selectable_value(&mut self.view.scale, Scale::Linear, "Linear");
+                ui.selectable_value(&mut self.view.scale, Scale::LogMagnitude, "Log");
+            }
+        });
     }
 
     fn statistics(&self, ui: &mut egui::Ui) {
@@ -1266,11 +1848,12 @@ impl eframe::App for EditorApp {
         self.record_frame_time();
         self.poll_bind();
         if std::mem::take(&mut self.retry_bind) {
-            self.start_bind(&ctx);
+            self.launch_next_bind(&ctx);
         }
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         egui::Panel::right("side")
             .default_size(300.0)
             .show(ui, |ui| {
@@ -1310,6 +1893,135 @@ fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageErr
         height as u32,
         image::ColorType::Rgba8,
     )
+}
+
+/// A row of the quality table: its name and how a method's bind shows in it.
+type QualityRow = (&'static str, fn(&Bound) -> String);
+
+fn other_method(method: Method) -> Method {
+    match method {
+        Method::Mvc => Method::Pmvc,
+        Method::Pmvc => Method::Mvc,
+    }
+}
+
+fn method_slot(method: Method) -> usize {
+    match method {
+        Method::Mvc => 0,
+        Method::Pmvc => 1,
+    }
+}
+
+fn colour32([r, g, b]: [f32; 3]) -> Color32 {
+    let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    Color32::from_rgb(byte(r), byte(g), byte(b))
+}
+
+/// A horizontal colour bar at the bottom of `rect`: the map from −limit to +limit
+/// (0 to +limit for distances), with the values' min and max marked.
+fn draw_colour_bar(
+    painter: &egui::Painter,
+    rect: Rect,
+    shading: &Shading,
+    range: ValueRange,
+    title: String,
+) {
+    let signed = shading.colouring != Colouring::MethodDistance;
+    let limit = shading.colour_limit;
+    let low = if signed { -limit } else { 0.0 };
+    let bar = Rect::from_min_size(
+        Pos2::new(rect.left() + 16.0, rect.bottom() - 42.0),
+        egui::vec2((rect.width() - 32.0).clamp(60.0, 320.0), 14.0),
+    );
+    let backdrop = bar.expand2(egui::vec2(8.0, 22.0));
+    painter.rect_filled(backdrop, 4.0, Color32::from_black_alpha(140));
+    let steps = 64;
+    let mut mesh = egui::Mesh::default();
+    for step in 0..=steps {
+        let fraction = step as f32 / steps as f32;
+        let value = low + (limit - low) * fraction;
+        let colour = colour32(colormap::heat_colour(value, limit, shading.scale));
+        let x = bar.left() + bar.width() * fraction;
+        mesh.colored_vertex(Pos2::new(x, bar.top()), colour);
+        mesh.colored_vertex(Pos2::new(x, bar.bottom()), colour);
+        if step > 0 {
+            let i = 2 * step as u32;
+            mesh.add_triangle(i - 2, i - 1, i);
+            mesh.add_triangle(i - 1, i + 1, i);
+        }
+    }
+    painter.add(egui::Shape::mesh(mesh));
+    // Where a value sits on the bar (the log scale bends the axis).
+    let x_of = |value: f32| {
+        let t = colormap::scaled(value, limit, shading.scale);
+        let fraction = if signed { (t + 1.0) / 2.0 } else { t };
+        bar.left() + bar.width() * fraction.clamp(0.0, 1.0)
+    };
+    for value in [range.min, range.max] {
+        let x = x_of(value);
+        painter.line_segment(
+            [
+                Pos2::new(x, bar.top() - 3.0),
+                Pos2::new(x, bar.bottom() + 3.0),
+            ],
+            Stroke::new(2.0, Color32::BLACK),
+        );
+    }
+    let font = egui::FontId::proportional(12.0);
+    let text = Color32::from_gray(235);
+    let log = if shading.scale == Scale::LogMagnitude {
+        " · log scale"
+    } else {
+        ""
+    };
+    painter.text(
+        bar.left_top() - egui::vec2(0.0, 4.0),
+        egui::Align2::LEFT_BOTTOM,
+        format!("{title}{log}"),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.center_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::CENTER_TOP,
+        format!("min {:.4} · max {:.4}", range.min, range.max),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.left_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::LEFT_TOP,
+        format!("{low:.3}"),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.right_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::RIGHT_TOP,
+        format!("{limit:.3}"),
+        font,
+        text,
+    );
+}
+
+/// The hover box: a vertex's largest weights and its most negative one.
+fn hover_box(ui: &mut egui::Ui, readout: &HoverReadout) {
+    ui.strong(format!(
+        "vertex {} · {}",
+        readout.vertex,
+        readout.method.name()
+    ));
+    ui.label(format!("largest {HOVER_TOP_WEIGHTS} weights:"));
+    for (cage_vertex, weight) in &readout.top {
+        ui.monospace(format!("λ{cage_vertex:<4} {weight:>9.5}"));
+    }
+    match readout.most_negative {
+        Some((cage_vertex, weight)) => ui.colored_label(
+            Color32::from_rgb(120, 150, 255),
+            format!("most negative: λ{cage_vertex} = {weight:.5}"),
+        ),
+        None => ui.label("no negative weight"),
+    };
 }
 
 /// Points in the renderer's f32.

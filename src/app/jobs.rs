@@ -7,7 +7,7 @@
 //! docs/gpu-binding.md). The job's thread first classifies the points, then
 //! forwards the binder's progress and the editor's cancel.
 
-use crate::coords::{BindOptions, Weights};
+use crate::coords::{BindOptions, WeightQuality, Weights};
 use crate::geometry::{classify_points, Cage};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder};
 use glam::DVec3;
@@ -33,6 +33,8 @@ pub struct BindOutcome {
     /// The same weights left in GPU memory by a bind on the editor's own device,
     /// for the vertex shader to read without a round trip through the CPU.
     pub resident: Option<wgpu::Buffer>,
+    /// Measured on the job's thread, so the UI never stalls on it.
+    pub quality: WeightQuality,
 }
 
 /// Why a bind produced no weights.
@@ -216,11 +218,14 @@ fn run(
             let weights = output
                 .weights
                 .ok_or_else(|| JobError::Failed("the binder returned no weights".into()))?;
+            let elapsed = started.elapsed();
+            let quality = WeightQuality::measure(&weights, points, &cage.positions);
             Ok(BindOutcome {
+                quality,
                 weights: Arc::new(weights),
                 outside: classes.outside,
                 options,
-                elapsed: started.elapsed(),
+                elapsed,
                 device: output.stats.device,
                 resident: output.gpu_weights.map(|resident| resident.buffer),
             })

@@ -3,10 +3,13 @@
 //!
 //! - [`editor`]: the application state and its UI; talks only to [`jobs`] and
 //!   [`crate::render`].
+//! - [`compare`]: what the views compare (MVC, PMVC, their difference) and how the
+//!   mesh is coloured; the read-outs behind colour bars and the hover box.
 //! - [`scene`]: the loaded mesh, cage, pose and weights, and the pose history.
 //! - [`jobs`]: binding on a background thread with progress and cancel.
 //! - [`scenes`]: the bundled scenes and their generators.
 
+pub mod compare;
 pub mod editor;
 pub mod jobs;
 pub mod scene;
@@ -32,6 +35,8 @@ pub struct EditorOptions {
     pub screenshot: Option<PathBuf>,
     /// Where binding runs.
     pub bind_on: BindOn,
+    /// The views and colouring to start with (`--view`, `--heatmap`, `--negativity`).
+    pub view: compare::ViewSettings,
 }
 
 /// Where the editor binds. On a GPU it binds on the editor's own device, and the

@@ -1,7 +1,7 @@
 //! What the editor edits: a mesh bound to a cage, the cage's current pose, the
-//! weights once a bind has finished, and the undo history of poses.
+//! weights of each method once its bind has finished, and the undo history of poses.
 
-use crate::coords::{BindOptions, Weights};
+use crate::coords::{BindOptions, Method, WeightQuality, Weights};
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use glam::DVec3;
 use std::path::PathBuf;
@@ -20,14 +20,28 @@ pub struct Scene {
     pub cage_path: Option<PathBuf>,
     /// The deformed cage: one position per cage vertex.
     pub pose: Vec<DVec3>,
-    /// Weights for this mesh and cage; `None` until a bind finishes.
-    pub weights: Option<Arc<Weights>>,
-    pub bound_with: Option<BindOptions>,
-    pub bind_time: Option<Duration>,
-    /// Where the last bind ran ("CPU" or the GPU's description).
-    pub bind_device: String,
+    /// Per method ([`Scene::bound`]): its weights once its bind has finished.
+    bound: [Option<Bound>; 2],
     /// Mesh vertices outside the cage, known once bound.
     pub outside: Vec<u32>,
+}
+
+/// One method's weights for the scene's mesh and cage, and how they were made.
+#[derive(Clone, Debug)]
+pub struct Bound {
+    pub weights: Arc<Weights>,
+    pub options: BindOptions,
+    pub bind_time: Duration,
+    /// Where the bind ran ("CPU" or the GPU's description).
+    pub device: String,
+    pub quality: WeightQuality,
+}
+
+fn method_slot(method: Method) -> usize {
+    match method {
+        Method::Mvc => 0,
+        Method::Pmvc => 1,
+    }
 }
 
 impl Scene {
@@ -39,18 +53,29 @@ impl Scene {
             mesh_file: None,
             cage: Arc::new(cage),
             cage_path: None,
-            weights: None,
-            bound_with: None,
-            bind_time: None,
-            bind_device: String::new(),
+            bound: [None, None],
             outside: Vec::new(),
         }
     }
 
-    /// The deformed mesh computed once on the CPU (for export), or the rest mesh
-    /// before binding.
-    pub fn deformed_positions(&self) -> Vec<DVec3> {
-        match &self.weights {
+    /// `method`'s weights and their bind, once bound.
+    pub fn bound(&self, method: Method) -> Option<&Bound> {
+        self.bound[method_slot(method)].as_ref()
+    }
+
+    /// `method`'s weights, once bound.
+    pub fn weights(&self, method: Method) -> Option<&Arc<Weights>> {
+        self.bound(method).map(|bound| &bound.weights)
+    }
+
+    pub fn set_bound(&mut self, method: Method, bound: Bound) {
+        self.bound[method_slot(method)] = Some(bound);
+    }
+
+    /// The mesh deformed with `method` on the CPU (for export), or the rest mesh
+    /// before that method is bound.
+    pub fn deformed_positions(&self, method: Method) -> Vec<DVec3> {
+        match self.weights(method) {
             Some(weights) => weights.apply(&self.pose),
             None => self.mesh.positions.clone(),
         }

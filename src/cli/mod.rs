@@ -152,6 +152,72 @@ pub struct EditArgs {
     /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
+    /// What the viewport shows: one method, both side by side, or the distance
+    /// between their deformations.
+    #[arg(long, value_enum)]
+    pub view: Option<ViewArg>,
+    /// Colour the mesh by the coordinate function of this cage vertex (0-based).
+    #[arg(long, value_name = "CAGE_VERTEX", conflicts_with = "negativity")]
+    pub heatmap: Option<usize>,
+    /// Colour the mesh by each vertex's most negative weight.
+    #[arg(long)]
+    pub negativity: bool,
+    /// Show heatmap magnitudes on a log scale (three decades).
+    #[arg(long)]
+    pub log_scale: bool,
+}
+
+/// What the editor's viewport shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ViewArg {
+    /// The mesh deformed with MVC.
+    Mvc,
+    /// The mesh deformed with PMVC.
+    Pmvc,
+    /// MVC and PMVC next to each other, cameras locked.
+    SideBySide,
+    /// |p′_MVC − p′_PMVC| per mesh vertex, relative to the cage size.
+    Difference,
+}
+
+impl EditArgs {
+    fn editor_options(self) -> crate::app::EditorOptions {
+        use crate::app::compare::{Layout, Overlay, ViewSettings};
+        use crate::coords::Method;
+        let mut view = ViewSettings::default();
+        let mut method = self.method.map(Method::from);
+        match self.view {
+            Some(ViewArg::Mvc) => method = Some(Method::Mvc),
+            Some(ViewArg::Pmvc) => method = Some(Method::Pmvc),
+            Some(ViewArg::SideBySide) => view.layout = Layout::SideBySide,
+            Some(ViewArg::Difference) => view.layout = Layout::Difference,
+            None => {}
+        }
+        if let Some(vertex) = self.heatmap {
+            view.overlay = Overlay::Heatmap;
+            view.heat_vertex = vertex;
+        }
+        if self.negativity {
+            view.overlay = Overlay::Negativity;
+        }
+        if self.log_scale {
+            view.scale = crate::render::colormap::Scale::LogMagnitude;
+        }
+        crate::app::EditorOptions {
+            mesh: self.mesh,
+            cage: self.cage,
+            pose: self.pose,
+            resolution: self.resolution,
+            method,
+            screenshot: self.screenshot,
+            bind_on: match self.backend {
+                BackendArg::Auto => crate::app::BindOn::Auto,
+                BackendArg::Cpu => crate::app::BindOn::Cpu,
+                BackendArg::Gpu => crate::app::BindOn::Gpu,
+            },
+            view,
+        }
+    }
 }
 
 #[derive(Debug, clap::Args)]
@@ -173,20 +239,9 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         None => crate::app::run_editor(crate::app::EditorOptions::default())
             .map_err(anyhow::Error::from),
-        Some(Command::Edit(args)) => crate::app::run_editor(crate::app::EditorOptions {
-            mesh: args.mesh,
-            cage: args.cage,
-            pose: args.pose,
-            resolution: args.resolution,
-            method: args.method.map(Into::into),
-            screenshot: args.screenshot,
-            bind_on: match args.backend {
-                BackendArg::Auto => crate::app::BindOn::Auto,
-                BackendArg::Cpu => crate::app::BindOn::Cpu,
-                BackendArg::Gpu => crate::app::BindOn::Gpu,
-            },
-        })
-        .map_err(anyhow::Error::from),
+        Some(Command::Edit(args)) => {
+            crate::app::run_editor(args.editor_options()).map_err(anyhow::Error::from)
+        }
         Some(Command::Bind(args)) => commands::bind(&args),
         Some(Command::Deform(args)) => commands::deform(&args),
         Some(Command::Check(args)) => commands::check(&args),
@@ -200,5 +255,48 @@ pub fn main() -> ExitCode {
             eprintln!("pmvc: error: {error:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::compare::{Layout, Overlay};
+    use crate::coords::Method;
+
+    fn edit_options(args: &[&str]) -> crate::app::EditorOptions {
+        let cli = Cli::try_parse_from(["pmvc", "edit"].iter().chain(args)).expect("parses");
+        match cli.command {
+            Some(Command::Edit(args)) => args.editor_options(),
+            other => panic!("not an edit command: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn view_flags_set_the_editors_views() {
+        let options = edit_options(&["--view", "side-by-side", "--heatmap", "7", "--log-scale"]);
+        assert_eq!(options.view.layout, Layout::SideBySide);
+        assert_eq!(options.view.overlay, Overlay::Heatmap);
+        assert_eq!(options.view.heat_vertex, 7);
+        assert_eq!(
+            options.view.scale,
+            crate::render::colormap::Scale::LogMagnitude
+        );
+        let options = edit_options(&["--view", "mvc", "--negativity"]);
+        assert_eq!(options.view.layout, Layout::Single);
+        assert_eq!(options.method, Some(Method::Mvc));
+        assert_eq!(options.view.overlay, Overlay::Negativity);
+        assert_eq!(
+            edit_options(&["--view", "difference"]).view.layout,
+            Layout::Difference
+        );
+    }
+
+    #[test]
+    fn heatmap_and_negativity_exclude_each_other() {
+        let parsed = Cli::try_parse_from(["pmvc", "edit", "--heatmap", "1", "--negativity"]);
+        assert!(parsed.is_err());
+        let parsed = Cli::try_parse_from(["pmvc", "edit", "--view", "sideways"]);
+        assert!(parsed.is_err());
     }
 }

@@ -81,11 +81,18 @@ impl CageRenderer {
         }
     }
 
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu) {
+    /// Draw with `bind_group`, whose frame uniform is at `frame_offset`.
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &SceneGpu,
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+    ) {
         if scene.cage_vertex_count == 0 {
             return;
         }
-        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(0, bind_group, &[frame_offset]);
         pass.set_index_buffer(scene.cage_edges.slice(..), wgpu::IndexFormat::Uint32);
         for pipeline in [&self.hidden_edges, &self.visible_edges] {
             pass.set_pipeline(pipeline);

@@ -7,6 +7,16 @@ use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 /// Vertical field of view.
 const FOV_Y: f32 = 40.0 * std::f32::consts::PI / 180.0;
 
+/// The vertical field of view for a viewport of `aspect` (width / height): `FOV_Y`
+/// spans the shorter side, so narrow views (side by side) still show the scene.
+fn fov_y(aspect: f32) -> f32 {
+    if aspect >= 1.0 {
+        FOV_Y
+    } else {
+        2.0 * ((FOV_Y / 2.0).tan() / aspect).atan()
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitCamera {
     pub target: Vec3,
@@ -50,15 +60,16 @@ impl OrbitCamera {
     pub fn view_projection(&self, aspect: f32) -> Mat4 {
         let near = (self.distance * 0.01).max(1e-4);
         let far = self.distance * 100.0 + 10.0;
+        let aspect = aspect.max(1e-3);
         // wgpu's clip space is DirectX's: z in [0, 1], y up.
-        glam::camera::rh::proj::directx::perspective(FOV_Y, aspect.max(1e-3), near, far)
+        glam::camera::rh::proj::directx::perspective(fov_y(aspect), aspect, near, far)
             * glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
     }
 
     /// World units per pixel at `depth` along the view direction, in a viewport
-    /// `height_px` tall.
-    pub fn units_per_pixel(&self, depth: f32, height_px: f32) -> f32 {
-        2.0 * depth.max(1e-4) * (FOV_Y / 2.0).tan() / height_px.max(1.0)
+    /// whose shorter side is `short_side_px` (the field of view spans that side).
+    pub fn units_per_pixel(&self, depth: f32, short_side_px: f32) -> f32 {
+        2.0 * depth.max(1e-4) * (FOV_Y / 2.0).tan() / short_side_px.max(1.0)
     }
 
     /// Depth of `point` along the view direction.
@@ -73,10 +84,11 @@ impl OrbitCamera {
         self.pitch = (self.pitch + delta.y * 0.008).clamp(-limit, limit);
     }
 
-    /// Move the target with the mouse by `delta` pixels.
-    pub fn pan(&mut self, delta: Vec2, height_px: f32) {
+    /// Move the target with the mouse by `delta` pixels in a viewport whose shorter
+    /// side is `short_side_px`.
+    pub fn pan(&mut self, delta: Vec2, short_side_px: f32) {
         let (right, up) = self.right_up();
-        let scale = self.units_per_pixel(self.distance, height_px);
+        let scale = self.units_per_pixel(self.distance, short_side_px);
         self.target += (-right * delta.x + up * delta.y) * scale;
     }
 
@@ -84,7 +96,7 @@ impl OrbitCamera {
     /// the plane through the target.
     pub fn zoom_towards(&mut self, factor: f32, cursor_ndc: Vec2, aspect: f32) {
         let (right, up) = self.right_up();
-        let half_height = self.distance * (FOV_Y / 2.0).tan();
+        let half_height = self.distance * (fov_y(aspect.max(1e-3)) / 2.0).tan();
         let under_cursor = self.target
             + right * cursor_ndc.x * half_height * aspect
             + up * cursor_ndc.y * half_height;
@@ -92,7 +104,7 @@ impl OrbitCamera {
         self.distance = (self.distance * factor).max(1e-3);
     }
 
-    /// Look at a sphere so that it fills the view.
+    /// Look at a sphere so that it fills the view's shorter side.
     pub fn frame(&mut self, centre: Vec3, radius: f32) {
         self.target = centre;
         self.distance = radius.max(1e-3) / (FOV_Y / 2.0).sin() * 1.1;

@@ -2,7 +2,7 @@
 //! the weights and the deformed cage, and a compute pipeline doing the same sums
 //! into a buffer for readback. Paired with `shaders/render_mesh.wgsl`.
 
-use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
+use super::viewport::{ReadBack, SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
 use glam::Vec3;
 
 const SHADER: &str = include_str!("../../shaders/render_mesh.wgsl");
@@ -64,16 +64,7 @@ impl MeshRenderer {
         });
         let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deformed output"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[output_entry(0), output_entry(1)],
         });
         let compute_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("deform readback"),
@@ -95,55 +86,77 @@ impl MeshRenderer {
         }
     }
 
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu) {
+    /// Draw with `bind_group` (which picks the method's weights), whose frame
+    /// uniform is at `frame_offset`.
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &SceneGpu,
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+    ) {
         if scene.index_count == 0 {
             return;
         }
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(0, bind_group, &[frame_offset]);
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..scene.index_count, 0, 0..1);
     }
 
-    /// Run the vertex shader's deformation for every mesh vertex and read it back.
-    /// Blocks until the GPU is done. The frame uniform must hold the current counts.
+    /// Run the vertex shader's deformation and colouring for every mesh vertex and
+    /// read them back. Blocks until the GPU is done. The frame uniform at
+    /// `frame_offset` must describe the shading wanted.
     pub fn read_back(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &SceneGpu,
-    ) -> Result<Vec<Vec3>, wgpu::BufferAsyncError> {
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+    ) -> Result<ReadBack, wgpu::BufferAsyncError> {
         let count = scene.vertex_count as u64;
         let size = (count * 16).max(16);
-        let output = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("deformed positions"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let storage = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let (output, colours) = (storage("deformed positions"), storage("vertex colours"));
+        // Positions, then colours.
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("deformed positions staging"),
-            size,
+            label: Some("readback staging"),
+            size: 2 * size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let output_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("deformed output"),
+            label: Some("readback output"),
             layout: &self.output_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: output.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: output.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: colours.as_entire_binding(),
+                },
+            ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_pipeline(&self.deform_pipeline);
-            pass.set_bind_group(0, &scene.bind_group, &[]);
+            pass.set_bind_group(0, bind_group, &[frame_offset]);
             pass.set_bind_group(1, &output_group, &[]);
             pass.dispatch_workgroups((scene.vertex_count).div_ceil(64).max(1), 1, 1);
         }
         encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
+        encoder.copy_buffer_to_buffer(&colours, 0, &staging, size, size);
         queue.submit([encoder.finish()]);
         let (sender, receiver) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |result| {
@@ -151,18 +164,39 @@ impl MeshRenderer {
         });
         let _ = device.poll(wgpu::PollType::wait_indefinitely());
         receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
-        let positions = {
+        let read_back = {
             let view = staging
                 .get_mapped_range(..)
                 .map_err(|_| wgpu::BufferAsyncError)?;
             let floats: &[[f32; 4]] = bytemuck::cast_slice(&view);
-            floats
-                .iter()
-                .take(scene.vertex_count as usize)
-                .map(|p| Vec3::new(p[0], p[1], p[2]))
-                .collect()
+            let (deformed, colours) = floats.split_at(floats.len() / 2);
+            let vertices = scene.vertex_count as usize;
+            ReadBack {
+                positions: deformed[..vertices]
+                    .iter()
+                    .map(|p| Vec3::new(p[0], p[1], p[2]))
+                    .collect(),
+                values: deformed[..vertices].iter().map(|p| p[3]).collect(),
+                colours: colours[..vertices]
+                    .iter()
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect(),
+            }
         };
         staging.unmap();
-        Ok(positions)
+        Ok(read_back)
+    }
+}
+
+fn output_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
     }
 }

@@ -2,10 +2,16 @@
 //! depth target (egui's own pass has no depth buffer), and the paint callback that
 //! draws the mesh and cage there and composites the image into egui's pass.
 //! Paired with `shaders/render_composite.wgsl`.
+//!
+//! Up to [`MAX_VIEWS`] views are drawn in one frame (MVC and PMVC side by side, and
+//! their difference). Each has its own slot of the frame uniform (a dynamic
+//! offset) and its own offscreen target; the weights of both methods stay
+//! resident, so switching the method shown is only a different bind group.
 
 use super::cage::CageRenderer;
+use super::colormap::Scale;
 use super::mesh::MeshRenderer;
-use crate::coords::Weights;
+use crate::coords::{Method, Weights};
 use eframe::egui_wgpu::{self, wgpu::util::DeviceExt};
 use glam::{Mat4, Vec3};
 
@@ -15,6 +21,12 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// costs about 16 ms a frame on lavapipe, so software adapters default to 1.
 pub const MSAA_SAMPLES: u32 = 4;
 const COMPOSITE_SHADER: &str = include_str!("../../shaders/render_composite.wgsl");
+/// Views drawn in one frame.
+pub const MAX_VIEWS: usize = 3;
+/// Frame uniform slots: one per view and one for readbacks, each at an offset that
+/// every adapter accepts for dynamic uniform offsets.
+const FRAME_SLOT_BYTES: u64 = 256;
+const READBACK_SLOT: usize = MAX_VIEWS;
 const BACKGROUND: wgpu::Color = wgpu::Color {
     r: 0.13,
     g: 0.14,
@@ -35,6 +47,73 @@ pub enum RenderError {
     NoScene,
 }
 
+/// What the mesh is coloured by.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Colouring {
+    /// Plain shading.
+    #[default]
+    Shaded,
+    /// λᵢ of one cage vertex i.
+    CageVertexWeight(u32),
+    /// minⱼ λⱼ per mesh vertex: where the coordinates go negative.
+    MostNegativeWeight,
+    /// |p′ − p′_other| between the two methods' deformations, over the cage size.
+    MethodDistance,
+}
+
+impl Colouring {
+    fn code(self) -> [u32; 2] {
+        match self {
+            Colouring::Shaded => [0, 0],
+            Colouring::CageVertexWeight(vertex) => [1, vertex],
+            Colouring::MostNegativeWeight => [2, 0],
+            Colouring::MethodDistance => [3, 0],
+        }
+    }
+}
+
+/// How one view colours the mesh, and with which method's weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    /// The weights the mesh is deformed (and coloured) with.
+    pub method: Method,
+    pub colouring: Colouring,
+    pub scale: Scale,
+    /// Magnitude at which the colour map saturates.
+    pub colour_limit: f32,
+    /// Distances of [`Colouring::MethodDistance`] are divided by this.
+    pub cage_size: f32,
+}
+
+impl Default for Shading {
+    fn default() -> Self {
+        Self {
+            method: Method::Pmvc,
+            colouring: Colouring::Shaded,
+            scale: Scale::Linear,
+            colour_limit: 1.0,
+            cage_size: 1.0,
+        }
+    }
+}
+
+/// What a readback returns per mesh vertex, exactly as the shaders compute it.
+#[derive(Clone, Debug, Default)]
+pub struct ReadBack {
+    pub positions: Vec<Vec3>,
+    /// The colouring value (0 when shaded).
+    pub values: Vec<f32>,
+    /// The unshaded colour of each value.
+    pub colours: Vec<[f32; 3]>,
+}
+
+fn method_slot(method: Method) -> usize {
+    match method {
+        Method::Mvc => 0,
+        Method::Pmvc => 1,
+    }
+}
+
 /// The uniform shared by all viewport shaders (`struct Frame` in the WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
@@ -43,11 +122,16 @@ struct FrameUniform {
     eye: [f32; 4],
     viewport: [f32; 4],
     counts: [u32; 4],
+    colouring: [u32; 4],
+    colour_scale: [f32; 4],
 }
 
 /// Per-frame camera settings, carried by the paint callback.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameParams {
+    /// Which view this is, below [`MAX_VIEWS`].
+    pub view: usize,
+    pub shading: Shading,
     pub view_projection: Mat4,
     pub eye: Vec3,
     /// Viewport size in physical pixels.
@@ -66,7 +150,9 @@ pub struct SceneUpload<'a> {
 
 /// The scene's GPU buffers and their bind group.
 pub struct SceneGpu {
-    pub bind_group: wgpu::BindGroup,
+    /// Per method shown ([`method_slot`]): that method's weights at binding 1,
+    /// the other's at binding 5.
+    bind_groups: [wgpu::BindGroup; 2],
     pub indices: wgpu::Buffer,
     pub index_count: u32,
     pub vertex_count: u32,
@@ -74,7 +160,8 @@ pub struct SceneGpu {
     pub cage_edge_index_count: u32,
     pub cage_vertex_count: u32,
     rest: wgpu::Buffer,
-    weights: Option<wgpu::Buffer>,
+    /// Per method ([`method_slot`]).
+    weights: [Option<wgpu::Buffer>; 2],
     placeholder: wgpu::Buffer,
     cage: wgpu::Buffer,
     handle_state: wgpu::Buffer,
@@ -92,14 +179,14 @@ struct OffscreenTarget {
 /// All GPU state of the viewport; lives in egui_wgpu's callback resources.
 pub struct ViewportRenderer {
     scene_layout: wgpu::BindGroupLayout,
+    /// One [`FRAME_SLOT_BYTES`] slot per view, then the readback slot.
     frame: wgpu::Buffer,
-    last_frame: FrameUniform,
     mesh: MeshRenderer,
     cage: CageRenderer,
     composite: wgpu::RenderPipeline,
     composite_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
-    target: Option<OffscreenTarget>,
+    targets: [Option<OffscreenTarget>; MAX_VIEWS],
     scene: Option<SceneGpu>,
     max_storage_binding: u64,
     sample_count: u32,
@@ -138,8 +225,10 @@ impl ViewportRenderer {
                         | wgpu::ShaderStages::COMPUTE,
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<FrameUniform>() as u64,
+                        ),
                     },
                     count: None,
                 },
@@ -147,11 +236,12 @@ impl ViewportRenderer {
                 storage_entry(2, true),
                 storage_entry(3, true),
                 storage_entry(4, true),
+                storage_entry(5, true),
             ],
         });
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame"),
-            size: std::mem::size_of::<FrameUniform>() as u64,
+            size: FRAME_SLOT_BYTES * (MAX_VIEWS as u64 + 1),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -218,11 +308,10 @@ impl ViewportRenderer {
             sample_count,
             scene_layout,
             frame,
-            last_frame: FrameUniform::default(),
             composite,
             composite_layout,
             sampler,
-            target: None,
+            targets: Default::default(),
             scene: None,
             max_storage_binding: limits
                 .max_storage_buffer_binding_size
@@ -242,7 +331,7 @@ impl ViewportRenderer {
         self.sample_count = sample_count;
         self.mesh = MeshRenderer::new(device, &self.scene_layout, sample_count);
         self.cage = CageRenderer::new(device, &self.scene_layout, sample_count);
-        self.target = None;
+        self.targets = Default::default();
     }
 
     /// Replace the scene. Weights start unbound: the mesh shows at rest.
@@ -267,9 +356,10 @@ impl ViewportRenderer {
         let handle_state = buffer_with(device, "handle states", &states, storage);
         let placeholder = buffer_with(device, "no weights", &[0f32; 4], storage);
         let cage_edges = buffer_with(device, "cage edges", &edges, wgpu::BufferUsages::INDEX);
-        let bind_group = self.scene_bind_group(device, &placeholder, &rest, &cage, &handle_state);
+        let bind_group =
+            || self.scene_bind_group(device, [&placeholder; 2], &rest, &cage, &handle_state);
         self.scene = Some(SceneGpu {
-            bind_group,
+            bind_groups: [bind_group(), bind_group()],
             indices: index_buffer,
             index_count: indices.len() as u32,
             vertex_count: scene.rest_positions.len() as u32,
@@ -277,7 +367,7 @@ impl ViewportRenderer {
             cage_edge_index_count: edges.len() as u32 * 2,
             cage_vertex_count: scene.cage_rest.len() as u32,
             rest,
-            weights: None,
+            weights: [None, None],
             placeholder,
             cage,
             handle_state,
@@ -287,7 +377,7 @@ impl ViewportRenderer {
     fn scene_bind_group(
         &self,
         device: &wgpu::Device,
-        weights: &wgpu::Buffer,
+        [shown_weights, other_weights]: [&wgpu::Buffer; 2],
         rest: &wgpu::Buffer,
         cage: &wgpu::Buffer,
         handle_state: &wgpu::Buffer,
@@ -302,22 +392,31 @@ impl ViewportRenderer {
             label: Some("scene"),
             layout: &self.scene_layout,
             entries: &[
-                entry(0, &self.frame),
-                entry(1, weights),
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.frame,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+                    }),
+                },
+                entry(1, shown_weights),
                 entry(2, rest),
                 entry(3, cage),
                 entry(4, handle_state),
+                entry(5, other_weights),
             ],
         })
     }
 
-    /// Bind weights (or unbind them with `None`, showing the mesh at rest). A
-    /// `resident` buffer already holding them on this device is used as it is;
-    /// otherwise they are uploaded. Fails, leaving the weights unbound, when the
-    /// matrix exceeds the GPU's limit.
+    /// Bind one method's weights (or unbind them with `None`, showing the mesh at
+    /// rest in views of that method). A `resident` buffer already holding them on
+    /// this device is used as it is; otherwise they are uploaded. Fails, leaving
+    /// the weights unbound, when the matrix exceeds the GPU's limit.
     pub fn set_weights(
         &mut self,
         device: &wgpu::Device,
+        method: Method,
         weights: Option<&Weights>,
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
@@ -326,7 +425,7 @@ impl ViewportRenderer {
             return Err(RenderError::NoScene);
         };
         let mut result = Ok(());
-        scene.weights = match weights {
+        scene.weights[method_slot(method)] = match weights {
             Some(weights) if (weights.values.len() as u64) * 4 > limit => {
                 result = Err(RenderError::WeightsTooLarge {
                     needed_mib: weights.values.len() as f64 * 4.0 / 1048576.0,
@@ -345,14 +444,18 @@ impl ViewportRenderer {
             }),
             _ => None,
         };
-        let weights_buffer = scene.weights.as_ref().unwrap_or(&scene.placeholder);
-        scene.bind_group = self.scene_bind_group(
-            device,
-            weights_buffer,
-            &scene.rest,
-            &scene.cage,
-            &scene.handle_state,
-        );
+        let buffer = |slot: usize| scene.weights[slot].as_ref().unwrap_or(&scene.placeholder);
+        let group = |shown: usize| {
+            self.scene_bind_group(
+                device,
+                [buffer(shown), buffer(1 - shown)],
+                &scene.rest,
+                &scene.cage,
+                &scene.handle_state,
+            )
+        };
+        let bind_groups = [group(0), group(1)];
+        scene.bind_groups = bind_groups;
         self.scene = Some(scene);
         result
     }
@@ -392,15 +495,26 @@ impl ViewportRenderer {
         }
     }
 
+    /// Whether `method`'s weights are on the GPU.
+    pub fn has_weights(&self, method: Method) -> bool {
+        self.scene
+            .as_ref()
+            .is_some_and(|scene| scene.weights[method_slot(method)].is_some())
+    }
+
     fn frame_uniform(&self, params: &FrameParams) -> FrameUniform {
-        let (columns, weights_bound, vertices) = match &self.scene {
+        let shading = &params.shading;
+        let slot = method_slot(shading.method);
+        let (columns, weights_bound, other_bound, vertices) = match &self.scene {
             Some(scene) => (
                 scene.cage_vertex_count,
-                scene.weights.is_some() as u32,
+                scene.weights[slot].is_some() as u32,
+                scene.weights[1 - slot].is_some() as u32,
                 scene.vertex_count,
             ),
-            None => (0, 0, 0),
+            None => (0, 0, 0, 0),
         };
+        let [colouring, cage_vertex] = shading.colouring.code();
         FrameUniform {
             view_projection: params.view_projection.to_cols_array_2d(),
             eye: params.eye.extend(1.0).to_array(),
@@ -416,34 +530,56 @@ impl ViewportRenderer {
                 params.highlight_outside as u32,
                 vertices,
             ],
+            colouring: [
+                colouring,
+                cage_vertex,
+                (shading.scale == Scale::LogMagnitude) as u32,
+                other_bound,
+            ],
+            colour_scale: [shading.colour_limit, shading.cage_size, 0.0, 0.0],
         }
     }
 
-    /// The deformed mesh positions exactly as the vertex shader computes them.
-    pub fn read_back_deformed(
+    fn write_frame_slot(&self, queue: &wgpu::Queue, slot: usize, uniform: &FrameUniform) {
+        queue.write_buffer(
+            &self.frame,
+            slot as u64 * FRAME_SLOT_BYTES,
+            bytemuck::bytes_of(uniform),
+        );
+    }
+
+    /// The deformed mesh positions, colouring values and colours exactly as the
+    /// shaders compute them for `shading`.
+    pub fn read_back(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-    ) -> Result<Vec<Vec3>, RenderError> {
+        shading: &Shading,
+    ) -> Result<ReadBack, RenderError> {
+        let params = FrameParams {
+            view: READBACK_SLOT,
+            shading: *shading,
+            view_projection: Mat4::IDENTITY,
+            eye: Vec3::ZERO,
+            size_px: [1, 1],
+            handle_radius_px: 0.0,
+            highlight_outside: false,
+        };
+        let uniform = self.frame_uniform(&params);
+        self.write_frame_slot(queue, READBACK_SLOT, &uniform);
         let Some(scene) = &self.scene else {
             return Err(RenderError::NoScene);
         };
-        let mut uniform = self.last_frame;
-        uniform.counts = [
-            scene.cage_vertex_count,
-            scene.weights.is_some() as u32,
-            0,
-            scene.vertex_count,
-        ];
-        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = &scene.bind_groups[method_slot(shading.method)];
+        let offset = (READBACK_SLOT as u64 * FRAME_SLOT_BYTES) as u32;
         self.mesh
-            .read_back(device, queue, scene)
+            .read_back(device, queue, scene, bind_group, offset)
             .map_err(|_| RenderError::ReadBack)
     }
 
-    fn ensure_target(&mut self, device: &wgpu::Device, size: [u32; 2]) {
+    fn ensure_target(&mut self, device: &wgpu::Device, view: usize, size: [u32; 2]) {
         let samples = self.sample_count;
-        if self.target.as_ref().is_some_and(|t| t.size == size) {
+        if self.targets[view].as_ref().is_some_and(|t| t.size == size) {
             return;
         }
         let extent = wgpu::Extent3d {
@@ -486,7 +622,7 @@ impl ViewportRenderer {
                 },
             ],
         });
-        self.target = Some(OffscreenTarget {
+        self.targets[view] = Some(OffscreenTarget {
             size,
             multisampled: (samples > 1)
                 .then(|| texture("viewport msaa", OFFSCREEN_FORMAT, samples, attachment)),
@@ -557,12 +693,12 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
         let Some(renderer) = resources.get_mut::<ViewportRenderer>() else {
             return Vec::new();
         };
+        let view = self.params.view.min(MAX_VIEWS - 1);
         let size = [self.params.size_px[0].max(1), self.params.size_px[1].max(1)];
-        renderer.ensure_target(device, size);
+        renderer.ensure_target(device, view, size);
         let uniform = renderer.frame_uniform(&self.params);
-        renderer.last_frame = uniform;
-        queue.write_buffer(&renderer.frame, 0, bytemuck::bytes_of(&uniform));
-        let Some(target) = &renderer.target else {
+        renderer.write_frame_slot(queue, view, &uniform);
+        let Some(target) = &renderer.targets[view] else {
             return Vec::new();
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -595,8 +731,10 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
             multiview_mask: None,
         });
         if let Some(scene) = &renderer.scene {
-            renderer.mesh.draw(&mut pass, scene);
-            renderer.cage.draw(&mut pass, scene);
+            let bind_group = &scene.bind_groups[method_slot(self.params.shading.method)];
+            let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
+            renderer.mesh.draw(&mut pass, scene, bind_group, offset);
+            renderer.cage.draw(&mut pass, scene, bind_group, offset);
         }
         Vec::new()
     }
@@ -610,7 +748,7 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
         let Some(renderer) = resources.get::<ViewportRenderer>() else {
             return;
         };
-        let Some(target) = &renderer.target else {
+        let Some(target) = &renderer.targets[self.params.view.min(MAX_VIEWS - 1)] else {
             return;
         };
         pass.set_pipeline(&renderer.composite);

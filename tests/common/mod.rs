@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: writing scenes to files and running the binary.
 #![allow(dead_code)]
 
+pub mod editor;
+
 use pmvc::geometry::{procedural, Cage};
 use std::path::{Path, PathBuf};
 use std::process::Output;

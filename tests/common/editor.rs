@@ -1,0 +1,145 @@
+//! Driving the editor through egui_kittest with the real app state and the wgpu
+//! renderer (lavapipe on CI). Without a GPU adapter the editor tests print "not
+//! run" and pass, unless `PMVC_REQUIRE_GPU=1`, which turns a missing adapter into a
+//! failure.
+
+use egui::{Event, Modifiers, PointerButton, Pos2};
+use egui_kittest::Harness;
+use pmvc::app::{BindOn, EditorApp, EditorOptions};
+use std::time::{Duration, Instant};
+
+/// A fast resolution keeps the binds in these tests short.
+pub const TEST_RESOLUTION: u32 = 8;
+
+pub fn render_state() -> Option<eframe::egui_wgpu::RenderState> {
+    let setup = egui_kittest::wgpu::default_wgpu_setup();
+    let created = pollster::block_on(async {
+        let instance = setup.new_instance().await;
+        eframe::egui_wgpu::RenderState::create(
+            &eframe::egui_wgpu::WgpuConfiguration {
+                wgpu_setup: setup,
+                ..Default::default()
+            },
+            &instance,
+            None,
+            eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+        )
+        .await
+    });
+    match created {
+        Ok(state) => Some(state),
+        Err(error) if std::env::var("PMVC_REQUIRE_GPU").as_deref() == Ok("1") => {
+            panic!("PMVC_REQUIRE_GPU=1 but no wgpu adapter: {error}")
+        }
+        Err(error) => {
+            eprintln!("not run: no wgpu adapter ({error})");
+            None
+        }
+    }
+}
+
+pub fn editor() -> Option<Harness<'static, EditorApp>> {
+    editor_binding_on(BindOn::Auto)
+}
+
+pub fn editor_binding_on(bind_on: BindOn) -> Option<Harness<'static, EditorApp>> {
+    editor_with(EditorOptions {
+        bind_on,
+        ..Default::default()
+    })
+}
+
+/// The editor on the default scene with `options` (at [`TEST_RESOLUTION`] unless
+/// they name one).
+pub fn editor_with(options: EditorOptions) -> Option<Harness<'static, EditorApp>> {
+    let state = render_state()?;
+    let harness = Harness::builder()
+        .with_size(egui::vec2(1100.0, 700.0))
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
+            state,
+        ))
+        .build_eframe(move |cc| {
+            EditorApp::new(
+                cc,
+                EditorOptions {
+                    resolution: Some(options.resolution.unwrap_or(TEST_RESOLUTION)),
+                    ..options
+                },
+            )
+        });
+    Some(harness)
+}
+
+/// Step the app until the bind finishes, checking that progress is reported.
+pub fn run_until_bound(harness: &mut Harness<'static, EditorApp>) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while harness.state().is_binding() {
+        assert!(Instant::now() < deadline, "the bind did not finish in time");
+        harness.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    harness.run_steps(3);
+}
+
+/// A cage handle with no other handle near it on screen, and its position.
+pub fn isolated_handle(harness: &Harness<'static, EditorApp>) -> (usize, Pos2) {
+    let app = harness.state();
+    let screen: Vec<Option<Pos2>> = (0..app.scene.pose.len())
+        .map(|i| app.handle_screen_position(i))
+        .collect();
+    screen
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| Some((i, (*p)?)))
+        .filter(|(_, p)| p.x > 50.0 && p.x < 700.0 && p.y > 80.0 && p.y < 650.0)
+        .find(|(i, p)| {
+            screen
+                .iter()
+                .enumerate()
+                .all(|(j, q)| j == *i || q.is_none_or(|q| q.distance(*p) > 25.0))
+        })
+        .expect("some handle stands alone on screen")
+}
+
+/// A plain left click at `at`, as a press and release without movement.
+pub fn click(harness: &mut Harness<'static, EditorApp>, at: Pos2) {
+    harness.hover_at(at);
+    harness.run_steps(2);
+    harness.drag_at(at);
+    harness.step();
+    harness.drop_at(at);
+    harness.run_steps(2);
+}
+
+pub fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
+    // Held modifier keys, as the window system reports them with every event.
+    harness.event(Event::ModifiersChanged(modifiers));
+    harness.hover_at(from);
+    harness.run_steps(2);
+    harness.event(Event::PointerButton {
+        pos: from,
+        button: PointerButton::Primary,
+        pressed: true,
+        modifiers,
+    });
+    harness.step();
+    for k in 1..=10 {
+        harness.hover_at(from + (to - from) * (k as f32 / 10.0));
+        harness.step();
+    }
+    harness.event(Event::PointerButton {
+        pos: to,
+        button: PointerButton::Primary,
+        pressed: false,
+        modifiers,
+    });
+    harness.run_steps(2);
+    harness.event(Event::ModifiersChanged(Modifiers::NONE));
+}
+
+pub fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f32::max)
+}
