@@ -17,3 +17,16 @@ shoot default-scene
 shoot pmvc-posed --pose docs/poses/middle-finger-sideways.obj
 shoot mvc-posed --method mvc --pose docs/poses/middle-finger-sideways.obj
 shoot scanned-elephant assets/scan_mesh.obj assets/scan_cage.obj
+
+# The comparison gallery (docs/comparison.md).
+finger=docs/poses/middle-finger-sideways.obj
+shoot compare-side-by-side --pose "$finger" --view side-by-side
+shoot compare-heatmap --pose "$finger" --view side-by-side --heatmap 7
+shoot compare-heatmap-log --pose "$finger" --view side-by-side --heatmap 7 --log-scale
+shoot compare-negativity --pose "$finger" --view side-by-side --negativity
+shoot compare-difference --pose "$finger" --view difference
+elephant=(assets/scan_mesh.obj assets/scan_cage.obj --pose docs/poses/elephant-head-sideways.obj)
+shoot compare-elephant-side-by-side "${elephant[@]}" --view side-by-side
+shoot compare-elephant-heatmap "${elephant[@]}" --view side-by-side --heatmap 56 --log-scale
+shoot compare-elephant-negativity "${elephant[@]}" --view side-by-side --negativity --log-scale
+shoot compare-elephant-difference "${elephant[@]}" --view difference

@@ -1158,7 +1158,11 @@ impl EditorApp {
     /// Find the mesh vertex under the cursor and read out its weights.
     fn update_hover(&mut self, ui: &egui::Ui, hovered: Option<(usize, Option<Pos2>)>) {
         let target = match hovered {
-            Some((pane, Some(pointer))) if self.drag.is_none() => Some((pane, pointer)),
+            // Not in `--screenshot` runs, where the pointer rests wherever the
+            // display server put it.
+            Some((pane, Some(pointer))) if self.drag.is_none() && self.screenshot.is_none() => {
+                Some((pane, pointer))
+            }
             _ => None,
         };
         let readout = target.and_then(|(pane, pointer)| {
@@ -1984,24 +1988,33 @@ fn draw_colour_bar(
     painter.text(
         bar.center_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::CENTER_TOP,
-        format!("min {:.4} · max {:.4}", range.min, range.max),
+        format!("min {} · max {}", short(range.min), short(range.max)),
         font.clone(),
         text,
     );
     painter.text(
         bar.left_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::LEFT_TOP,
-        format!("{low:.3}"),
+        short(low),
         font.clone(),
         text,
     );
     painter.text(
         bar.right_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::RIGHT_TOP,
-        format!("{limit:.3}"),
+        short(limit),
         font,
         text,
     );
+}
+
+/// A colour-bar number: three decimals, or three significant digits when small.
+fn short(value: f32) -> String {
+    if value == 0.0 || value.abs() >= 0.01 {
+        format!("{value:.3}")
+    } else {
+        format!("{value:.2e}")
+    }
 }
 
 /// The hover box: a vertex's largest weights and its most negative one.
