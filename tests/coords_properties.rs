@@ -238,3 +238,46 @@ fn points_on_the_surface_get_barycentrics_and_never_nan() {
         assert!((f64::from(weights.row(0)[corners[2] as usize]) - 0.5).abs() < 1e-6);
     }
 }
+
+/// The inside-only evaluation skips triangles that x sees from their outer side; it
+/// must agree with the full one up to rounding, also for points just off the surface
+/// (at 1e-8 of the diagonal, where the sign of the determinant matters most).
+#[test]
+fn skipping_triangles_facing_away_from_inside_points_changes_nothing() {
+    let table = TexelTable::new(16);
+    for (name, cage) in [("convex", convex()), ("comb", comb()), ("star", star())] {
+        let mut points = procedural::points_inside(&cage, 200, 11, 1e-3);
+        for t in 0..cage.triangles.len() {
+            let [a, b, c] = cage.triangle(t);
+            let inward = -(b - a).cross(c - a).normalize();
+            points.push((a + b + c) / 3.0 + 1e-8 * cage.diagonal() * inward);
+        }
+        let classes = classify_points(&cage, &points);
+        let mut worst = 0.0f64;
+        for (x, class) in points.iter().zip(&classes.classes) {
+            if *class != PointClass::Inside {
+                continue;
+            }
+            let mut full = vec![0.0; cage.vertex_count()];
+            let mut culled = vec![0.0; cage.vertex_count()];
+            let enclosed =
+                pmvc_ref::pmvc_weights(*x, &cage, &table, &mut full, &mut Default::default());
+            let enclosed_culled = pmvc_ref::pmvc_weights_inside(
+                *x,
+                &cage,
+                &table,
+                &mut culled,
+                &mut Default::default(),
+            );
+            assert_eq!(enclosed, enclosed_culled, "{name}: at {x}");
+            for (f, c) in full.iter().zip(&culled) {
+                worst = worst.max((f - c).abs());
+            }
+        }
+        println!("{name}: largest difference {worst:e}");
+        assert!(
+            worst <= 1e-12,
+            "{name}: culling changed a weight by {worst}"
+        );
+    }
+}

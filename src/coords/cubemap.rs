@@ -87,7 +87,18 @@ pub struct TexelTable {
     pub centres: Vec<f64>,
     /// `Ω / |(u, v, 1)|` for texel `(i, j)` at `j·R + i`.
     pub solid_angle_over_length: Vec<f64>,
+    /// Row length of the padded layout below: `R` rounded up to [`TEXEL_LANES`].
+    pub stride: usize,
+    /// `centres` padded to `stride` with NaN, which no edge test passes.
+    pub padded_centres: Vec<f64>,
+    /// `Ω·d̂` in face coordinates, then 1, for texel `(i, j)` at `j·stride + i`; zero
+    /// in the padding. A hit's weight times its barycentrics is linear in `Ω·d̂`, so
+    /// the CPU reference sums these per triangle; the 1 counts texels.
+    pub texel_directions: Vec<[f64; 4]>,
 }
+
+/// Texels per step of the CPU rasteriser's inner loop.
+pub const TEXEL_LANES: usize = 4;
 
 impl TexelTable {
     pub fn new(resolution: u32) -> Self {
@@ -103,10 +114,25 @@ impl TexelTable {
                 solid_angle_over_length.push(texel_solid_angle(i, j, resolution) / length);
             }
         }
+        let r = resolution as usize;
+        let stride = r.div_ceil(TEXEL_LANES) * TEXEL_LANES;
+        let mut padded_centres = centres.clone();
+        padded_centres.resize(stride, f64::NAN);
+        let mut texel_directions = vec![[0.0; 4]; stride * r];
+        for j in 0..r {
+            for i in 0..r {
+                let (u, v) = (centres[i], centres[j]);
+                let w = solid_angle_over_length[j * r + i];
+                texel_directions[j * stride + i] = [w * u, w * v, w, 1.0];
+            }
+        }
         Self {
             resolution,
             centres,
             solid_angle_over_length,
+            stride,
+            padded_centres,
+            texel_directions,
         }
     }
 }

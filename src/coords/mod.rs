@@ -227,7 +227,7 @@ pub fn weights_at(
         PointClass::Inside => match method {
             Method::Mvc => mvc::mvc_weights(x, cage, out, mvc_scratch),
             Method::Pmvc => {
-                if !pmvc::pmvc_weights(x, cage, table, out, pmvc_scratch) {
+                if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the
                     // surface or in a cage defect). Follow the outside policy.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);

@@ -12,8 +12,14 @@
 //! the unnormalised barycentrics of the hit, and their sum `D` gives the ray
 //! parameter `t = det[a,b,c] / D`. A shared edge yields exactly negated values in
 //! its two triangles, so no ray slips between them.
+//!
+//! The resolve needs only which triangle won each texel: the texel's weight times
+//! the hit's barycentrics, `Ω/r · Eₖ/D = Eₖ·(Ω·d̂)/det`, is linear in `Ω·d̂`, so the
+//! per-texel vectors `Ω·d̂` are summed per triangle and dotted with its edge normals
+//! once. The winner is kept in the depth buffer itself, coded in the low mantissa
+//! bits of the inverse depth ([`hit_key`]).
 
-use super::cubemap::{TexelTable, CUBE_FACES};
+use super::cubemap::{TexelTable, CUBE_FACES, TEXEL_LANES};
 use crate::geometry::Cage;
 use glam::DVec3;
 use std::ops::Range;
@@ -22,16 +28,20 @@ use std::ops::Range;
 #[derive(Debug, Default)]
 pub struct PmvcScratch {
     triangles: Vec<TriangleSetup>,
-    /// Per texel of the current face: inverse hit distance along the ray (0 = no hit).
+    /// Per texel of the current face (padded rows): the nearest hit's key (0 = none),
+    /// see [`hit_key`].
     nearest: Vec<f64>,
-    /// Per triangle: its edge functions on the current face (valid where rasterised).
-    face_edges: Vec<[DVec3; 3]>,
-    /// Per texel: triangle of the nearest hit.
-    hit_triangle: Vec<u32>,
+    /// Triangles rasterised on the current face, with their signed edge functions.
+    drawn: Vec<(u32, [DVec3; 3])>,
+    /// Two banks per hit code (code 0: the misses): the sums of
+    /// [`TexelTable::texel_directions`] over the texels each code won.
+    sums: Vec<[f64; 4]>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
 struct TriangleSetup {
+    /// Index into the cage's triangles.
+    index: u32,
     /// Corners relative to x.
     corners: [DVec3; 3],
     /// `b×c`, `c×a`, `a×b`: a ray direction dotted with these gives unnormalised barycentrics.
@@ -45,6 +55,10 @@ struct TriangleSetup {
 /// edge tests all round the same way, which is vanishingly rare.
 const MAX_MISSED_SHARE: f64 = 0.01;
 
+/// Accumulator banks per triangle: consecutive texels add into different ones, so
+/// runs of texels won by one triangle do not wait on each other's stores.
+const BANKS: usize = 2;
+
 /// PMVC of `x`, written to `out` (one value per cage vertex). Returns `false`, with
 /// `out` unspecified, when x is not enclosed by the cage (too many rays escape).
 pub fn pmvc_weights(
@@ -54,30 +68,75 @@ pub fn pmvc_weights(
     out: &mut [f64],
     scratch: &mut PmvcScratch,
 ) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has just been checked to support AVX2.
-        return unsafe { pmvc_weights_avx2(x, cage, table, out, scratch) };
-    }
-    pmvc_weights_any_cpu(x, cage, table, out, scratch)
+    dispatch::<false>(x, cage, table, out, scratch)
 }
 
-/// The same code compiled for AVX2, so that the texel loops are vectorised four
-/// wide. Rust never fuses multiply-adds on its own, so the results are bit-identical.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn pmvc_weights_avx2(
+/// [`pmvc_weights`] for a point that [`crate::geometry::classify_points`] found
+/// strictly inside the cage, which must not intersect itself. Gives the same weights
+/// up to rounding, faster: from inside, the first hit of every ray leaves the
+/// volume, so it is never on a triangle that x sees from its outer side, and those
+/// triangles are skipped.
+pub fn pmvc_weights_inside(
     x: DVec3,
     cage: &Cage,
     table: &TexelTable,
     out: &mut [f64],
     scratch: &mut PmvcScratch,
 ) -> bool {
-    pmvc_weights_any_cpu(x, cage, table, out, scratch)
+    dispatch::<true>(x, cage, table, out, scratch)
 }
 
 #[inline(always)]
-fn pmvc_weights_any_cpu(
+fn dispatch<const CULL: bool>(
+    x: DVec3,
+    cage: &Cage,
+    table: &TexelTable,
+    out: &mut [f64],
+    scratch: &mut PmvcScratch,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has just been checked to support AVX2.
+        return unsafe { pmvc_weights_avx2::<CULL>(x, cage, table, out, scratch) };
+    }
+    pmvc_weights_any_cpu::<CULL>(x, cage, table, out, scratch)
+}
+
+/// The same code compiled for AVX2, so that the texel loops are vectorised four
+/// wide. Rust never fuses multiply-adds on its own, so the results are bit-identical.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn pmvc_weights_avx2<const CULL: bool>(
+    x: DVec3,
+    cage: &Cage,
+    table: &TexelTable,
+    out: &mut [f64],
+    scratch: &mut PmvcScratch,
+) -> bool {
+    pmvc_weights_any_cpu::<CULL>(x, cage, table, out, scratch)
+}
+
+/// The depth test's key: the inverse depth `1/t > 0` with the low bits of its
+/// mantissa replaced by the triangle's code. Positive doubles order like their bits,
+/// so the largest key is the nearest hit (to 2⁻⁴⁰ relative for up to 4,095
+/// triangles), and on a tie the lowest triangle index, as in ascending order with a
+/// strict test.
+#[inline(always)]
+fn hit_key(inverse_t: f64, code_mask: usize, code: u64) -> f64 {
+    f64::from_bits((inverse_t.to_bits() & !(code_mask as u64)) | code)
+}
+
+/// True when x is certainly on the outer side of the plane of the outward triangle
+/// (a, b, c), taken relative to x: `det[a,b,c] < 0` by far more than its rounding.
+#[inline(always)]
+fn faces_away(det: f64, corners: &[DVec3; 3]) -> bool {
+    let scale =
+        corners[0].length_squared() * corners[1].length_squared() * corners[2].length_squared();
+    det < 0.0 && det * det > 1e-24 * scale
+}
+
+#[inline(always)]
+fn pmvc_weights_any_cpu<const CULL: bool>(
     x: DVec3,
     cage: &Cage,
     table: &TexelTable,
@@ -85,37 +144,40 @@ fn pmvc_weights_any_cpu(
     scratch: &mut PmvcScratch,
 ) -> bool {
     let resolution = table.resolution as usize;
-    let texels = resolution * resolution;
+    let stride = table.stride;
+    let texels = stride * resolution;
     out.fill(0.0);
     scratch.triangles.clear();
-    for corners in &cage.triangles {
+    for (index, corners) in cage.triangles.iter().enumerate() {
         let a = cage.positions[corners[0] as usize] - x;
         let b = cage.positions[corners[1] as usize] - x;
         let c = cage.positions[corners[2] as usize] - x;
         let edge_normals = [b.cross(c), c.cross(a), a.cross(b)];
         let det = a.dot(edge_normals[0]);
+        // x in the triangle's plane: rays graze it, so it never blocks or contributes.
+        if det == 0.0 || (CULL && faces_away(det, &[a, b, c])) {
+            continue;
+        }
         scratch.triangles.push(TriangleSetup {
+            index: index as u32,
             corners: [a, b, c],
             edge_normals,
             det,
         });
     }
+    // Triangle t is coded as `code_mask − t` in the low bits of its hit keys; 0 is a miss.
+    let code_mask = (scratch.triangles.len() + 1).next_power_of_two() - 1;
     scratch.nearest.resize(texels, 0.0);
-    scratch
-        .face_edges
-        .resize(cage.triangles.len(), [DVec3::ZERO; 3]);
-    scratch.hit_triangle.resize(texels, 0);
+    scratch.sums.clear();
+    scratch.sums.resize(BANKS * (code_mask + 1), [0.0; 4]);
 
     let mut total_weight = 0.0;
-    let mut missed = 0usize;
+    let mut missed = 0.0;
     for face in &CUBE_FACES {
         scratch.nearest.fill(0.0);
+        scratch.drawn.clear();
         let frame = FaceFrame::new(face);
         for (t, setup) in scratch.triangles.iter().enumerate() {
-            // x in the triangle's plane: rays graze it, so it never blocks or contributes.
-            if setup.det == 0.0 {
-                continue;
-            }
             let local = [
                 frame.local(setup.corners[0]),
                 frame.local(setup.corners[1]),
@@ -127,6 +189,9 @@ fn pmvc_weights_any_cpu(
             let Some((columns, rows)) = texel_bounds(&local, table) else {
                 continue;
             };
+            // Whole steps of TEXEL_LANES; the padding's NaN centres never pass.
+            let columns = columns.start / TEXEL_LANES * TEXEL_LANES
+                ..(columns.end.div_ceil(TEXEL_LANES) * TEXEL_LANES).min(stride);
             let sign = setup.det.signum();
             // s·E_k(u, v) = a·u + b·v + c per edge, with the sign of det folded in.
             let [e0, e1, e2] = setup.edge_normals;
@@ -135,8 +200,10 @@ fn pmvc_weights_any_cpu(
                 frame.local(e1) * sign,
                 frame.local(e2) * sign,
             ];
-            scratch.face_edges[t] = edges;
+            scratch.drawn.push((t as u32, edges));
+            let code = (code_mask - t) as u64;
             let depth = (edges[0] + edges[1] + edges[2]) * (sign / setup.det);
+            let centres = &table.padded_centres[columns.clone()];
             for j in rows {
                 let v = table.centres[j];
                 let row_offsets = [
@@ -145,13 +212,10 @@ fn pmvc_weights_any_cpu(
                     v * edges[2].y + edges[2].z,
                 ];
                 let row_depth = v * depth.y + depth.z;
-                let row = j * resolution;
+                let row = j * stride;
                 let texels = row + columns.start..row + columns.end;
-                let nearest = &mut scratch.nearest[texels.clone()];
-                let hits = &mut scratch.hit_triangle[texels];
-                for ((&u, nearest), hit) in
-                    table.centres[columns.clone()].iter().zip(nearest).zip(hits)
-                {
+                let nearest = &mut scratch.nearest[texels];
+                for (&u, nearest) in centres.iter().zip(nearest) {
                     // Exact per texel: a shared edge gives exactly negated values in its
                     // two triangles, so no ray slips between them.
                     let inside = (u * edges[0].x + row_offsets[0] >= 0.0)
@@ -159,42 +223,51 @@ fn pmvc_weights_any_cpu(
                         & (u * edges[2].x + row_offsets[2] >= 0.0);
                     // 1/t of the hit, linear in (u, v); larger is nearer.
                     let inverse_t = u * depth.x + row_depth;
-                    if inside & (inverse_t > *nearest) {
-                        *nearest = inverse_t;
-                        *hit = t as u32;
-                    }
+                    let key = hit_key(inverse_t, code_mask, code);
+                    // A maximum and a plain store: a conditional store would become a
+                    // masked store, which is slow on some CPUs.
+                    *nearest = nearest.max(if inside { key } else { 0.0 });
                 }
             }
         }
-        for j in 0..resolution {
-            let v = table.centres[j];
-            for i in 0..resolution {
-                let texel = j * resolution + i;
-                let inverse_t = scratch.nearest[texel];
-                if inverse_t <= 0.0 {
-                    missed += 1;
-                    continue;
+        // Sum Ω·d̂ per winning triangle; then w·bₖ = Ω/r · Eₖ/ΣE = sE_k·(Ω·d̂)/|det|,
+        // linear in Ω·d̂, so each triangle needs only its sum.
+        for (keys, directions) in scratch.nearest[..texels]
+            .chunks_exact(BANKS)
+            .zip(table.texel_directions.chunks_exact(BANKS))
+        {
+            for bank in 0..BANKS {
+                let code = keys[bank].to_bits() as usize & code_mask;
+                let sum = &mut scratch.sums[BANKS * code + bank];
+                for c in 0..4 {
+                    sum[c] += directions[bank][c];
                 }
-                let triangle = scratch.hit_triangle[texel] as usize;
-                let u = table.centres[i];
-                let [c0, c1, c2] = scratch.face_edges[triangle];
-                let e = [
-                    u * c0.x + (v * c0.y + c0.z),
-                    u * c1.x + (v * c1.y + c1.z),
-                    u * c2.x + (v * c2.y + c2.z),
-                ];
-                // w = Ω / r with r = t·|(u, v, 1)|, spread by the barycentrics e / Σe.
-                let weight = table.solid_angle_over_length[texel] * inverse_t;
-                let scale = weight / (e[0] + e[1] + e[2]);
-                let corners = cage.triangles[triangle];
-                for k in 0..3 {
-                    out[corners[k] as usize] += scale * e[k];
-                }
+            }
+        }
+        for &(t, edges) in &scratch.drawn {
+            let t = t as usize;
+            let code = code_mask - t;
+            let mut sum = DVec3::ZERO;
+            for bank in &mut scratch.sums[BANKS * code..BANKS * (code + 1)] {
+                sum += DVec3::new(bank[0], bank[1], bank[2]);
+                *bank = [0.0; 4];
+            }
+            let setup = &scratch.triangles[t];
+            let inverse_det = 1.0 / setup.det.abs();
+            let corners = cage.triangles[setup.index as usize];
+            for k in 0..3 {
+                // Non-negative per texel; clamp away the rounding of the sum.
+                let weight = (edges[k].dot(sum) * inverse_det).max(0.0);
+                out[corners[k] as usize] += weight;
                 total_weight += weight;
             }
         }
+        for bank in &mut scratch.sums[..BANKS] {
+            missed += bank[3];
+            *bank = [0.0; 4];
+        }
     }
-    if missed as f64 > MAX_MISSED_SHARE * (6 * texels) as f64 || total_weight <= 0.0 {
+    if missed > MAX_MISSED_SHARE * (6 * resolution * resolution) as f64 || total_weight <= 0.0 {
         return false;
     }
     let inverse_total = 1.0 / total_weight;
@@ -316,22 +389,32 @@ mod tests {
     fn every_code_path_gives_identical_weights() {
         let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
         let table = TexelTable::new(16);
+        let n = cage.vertex_count();
         for x in procedural::points_inside(&cage, 20, 9, 1e-3) {
-            let mut dispatched = vec![0.0; cage.vertex_count()];
-            let mut portable = vec![0.0; cage.vertex_count()];
-            assert!(pmvc_weights(
-                x,
-                &cage,
-                &table,
-                &mut dispatched,
-                &mut PmvcScratch::default()
-            ));
-            assert!(pmvc_weights_any_cpu(
+            let scratch = &mut PmvcScratch::default();
+            let (mut dispatched, mut portable) = (vec![0.0; n], vec![0.0; n]);
+            assert!(pmvc_weights(x, &cage, &table, &mut dispatched, scratch));
+            assert!(pmvc_weights_any_cpu::<false>(
                 x,
                 &cage,
                 &table,
                 &mut portable,
-                &mut PmvcScratch::default()
+                scratch
+            ));
+            assert_eq!(dispatched, portable);
+            assert!(pmvc_weights_inside(
+                x,
+                &cage,
+                &table,
+                &mut dispatched,
+                scratch
+            ));
+            assert!(pmvc_weights_any_cpu::<true>(
+                x,
+                &cage,
+                &table,
+                &mut portable,
+                scratch
             ));
             assert_eq!(dispatched, portable);
         }
