@@ -2,7 +2,8 @@
 # Smoke test of the real editor binary under Xvfb on a software Vulkan driver:
 #  1. `--screenshot` run: the default scene binds and a PNG of the window is saved;
 #  2. an interactive run: xdotool drags across the viewport (orbiting the view, or
-#     moving a handle if one is under the cursor), and the screen is captured.
+#     moving a handle if one is under the cursor), presses M to switch between MVC
+#     and PMVC, and the screen is captured after each.
 # Needs: xvfb, xdotool, imagemagick (import), mesa-vulkan-drivers.
 # Usage: tests/xvfb-smoke.sh [OUT_DIR]   (default: target/smoke)
 # Set PMVC_EDITOR to the pmvc binary (default: built here in release mode).
@@ -54,6 +55,12 @@ done
 xdotool mouseup 1
 sleep 2
 import -window root "$out/after-drag.png"
+# M switches the method shown (MVC/PMVC) without rebinding; at least the view's
+# label changes.
+xdotool windowfocus "$window" 2>/dev/null || true
+xdotool key m
+sleep 2
+import -window root "$out/after-method-switch.png"
 kill "$editor_pid" 2>/dev/null || true
 wait "$editor_pid" 2>/dev/null || true
 test -s "$out/after-drag.png"
@@ -63,4 +70,8 @@ changed=$(compare -metric AE "$out/before-drag.png" "$out/after-drag.png" null: 
 echo "   pixels changed by the drag: $changed"
 [[ "${changed%% *}" =~ ^[0-9.e+]+$ ]] && awk "BEGIN { exit !(${changed%% *} > 1000) }" || {
   echo "the drag did not change the view"; exit 1; }
+switched=$(compare -metric AE "$out/after-drag.png" "$out/after-method-switch.png" null: 2>&1 || true)
+echo "   pixels changed by pressing M: $switched"
+[[ "${switched%% *}" =~ ^[0-9.e+]+$ ]] && awk "BEGIN { exit !(${switched%% *} > 50) }" || {
+  echo "pressing M did not switch the method shown"; exit 1; }
 echo "smoke test passed"
