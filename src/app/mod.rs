@@ -8,12 +8,14 @@
 //! - [`scene`]: the loaded mesh, cage, pose and weights, and the pose history.
 //! - [`jobs`]: binding on a background thread with progress and cancel.
 //! - [`scenes`]: the bundled scenes and their generators.
+//! - [`widgets`]: the colour bar and the hover box drawn over the views.
 
 pub mod compare;
 pub mod editor;
 pub mod jobs;
 pub mod scene;
 pub mod scenes;
+pub mod widgets;
 
 pub use editor::EditorApp;
 

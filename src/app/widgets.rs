@@ -1,0 +1,129 @@
+//! The comparison widgets drawn over the viewport: the colour bar of a heatmap
+//! and the hover box with a vertex's weights. Pure egui painting; the values
+//! come from [`super::compare`] and the colours from [`crate::render::colormap`].
+
+use super::compare::{HoverReadout, ValueRange, HOVER_TOP_WEIGHTS};
+use crate::render::colormap::{self, Scale};
+use crate::render::{Colouring, Shading};
+use egui::{Color32, Pos2, Rect, Stroke};
+
+fn colour32([r, g, b]: [f32; 3]) -> Color32 {
+    let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    Color32::from_rgb(byte(r), byte(g), byte(b))
+}
+
+/// A horizontal colour bar at the bottom of `rect`: the map from −limit to +limit
+/// (0 to +limit for distances), with the values' min and max marked.
+pub fn draw_colour_bar(
+    painter: &egui::Painter,
+    rect: Rect,
+    shading: &Shading,
+    range: ValueRange,
+    title: String,
+) {
+    let signed = shading.colouring != Colouring::MethodDistance;
+    let limit = shading.colour_limit;
+    let low = if signed { -limit } else { 0.0 };
+    let bar = Rect::from_min_size(
+        Pos2::new(rect.left() + 16.0, rect.bottom() - 42.0),
+        egui::vec2((rect.width() - 32.0).clamp(60.0, 320.0), 14.0),
+    );
+    let backdrop = bar.expand2(egui::vec2(8.0, 22.0));
+    painter.rect_filled(backdrop, 4.0, Color32::from_black_alpha(140));
+    let steps = 64;
+    let mut mesh = egui::Mesh::default();
+    for step in 0..=steps {
+        let fraction = step as f32 / steps as f32;
+        let value = low + (limit - low) * fraction;
+        let colour = colour32(colormap::heat_colour(value, limit, shading.scale));
+        let x = bar.left() + bar.width() * fraction;
+        mesh.colored_vertex(Pos2::new(x, bar.top()), colour);
+        mesh.colored_vertex(Pos2::new(x, bar.bottom()), colour);
+        if step > 0 {
+            let i = 2 * step as u32;
+            mesh.add_triangle(i - 2, i - 1, i);
+            mesh.add_triangle(i - 1, i + 1, i);
+        }
+    }
+    painter.add(egui::Shape::mesh(mesh));
+    // Where a value sits on the bar (the log scale bends the axis).
+    let x_of = |value: f32| {
+        let t = colormap::scaled(value, limit, shading.scale);
+        let fraction = if signed { (t + 1.0) / 2.0 } else { t };
+        bar.left() + bar.width() * fraction.clamp(0.0, 1.0)
+    };
+    for value in [range.min, range.max] {
+        let x = x_of(value);
+        painter.line_segment(
+            [
+                Pos2::new(x, bar.top() - 3.0),
+                Pos2::new(x, bar.bottom() + 3.0),
+            ],
+            Stroke::new(2.0, Color32::BLACK),
+        );
+    }
+    let font = egui::FontId::proportional(12.0);
+    let text = Color32::from_gray(235);
+    let log = if shading.scale == Scale::LogMagnitude {
+        " · log scale"
+    } else {
+        ""
+    };
+    painter.text(
+        bar.left_top() - egui::vec2(0.0, 4.0),
+        egui::Align2::LEFT_BOTTOM,
+        format!("{title}{log}"),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.center_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::CENTER_TOP,
+        format!("min {} · max {}", short(range.min), short(range.max)),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.left_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::LEFT_TOP,
+        short(low),
+        font.clone(),
+        text,
+    );
+    painter.text(
+        bar.right_bottom() + egui::vec2(0.0, 2.0),
+        egui::Align2::RIGHT_TOP,
+        short(limit),
+        font,
+        text,
+    );
+}
+
+/// A colour-bar number: three decimals, or three significant digits when small.
+fn short(value: f32) -> String {
+    if value == 0.0 || value.abs() >= 0.01 {
+        format!("{value:.3}")
+    } else {
+        format!("{value:.2e}")
+    }
+}
+
+/// The hover box: a vertex's largest weights and its most negative one.
+pub fn hover_box(ui: &mut egui::Ui, readout: &HoverReadout) {
+    ui.strong(format!(
+        "vertex {} · {}",
+        readout.vertex,
+        readout.method.name()
+    ));
+    ui.label(format!("largest {HOVER_TOP_WEIGHTS} weights:"));
+    for (cage_vertex, weight) in &readout.top {
+        ui.monospace(format!("λ{cage_vertex:<4} {weight:>9.5}"));
+    }
+    match readout.most_negative {
+        Some((cage_vertex, weight)) => ui.colored_label(
+            Color32::from_rgb(120, 150, 255),
+            format!("most negative: λ{cage_vertex} = {weight:.5}"),
+        ),
+        None => ui.label("no negative weight"),
+    };
+}
