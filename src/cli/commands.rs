@@ -77,13 +77,18 @@ pub(super) fn compute_weights(input: &BoundInput, choice: &MethodChoice) -> Resu
         cage: input.cage.clone(),
         options,
     };
-    let handle = Binder::new(backend).start(bind_input);
-    while !handle.is_finished() {
-        bar.set_position(handle.progress().0 as u64);
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    bar.finish_and_clear();
-    let output = handle.wait()?;
+    let output = if bar.is_hidden() {
+        // Nothing to show: wait on the bind directly, not in steps of the poll below.
+        Binder::new(backend).bind_blocking(&bind_input)?
+    } else {
+        let handle = Binder::new(backend).start(bind_input);
+        while !handle.is_finished() {
+            bar.set_position(handle.progress().0 as u64);
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        bar.finish_and_clear();
+        handle.wait()?
+    };
     output
         .weights
         .context("internal error: the bind returned no CPU weights")
@@ -271,16 +276,27 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
 
 /// Write weights as .npy v1: little-endian float32, C order, shape (rows, cols).
 pub fn write_npy(path: &Path, weights: &Weights) -> Result<()> {
-    use npyz::WriterBuilder;
-    let dtype = npyz::DType::new_scalar("<f4".parse().expect("valid type string"));
+    let mut header = format!(
+        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {}), }}",
+        weights.rows, weights.cols
+    );
+    // Magic, version, length and header end on a 64-byte boundary, with a newline.
+    let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
+    header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
+    header.push('\n');
+    let header_len = u16::try_from(header.len()).context("weights shape too long for .npy")?;
     geometry::write_atomically(path, |out| {
-        let mut writer = npyz::WriteOptions::<f32>::new()
-            .dtype(dtype)
-            .shape(&[weights.rows as u64, weights.cols as u64])
-            .writer(out)
-            .begin_nd()?;
-        writer.extend(weights.values.iter().copied())?;
-        writer.finish()
+        out.write_all(b"\x93NUMPY\x01\x00")?;
+        out.write_all(&header_len.to_le_bytes())?;
+        out.write_all(header.as_bytes())?;
+        // In blocks rather than element by element, which took tens of milliseconds.
+        let mut block = Vec::with_capacity(1 << 16);
+        for values in weights.values.chunks(1 << 14) {
+            block.clear();
+            block.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+            out.write_all(&block)?;
+        }
+        Ok(())
     })?;
     Ok(())
 }

@@ -19,7 +19,9 @@
 //! once. The winner is kept in the depth buffer itself, coded in the low mantissa
 //! bits of the inverse depth ([`hit_key`]).
 
-use super::cubemap::{TexelTable, CUBE_FACES, TEXEL_LANES};
+#[cfg(test)]
+use super::cubemap::CUBE_FACES;
+use super::cubemap::{TexelTable, TEXEL_LANES};
 use crate::geometry::Cage;
 use glam::DVec3;
 use std::ops::Range;
@@ -48,6 +50,8 @@ struct TriangleSetup {
     edge_normals: [DVec3; 3],
     /// `det[a, b, c]`; its sign tells which side x is on.
     det: f64,
+    /// Bit f: the triangle may reach into the frustum of cube face f.
+    faces: u8,
 }
 
 /// Share of texels that may miss every triangle before x is treated as not enclosed.
@@ -57,7 +61,7 @@ const MAX_MISSED_SHARE: f64 = 0.01;
 
 /// Accumulator banks per triangle: consecutive texels add into different ones, so
 /// runs of texels won by one triangle do not wait on each other's stores.
-const BANKS: usize = 2;
+const BANKS: usize = 4;
 
 /// PMVC of `x`, written to `out` (one value per cage vertex). Returns `false`, with
 /// `out` unspecified, when x is not enclosed by the cage (too many rays escape).
@@ -158,11 +162,13 @@ fn pmvc_weights_any_cpu<const CULL: bool>(
         if det == 0.0 || (CULL && faces_away(det, &[a, b, c])) {
             continue;
         }
+        let faces = faces_reached(&[a, b, c]);
         scratch.triangles.push(TriangleSetup {
             index: index as u32,
             corners: [a, b, c],
             edge_normals,
             det,
+            faces,
         });
     }
     // Triangle t is coded as `code_mask − t` in the low bits of its hit keys; 0 is a miss.
@@ -173,19 +179,18 @@ fn pmvc_weights_any_cpu<const CULL: bool>(
 
     let mut total_weight = 0.0;
     let mut missed = 0.0;
-    for face in &CUBE_FACES {
+    for (f, frame) in FACE_FRAMES.iter().enumerate() {
         scratch.nearest.fill(0.0);
         scratch.drawn.clear();
-        let frame = FaceFrame::new(face);
         for (t, setup) in scratch.triangles.iter().enumerate() {
+            if setup.faces & (1 << f) == 0 {
+                continue;
+            }
             let local = [
                 frame.local(setup.corners[0]),
                 frame.local(setup.corners[1]),
                 frame.local(setup.corners[2]),
             ];
-            if outside_frustum(&local) {
-                continue;
-            }
             let Some((columns, rows)) = texel_bounds(&local, table) else {
                 continue;
             };
@@ -232,16 +237,16 @@ fn pmvc_weights_any_cpu<const CULL: bool>(
         }
         // Sum Ω·d̂ per winning triangle; then w·bₖ = Ω/r · Eₖ/ΣE = sE_k·(Ω·d̂)/|det|,
         // linear in Ω·d̂, so each triangle needs only its sum.
+        let sums = &mut scratch.sums[..];
         for (keys, directions) in scratch.nearest[..texels]
             .chunks_exact(BANKS)
             .zip(table.texel_directions.chunks_exact(BANKS))
         {
             for bank in 0..BANKS {
                 let code = keys[bank].to_bits() as usize & code_mask;
-                let sum = &mut scratch.sums[BANKS * code + bank];
-                for c in 0..4 {
-                    sum[c] += directions[bank][c];
-                }
+                let (s, d) = (sums[BANKS * code + bank], directions[bank]);
+                // Whole arrays, so that this is one four-wide add.
+                sums[BANKS * code + bank] = [s[0] + d[0], s[1] + d[1], s[2] + d[2], s[3] + d[3]];
             }
         }
         for &(t, edges) in &scratch.drawn {
@@ -341,12 +346,47 @@ fn index_range(low: f64, high: f64, table: &TexelTable) -> Range<usize> {
 }
 
 /// A cube face as axis swizzles: exact, and cheaper than dot products with unit axes.
+#[derive(Debug, PartialEq)]
 struct FaceFrame {
     axes: [(usize, f64); 3],
 }
 
+/// [`CUBE_FACES`] as swizzles (checked by a test), constant so that loops over the
+/// faces compile to fixed swizzles.
+const FACE_FRAMES: [FaceFrame; 6] = [
+    FaceFrame {
+        axes: [(1, 1.0), (2, 1.0), (0, 1.0)],
+    },
+    FaceFrame {
+        axes: [(2, 1.0), (1, 1.0), (0, -1.0)],
+    },
+    FaceFrame {
+        axes: [(2, 1.0), (0, 1.0), (1, 1.0)],
+    },
+    FaceFrame {
+        axes: [(0, 1.0), (2, 1.0), (1, -1.0)],
+    },
+    FaceFrame {
+        axes: [(0, 1.0), (1, 1.0), (2, 1.0)],
+    },
+    FaceFrame {
+        axes: [(1, 1.0), (0, 1.0), (2, -1.0)],
+    },
+];
+
+/// Faces whose frustum the triangle (corners relative to x) may reach, as bits.
+#[inline(always)]
+fn faces_reached(corners: &[DVec3; 3]) -> u8 {
+    let mut faces = 0;
+    for (f, frame) in FACE_FRAMES.iter().enumerate() {
+        let local = corners.map(|p| frame.local(p));
+        faces |= u8::from(!outside_frustum(&local)) << f;
+    }
+    faces
+}
+
 impl FaceFrame {
-    #[inline(always)]
+    #[cfg(test)]
     fn new(face: &super::cubemap::CubeFace) -> Self {
         let axis = |direction: DVec3| {
             let index = (0..3).find(|&k| direction[k] != 0.0).expect("a unit axis");
@@ -383,6 +423,13 @@ fn outside_frustum(local: &[DVec3; 3]) -> bool {
 mod tests {
     use super::*;
     use crate::geometry::procedural;
+
+    #[test]
+    fn face_frames_follow_the_cube_faces() {
+        for (face, frame) in CUBE_FACES.iter().zip(&FACE_FRAMES) {
+            assert_eq!(&FaceFrame::new(face), frame);
+        }
+    }
 
     /// The AVX2 build and the portable one run the same code; they must agree bit for bit.
     #[test]
