@@ -64,11 +64,19 @@ fn outside_summary(classes: &PointClasses, total: usize) -> String {
 
 /// Compute the weights with the chosen backend, showing progress on a terminal.
 pub(super) fn compute_weights(input: &BoundInput, choice: &MethodChoice) -> Result<Weights> {
+    compute_weights_on(input, choice, choose_backend(choice.backend)?)
+}
+
+/// [`compute_weights`] on a backend chosen beforehand.
+fn compute_weights_on(
+    input: &BoundInput,
+    choice: &MethodChoice,
+    backend: Backend,
+) -> Result<Weights> {
     let options = BindOptions {
         method: choice.method.into(),
         resolution: choice.resolution,
     };
-    let backend = choose_backend(choice.backend)?;
     let points = &input.mesh.mesh.positions;
     let bar = progress_bar(points.len() as u64, options.method);
     let bind_input = BindInput {
@@ -126,8 +134,15 @@ pub(super) fn progress_bar(total: u64, method: Method) -> indicatif::ProgressBar
 }
 
 pub(super) fn bind(args: &BindArgs) -> Result<()> {
+    // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
+    // on the driver: do it while the inputs load and are classified.
+    let choice = args.method.backend;
+    let probe = std::thread::spawn(move || choose_backend(choice));
     let input = load_input(&args.input, args.method.strict)?;
-    let weights = compute_weights(&input, &args.method)?;
+    let backend = probe
+        .join()
+        .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
+    let weights = compute_weights_on(&input, &args.method, backend)?;
     write_npy(&args.out, &weights)?;
     Ok(())
 }
