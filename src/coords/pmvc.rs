@@ -231,7 +231,12 @@ fn pmvc_weights_any_cpu<const CULL: bool>(
                     let key = hit_key(inverse_t, code_mask, code);
                     // A maximum and a plain store: a conditional store would become a
                     // masked store, which is slow on some CPUs.
-                    *nearest = nearest.max(if inside { key } else { 0.0 });
+                    let offered = if inside { key } else { 0.0 };
+                    *nearest = if offered > *nearest {
+                        offered
+                    } else {
+                        *nearest
+                    };
                 }
             }
         }

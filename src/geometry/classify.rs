@@ -71,7 +71,7 @@ fn classify_point(cage: &Cage, planes: &[(DVec3, f64)], x: DVec3, tolerance: f64
             };
         }
     }
-    if generalized_winding_number(cage, x) > 0.5 {
+    if is_enclosed(cage, x) {
         PointClass::Inside
     } else {
         PointClass::Outside
@@ -81,15 +81,54 @@ fn classify_point(cage: &Cage, planes: &[(DVec3, f64)], x: DVec3, tolerance: f64
 /// Σ over triangles of their signed solid angle seen from `x`, over 4π (Van Oosterom
 /// and Strackee). 1 inside an outward cage, 0 outside.
 pub fn generalized_winding_number(cage: &Cage, x: DVec3) -> f64 {
+    winding_number_with(cage, x, f64::atan2)
+}
+
+/// `generalized_winding_number(cage, x) > 0.5`, decided first with a fast arctangent
+/// (error below 2e-5 per triangle, so below 0.25 in total for fewer than 75,000
+/// triangles) and redone exactly when that estimate is not clearly 0 or 1.
+fn is_enclosed(cage: &Cage, x: DVec3) -> bool {
+    let estimate = winding_number_with(cage, x, fast_atan2);
+    if (estimate - 0.5).abs() >= 0.25 {
+        return estimate > 0.5;
+    }
+    generalized_winding_number(cage, x) > 0.5
+}
+
+#[inline(always)]
+fn winding_number_with(cage: &Cage, x: DVec3, atan2: impl Fn(f64, f64) -> f64) -> f64 {
     let mut total = 0.0;
     for corners in &cage.triangles {
         let [a, b, c] = corners.map(|i| cage.positions[i as usize] - x);
         let (la, lb, lc) = (a.length(), b.length(), c.length());
         let numerator = a.dot(b.cross(c));
         let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-        total += 2.0 * numerator.atan2(denominator);
+        total += 2.0 * atan2(numerator, denominator);
     }
     total / (4.0 * std::f64::consts::PI)
+}
+
+/// `y.atan2(x)` within 2e-5 (Abramowitz and Stegun 4.4.49 on the octant), with the
+/// same quadrants and signed zeros; 0 at the origin.
+#[inline(always)]
+fn fast_atan2(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (low, high) = (ax.min(ay), ax.max(ay));
+    if high == 0.0 {
+        return 0.0;
+    }
+    let a = low / high;
+    let s = a * a;
+    let mut angle =
+        a * (0.999_866 + s * (-0.330_299_5 + s * (0.180_141 + s * (-0.085_133 + s * 0.020_835_1))));
+    if ay > ax {
+        angle = FRAC_PI_2 - angle;
+    }
+    if x.is_sign_negative() {
+        angle = PI - angle;
+    }
+    angle.copysign(y)
 }
 
 /// Closest point to `p` on triangle `abc` and its barycentric coordinates
@@ -128,4 +167,35 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVe
     let denominator = 1.0 / (va + vb + vc);
     let (v, w) = (vb * denominator, vc * denominator);
     (a + ab * v + ac * w, DVec3::new(1.0 - v - w, v, w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_atan2_is_within_its_bound_in_every_quadrant() {
+        let mut worst = 0.0f64;
+        for i in 0..3600 {
+            let angle = (f64::from(i) + 0.5) * std::f64::consts::PI / 1800.0 - std::f64::consts::PI;
+            for radius in [1e-300, 1e-3, 1.0, 1e12] {
+                let (y, x) = (radius * angle.sin(), radius * angle.cos());
+                worst = worst.max((fast_atan2(y, x) - y.atan2(x)).abs());
+            }
+        }
+        assert!(worst < 2e-5, "{worst}");
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+        ] {
+            assert!(
+                (fast_atan2(y, x) - f64::atan2(y, x)).abs() < 1e-12,
+                "({y}, {x})"
+            );
+        }
+    }
 }
