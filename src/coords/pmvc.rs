@@ -337,16 +337,17 @@ fn texel_bounds(local: &[DVec3; 3], table: &TexelTable) -> Option<(Range<usize>,
     ))
 }
 
-/// Texels whose centres may lie in `[low, high]`, widened by one texel against rounding.
+/// Texels whose centres may lie in `[low, high]`, widened by a thousandth of a texel,
+/// far above the rounding of the projection (a whole texel more per side would add
+/// a row or column to most triangles).
 #[inline(always)]
 fn index_range(low: f64, high: f64, table: &TexelTable) -> Range<usize> {
+    const MARGIN: f64 = 1e-3;
     let resolution = table.resolution as f64;
-    // Texel i has its centre at −1 + (2i + 1)/R. The index is ≥ −0.5 after clamping,
-    // so truncating k + 1 gives floor(k) + 1 without a libm call.
-    let floor_plus_one =
-        |coordinate: f64| ((coordinate.clamp(-1.0, 1.0) + 1.0) * 0.5 * resolution + 0.5) as usize;
-    let first = floor_plus_one(low).saturating_sub(1);
-    let last = (floor_plus_one(high) + 1).min(table.resolution as usize);
+    // Texel i has its centre at −1 + (2i + 1)/R, so index k = (c + 1)·R/2 − 0.5 ≥ −0.5.
+    let index = |coordinate: f64| (coordinate.clamp(-1.0, 1.0) + 1.0) * 0.5 * resolution - 0.5;
+    let first = (index(low) - MARGIN).ceil().max(0.0) as usize;
+    let last = ((index(high) + MARGIN).floor() + 1.0).min(resolution) as usize;
     first..last.max(first)
 }
 
