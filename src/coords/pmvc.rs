@@ -194,9 +194,11 @@ fn pmvc_weights_any_cpu<const CULL: bool>(
             let Some((columns, rows)) = texel_bounds(&local, table) else {
                 continue;
             };
-            // Whole steps of TEXEL_LANES; the padding's NaN centres never pass.
-            let columns = columns.start / TEXEL_LANES * TEXEL_LANES
-                ..(columns.end.div_ceil(TEXEL_LANES) * TEXEL_LANES).min(stride);
+            // Whole steps of TEXEL_LANES, from any column; the padding's NaN centres
+            // never pass.
+            let width = columns.len().div_ceil(TEXEL_LANES) * TEXEL_LANES;
+            let first = columns.start.min(stride - width);
+            let columns = first..first + width;
             let sign = setup.det.signum();
             // s·E_k(u, v) = a·u + b·v + c per edge, with the sign of det folded in.
             let [e0, e1, e2] = setup.edge_normals;
