@@ -7,6 +7,7 @@ mod common;
 
 use common::editor::*;
 use egui::{Event, Key, Modifiers, PointerButton, Pos2};
+use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use pmvc::app::editor::FileRole;
 use pmvc::app::{BindOn, EditorApp};
@@ -522,4 +523,60 @@ fn weights_bound_on_the_editors_device_deform_the_mesh() {
         Modifiers::NONE,
     );
     assert_gpu_mesh_moved_as_on_the_cpu(harness.state(), &rest_gpu);
+}
+
+/// A device without storage buffers (what wgpu's GL backend gives by default)
+/// cannot run the viewport's shaders: the editor says so and still binds on the
+/// CPU, where wgpu would otherwise panic on the first pipeline.
+#[test]
+fn an_adapter_too_weak_for_the_viewport_gets_a_notice_not_a_panic() {
+    let Some(state) = render_state_limited_to(wgpu::Limits::downlevel_webgl2_defaults()) else {
+        return;
+    };
+    let Some(mut harness) = editor_on(state, Default::default()) else {
+        return;
+    };
+    let error = harness.state().last_error().expect("a notice").to_owned();
+    assert!(
+        error.contains("cannot draw the viewport")
+            && error.contains("storage buffers")
+            && error.contains("mesa-vulkan-drivers"),
+        "{error}"
+    );
+    run_until_bound(&mut harness);
+    let app = harness.state();
+    assert_eq!(app.scene.bound(Method::Pmvc).expect("bound").device, "CPU");
+    assert!(app.read_back_deformed().is_none(), "no GPU mesh to read");
+    // The window still draws its panels.
+    harness.get_by_label("Side by side");
+}
+
+/// Notices name files by their full path; a long one wraps inside the side panel
+/// instead of widening it (and squeezing the viewport).
+#[test]
+fn a_long_path_in_a_notice_does_not_widen_the_side_panel() {
+    let pose = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/poses/middle-finger-sideways.obj");
+    let directory = tempfile::tempdir().unwrap();
+    let side_panel_left = |folder: &str| {
+        let copy = directory.path().join(folder).join("pose.obj");
+        std::fs::create_dir_all(copy.parent().unwrap()).unwrap();
+        std::fs::copy(&pose, &copy).unwrap();
+        let mut harness = editor_with(pmvc::app::EditorOptions {
+            pose: Some(copy),
+            ..Default::default()
+        })?;
+        harness.run_steps(3);
+        assert!(harness.state().last_error().is_none());
+        Some(harness.get_by_label("Reset pose").rect().left())
+    };
+    let Some(short) = side_panel_left("a") else {
+        return;
+    };
+    // The notice reads "loaded pose <path>": lengths around the panel's width, and
+    // far beyond it.
+    for length in (2..60).step_by(3).chain([200]) {
+        let long = side_panel_left(&"b".repeat(length));
+        assert_eq!(long, Some(short), "a folder name of {length} characters");
+    }
 }

@@ -150,7 +150,17 @@ struct ScreenshotState {
 impl EditorApp {
     /// Create the app from eframe's creation context and start binding.
     pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> Self {
-        let gpu = cc.wgpu_render_state.as_ref().map(|state| {
+        // An adapter that cannot run the viewport's shaders draws nothing, and the
+        // notice says why, rather than wgpu panicking on the first pipeline.
+        let unsupported = cc
+            .wgpu_render_state
+            .as_ref()
+            .and_then(|state| crate::render::check_adapter(&state.adapter, &state.device).err());
+        let usable_state = cc
+            .wgpu_render_state
+            .as_ref()
+            .filter(|_| unsupported.is_none());
+        let gpu = usable_state.map(|state| {
             let software = state.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
             // PMVC_EDITOR_MSAA=1 or 4 overrides the default (for screenshots).
             let samples = match std::env::var("PMVC_EDITOR_MSAA").as_deref() {
@@ -202,7 +212,7 @@ impl EditorApp {
             last_bind_progress: None,
             retry_bind: false,
             numeric_drag_start: None,
-            bind_backend: cc.wgpu_render_state.as_ref().map_or(Backend::Cpu, |state| {
+            bind_backend: usable_state.map_or(Backend::Cpu, |state| {
                 bind_backend_for(state, options.bind_on)
             }),
             screenshot: options.screenshot.map(|path| ScreenshotState {
@@ -212,7 +222,9 @@ impl EditorApp {
                 saved: Arc::new(std::sync::atomic::AtomicBool::new(false)),
             }),
         };
-        if app.gpu.is_none() {
+        if let Some(error) = unsupported {
+            app.error(error.to_string());
+        } else if app.gpu.is_none() {
             app.error("no wgpu device: the viewport cannot draw (run with the wgpu renderer)");
         }
         let mut opened = false;
@@ -1663,7 +1675,9 @@ impl EditorApp {
         ui.separator();
         let mut dismiss = None;
         for (index, notice) in self.notices.iter().enumerate().rev().take(6) {
-            ui.horizontal_wrapped(|ui| {
+            // Not horizontal_wrapped: there a text just wider than the space left
+            // beside the button widens the whole panel. Here it wraps in that space.
+            ui.horizontal_top(|ui| {
                 let colour = if notice.is_error {
                     Color32::LIGHT_RED
                 } else {
@@ -1672,7 +1686,10 @@ impl EditorApp {
                 if ui.small_button("x").clicked() {
                     dismiss = Some(index);
                 }
-                ui.colored_label(colour, &notice.text);
+                ui.add(
+                    egui::Label::new(egui::RichText::new(&notice.text).color(colour))
+                        .wrap_mode(egui::TextWrapMode::Wrap),
+                );
             });
         }
         if let Some(index) = dismiss {

@@ -59,7 +59,7 @@ pub enum BindOn {
 pub struct EditorError(String);
 
 pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
-    let native_options = eframe::NativeOptions {
+    let mut native_options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("pmvc editor")
             .with_inner_size([1280.0, 800.0])
@@ -67,6 +67,18 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
         renderer: eframe::Renderer::Wgpu,
         ..Default::default()
     };
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(setup) =
+        &mut native_options.wgpu_options.wgpu_setup
+    {
+        // The adapter's own limits, not wgpu's portable defaults: weight matrices
+        // beyond 128 MiB on GPUs that allow them, and storage buffers in the vertex
+        // stage on GL drivers that have them (the viewport needs both kinds).
+        setup.device_descriptor = std::sync::Arc::new(|adapter| wgpu::DeviceDescriptor {
+            label: Some("pmvc editor"),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        });
+    }
     eframe::run_native(
         "pmvc editor",
         native_options,

@@ -14,6 +14,6 @@ pub mod viewport;
 
 pub use camera::{OrbitCamera, ScreenProjection};
 pub use viewport::{
-    Colouring, FrameParams, ReadBack, RenderError, SceneUpload, Shading, ViewportCallback,
-    ViewportRenderer, MAX_VIEWS,
+    check_adapter, Colouring, FrameParams, ReadBack, RenderError, SceneUpload, Shading,
+    ViewportCallback, ViewportRenderer, MAX_VIEWS,
 };

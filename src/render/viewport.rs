@@ -45,6 +45,38 @@ pub enum RenderError {
     ReadBack,
     #[error("no scene is on the GPU")]
     NoScene,
+    #[error(
+        "the graphics adapter '{adapter}' cannot draw the viewport: {missing}; install a Vulkan, Metal or DirectX 12 driver (on Linux without a GPU: Mesa's lavapipe, package mesa-vulkan-drivers)"
+    )]
+    UnsupportedAdapter { adapter: String, missing: String },
+}
+
+/// Storage buffers one shader stage needs: the scene group's five (read by every
+/// stage) and the two outputs of the readback's compute pass.
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 7;
+
+/// Whether the viewport's shaders can run on `adapter` with `device`: they read
+/// storage buffers in the vertex stage and deform in a compute pass, which
+/// WebGL-class adapters (wgpu's GL backend, for one) do not offer.
+pub fn check_adapter(adapter: &wgpu::Adapter, device: &wgpu::Device) -> Result<(), RenderError> {
+    let flags = adapter.get_downlevel_capabilities().flags;
+    let storage_buffers = device.limits().max_storage_buffers_per_shader_stage;
+    let missing = if !flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
+        "no compute shaders".to_owned()
+    } else if !flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE) {
+        "no storage buffers in vertex shaders".to_owned()
+    } else if storage_buffers < STORAGE_BUFFERS_PER_STAGE {
+        format!(
+            "{storage_buffers} storage buffers per shader stage, and it needs {STORAGE_BUFFERS_PER_STAGE}"
+        )
+    } else {
+        return Ok(());
+    };
+    let info = adapter.get_info();
+    Err(RenderError::UnsupportedAdapter {
+        adapter: format!("{} ({:?})", info.name, info.backend),
+        missing,
+    })
 }
 
 /// What the mesh is coloured by.

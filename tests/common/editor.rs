@@ -12,7 +12,25 @@ use std::time::{Duration, Instant};
 pub const TEST_RESOLUTION: u32 = 8;
 
 pub fn render_state() -> Option<eframe::egui_wgpu::RenderState> {
-    let setup = egui_kittest::wgpu::default_wgpu_setup();
+    render_state_with(egui_kittest::wgpu::default_wgpu_setup())
+}
+
+/// A render state whose device has only `limits` (a weaker adapter than the one
+/// the tests run on).
+pub fn render_state_limited_to(limits: wgpu::Limits) -> Option<eframe::egui_wgpu::RenderState> {
+    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(create) = &mut setup {
+        create.device_descriptor = std::sync::Arc::new(move |_| wgpu::DeviceDescriptor {
+            required_limits: limits.clone(),
+            ..Default::default()
+        });
+    }
+    render_state_with(setup)
+}
+
+fn render_state_with(
+    setup: eframe::egui_wgpu::WgpuSetup,
+) -> Option<eframe::egui_wgpu::RenderState> {
     let created = pollster::block_on(async {
         let instance = setup.new_instance().await;
         eframe::egui_wgpu::RenderState::create(
@@ -52,7 +70,14 @@ pub fn editor_binding_on(bind_on: BindOn) -> Option<Harness<'static, EditorApp>>
 /// The editor on the default scene with `options` (at [`TEST_RESOLUTION`] unless
 /// they name one).
 pub fn editor_with(options: EditorOptions) -> Option<Harness<'static, EditorApp>> {
-    let state = render_state()?;
+    editor_on(render_state()?, options)
+}
+
+/// The editor with `options` on the device of `state`.
+pub fn editor_on(
+    state: eframe::egui_wgpu::RenderState,
+    options: EditorOptions,
+) -> Option<Harness<'static, EditorApp>> {
     let harness = Harness::builder()
         .with_size(egui::vec2(1100.0, 700.0))
         .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
