@@ -44,11 +44,11 @@ pub fn mvc_weights(x: DVec3, cage: &Cage, out: &mut [f64], scratch: &mut MvcScra
         let index = corners.map(|i| i as usize);
         let d = index.map(|i| scratch.distances[i]);
         let u = index.map(|i| scratch.directions[i]);
-        // θ_k: the arc opposite corner k on the unit sphere, via the chord length.
-        let theta: [f64; 3] = std::array::from_fn(|k| {
-            let chord = (u[(k + 1) % 3] - u[(k + 2) % 3]).length();
-            2.0 * (0.5 * chord).min(1.0).asin()
-        });
+        // θ_k: the arc opposite corner k on the unit sphere, via the half chord
+        // sin(θ_k/2), which also gives sin θ_k and cos θ_k without more trigonometry.
+        let half_chord: [f64; 3] =
+            std::array::from_fn(|k| (0.5 * (u[(k + 1) % 3] - u[(k + 2) % 3]).length()).min(1.0));
+        let theta = half_chord.map(|a| 2.0 * a.asin());
         let h = 0.5 * (theta[0] + theta[1] + theta[2]);
         if PI - h <= FLAT {
             // x lies inside this triangle: interpolate linearly on it.
@@ -60,9 +60,13 @@ pub fn mvc_weights(x: DVec3, cage: &Cage, out: &mut [f64], scratch: &mut MvcScra
             }
             return;
         }
-        let sin_theta = theta.map(f64::sin);
+        let sin_theta = half_chord.map(|a| 2.0 * a * (1.0 - a * a).max(0.0).sqrt());
+        let cos_theta = half_chord.map(|a| 1.0 - 2.0 * a * a);
+        let (sin_h, cos_h) = h.sin_cos();
         let c: [f64; 3] = std::array::from_fn(|k| {
-            2.0 * h.sin() * (h - theta[k]).sin() / (sin_theta[(k + 1) % 3] * sin_theta[(k + 2) % 3])
+            // sin(h − θ_k), expanded.
+            let sin_h_minus_theta = sin_h * cos_theta[k] - cos_h * sin_theta[k];
+            2.0 * sin_h * sin_h_minus_theta / (sin_theta[(k + 1) % 3] * sin_theta[(k + 2) % 3])
                 - 1.0
         });
         let orientation = u[0].dot(u[1].cross(u[2])).signum();
