@@ -70,14 +70,14 @@ pub fn editor_binding_on(bind_on: BindOn) -> Option<Harness<'static, EditorApp>>
 /// The editor on the default scene with `options` (at [`TEST_RESOLUTION`] unless
 /// they name one).
 pub fn editor_with(options: EditorOptions) -> Option<Harness<'static, EditorApp>> {
-    editor_on(render_state()?, options)
+    Some(editor_on(render_state()?, options))
 }
 
 /// The editor with `options` on the device of `state`.
 pub fn editor_on(
     state: eframe::egui_wgpu::RenderState,
     options: EditorOptions,
-) -> Option<Harness<'static, EditorApp>> {
+) -> Harness<'static, EditorApp> {
     let harness = Harness::builder()
         .with_size(egui::vec2(1100.0, 700.0))
         .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
@@ -92,7 +92,7 @@ pub fn editor_on(
                 },
             )
         });
-    Some(harness)
+    harness
 }
 
 /// Step the app until the bind finishes, checking that progress is reported.
