@@ -89,7 +89,7 @@ pub struct TexelTable {
     pub solid_angle_over_length: Vec<f64>,
     /// Row length of the padded layout below: `R` rounded up to [`TEXEL_LANES`].
     pub stride: usize,
-    /// `centres` padded to `stride` with NaN, which no edge test passes.
+    /// `centres` padded to `stride` with NaN, whose depth keys never win a texel.
     pub padded_centres: Vec<f64>,
     /// `Ω·d̂` in face coordinates, then 1, for texel `(i, j)` at `j·stride + i`; zero
     /// in the padding. A hit's weight times its barycentrics is linear in `Ω·d̂`, so
