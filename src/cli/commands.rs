@@ -111,8 +111,8 @@ pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
             let context = GpuContext::new().context("--backend gpu")?;
             Ok(Backend::Gpu(Arc::new(context)))
         }
-        BackendArg::Auto => match GpuContext::new() {
-            Ok(context) if !context.is_software() => Ok(Backend::Gpu(Arc::new(context))),
+        BackendArg::Auto => match GpuContext::new_hardware() {
+            Ok(Some(context)) => Ok(Backend::Gpu(Arc::new(context))),
             _ => Ok(Backend::Cpu),
         },
     }

@@ -59,7 +59,8 @@ impl From<MethodArg> for crate::coords::Method {
 /// Where binding runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {
-    /// The faster path for this machine.
+    /// The faster path for this machine: a hardware GPU when there is one, else the
+    /// CPU (without loading the GPU drivers where the system has no GPU device).
     Auto,
     /// Rayon-parallel CPU reference.
     Cpu,

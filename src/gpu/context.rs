@@ -33,7 +33,27 @@ impl GpuContext {
     pub fn new() -> Result<Self, GpuError> {
         let instance = make_instance();
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        Self::open(choose_adapter(adapters)?)
+    }
+
+    /// [`GpuContext::new`], or `None` when the adapter it would choose is a software
+    /// one, found without opening a device on it. Where the system has no GPU device
+    /// at all ([`may_have_hardware_adapter`]) it answers `None` without listing the
+    /// adapters, which loads every installed driver (60–90 ms with Mesa's).
+    pub fn new_hardware() -> Result<Option<Self>, GpuError> {
+        if !may_have_hardware_adapter(std::path::Path::new("/dev")) {
+            return Ok(None);
+        }
+        let instance = make_instance();
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         let adapter = choose_adapter(adapters)?;
+        if adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+            return Ok(None);
+        }
+        Self::open(adapter).map(Some)
+    }
+
+    fn open(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
         let info = adapter.get_info();
         let wanted = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -102,6 +122,25 @@ impl GpuContext {
             .as_ref()
             .map_err(Clone::clone)
     }
+}
+
+/// False only where no hardware adapter can be opened: on Linux, when `dev` has no GPU
+/// device node (`dri/renderD*` or `dri/card*` for Mesa and AMD/Intel drivers,
+/// `nvidia*` for NVIDIA's, `dxg` for WSL). Elsewhere always true.
+fn may_have_hardware_adapter(dev: &std::path::Path) -> bool {
+    if !cfg!(target_os = "linux") {
+        return true;
+    }
+    let has_entry = |dir: &std::path::Path, prefixes: &[&str]| {
+        std::fs::read_dir(dir).is_ok_and(|entries| {
+            entries.flatten().any(|entry| {
+                let name = entry.file_name();
+                let name = name.to_string_lossy();
+                prefixes.iter().any(|prefix| name.starts_with(prefix))
+            })
+        })
+    };
+    has_entry(&dev.join("dri"), &["renderD", "card"]) || has_entry(dev, &["nvidia", "dxg"])
 }
 
 fn record(slot: &Mutex<Option<GpuError>>, error: GpuError) {
@@ -240,4 +279,28 @@ pub fn adapters_report() -> String {
         }
     }
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::may_have_hardware_adapter;
+
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn a_gpu_device_node_is_what_makes_a_hardware_adapter_possible() {
+        let dev = tempfile::tempdir().expect("a temporary folder");
+        let touch = |name: &str| std::fs::write(dev.path().join(name), b"").expect("a file");
+        touch("null");
+        touch("tty0");
+        std::fs::create_dir(dev.path().join("dri")).expect("a folder");
+        assert!(!may_have_hardware_adapter(dev.path()), "no GPU node yet");
+        touch("dri/by-path");
+        assert!(!may_have_hardware_adapter(dev.path()), "no GPU node yet");
+        for node in ["dri/renderD128", "dri/card0", "nvidia0", "nvidiactl", "dxg"] {
+            touch(node);
+            assert!(may_have_hardware_adapter(dev.path()), "{node}");
+            std::fs::remove_file(dev.path().join(node)).expect("removed");
+            assert!(!may_have_hardware_adapter(dev.path()), "{node} removed");
+        }
+    }
 }
