@@ -40,9 +40,9 @@ pub struct PmvcScratch {
     by_face: Vec<u32>,
     /// Triangles rasterised on the current face, with their signed edge functions.
     drawn: Vec<(u32, [DVec3; 3])>,
-    /// Two banks per hit code (code 0: the misses): the sums of
+    /// [`BANKS`] accumulators per hit code (code 0: the misses): the sums of
     /// [`TexelTable::texel_directions`] over the texels each code won.
-    sums: Vec<[f64; 4]>,
+    sums: Vec<[[f64; 4]; BANKS]>,
 }
 
 /// What every triangle at a cage vertex needs, computed once per vertex.
@@ -378,7 +378,7 @@ fn pmvc_weights_with<const CULL: bool>(
     let code_mask = (scratch.triangles.len() + 1).next_power_of_two() - 1;
     scratch.nearest.resize(texels, 0.0);
     scratch.sums.clear();
-    scratch.sums.resize(BANKS * (code_mask + 1), [0.0; 4]);
+    scratch.sums.resize(code_mask + 1, [[0.0; 4]; BANKS]);
 
     let mut total_weight = 0.0;
     let mut missed = 0.0;
@@ -432,23 +432,24 @@ fn pmvc_weights_with<const CULL: bool>(
         }
         // Sum Ω·d̂ per winning triangle; then w·bₖ = Ω/r · Eₖ/ΣE = sE_k·(Ω·d̂)/|det|,
         // linear in Ω·d̂, so each triangle needs only its sum.
-        let sums = &mut scratch.sums[..];
+        // As long as the mask, so that indexing by a masked code needs no check.
+        let sums = &mut scratch.sums[..=code_mask];
         for (keys, directions) in scratch.nearest[..texels]
             .chunks_exact(BANKS)
             .zip(table.texel_directions.chunks_exact(BANKS))
         {
             for bank in 0..BANKS {
                 let code = keys[bank].to_bits() as usize & code_mask;
-                let (s, d) = (sums[BANKS * code + bank], directions[bank]);
+                let (s, d) = (sums[code][bank], directions[bank]);
                 // Whole arrays, so that this is one four-wide add.
-                sums[BANKS * code + bank] = [s[0] + d[0], s[1] + d[1], s[2] + d[2], s[3] + d[3]];
+                sums[code][bank] = [s[0] + d[0], s[1] + d[1], s[2] + d[2], s[3] + d[3]];
             }
         }
         for &(t, edges) in &scratch.drawn {
             let t = t as usize;
             let code = code_mask - t;
             let mut sum = DVec3::ZERO;
-            for bank in &mut scratch.sums[BANKS * code..BANKS * (code + 1)] {
+            for bank in &mut scratch.sums[code] {
                 sum += DVec3::new(bank[0], bank[1], bank[2]);
                 *bank = [0.0; 4];
             }
@@ -462,7 +463,7 @@ fn pmvc_weights_with<const CULL: bool>(
                 total_weight += weight;
             }
         }
-        for bank in &mut scratch.sums[..BANKS] {
+        for bank in &mut scratch.sums[0] {
             missed += bank[3];
             *bank = [0.0; 4];
         }
