@@ -79,8 +79,6 @@ impl VertexSetup {
 
 #[derive(Clone, Copy, Debug, Default)]
 struct TriangleSetup {
-    /// Index into the cage's triangles.
-    index: u32,
     /// Its cage vertices.
     vertices: [u32; 3],
     /// Corners relative to x.
@@ -346,7 +344,7 @@ fn pmvc_weights_with<const CULL: bool>(
     let triangle_count = cage.triangles.len();
     scratch.by_face.resize(6 * triangle_count, 0);
     let mut face_counts = [0; 6];
-    for (index, vertices) in cage.triangles.iter().enumerate() {
+    for vertices in &cage.triangles {
         let [a, b, c] = vertices.map(|k| &scratch.vertices[k as usize]);
         let edge_normals = [
             b.relative.cross(c.relative),
@@ -367,7 +365,6 @@ fn pmvc_weights_with<const CULL: bool>(
             *count += usize::from((faces >> f) & 1);
         }
         scratch.triangles.push(TriangleSetup {
-            index: index as u32,
             vertices: *vertices,
             corners,
             edge_normals,
@@ -455,7 +452,7 @@ fn pmvc_weights_with<const CULL: bool>(
             }
             let setup = &scratch.triangles[t];
             let inverse_det = 1.0 / setup.det.abs();
-            let corners = cage.triangles[setup.index as usize];
+            let corners = setup.vertices;
             for k in 0..3 {
                 // Non-negative per texel; clamp away the rounding of the sum.
                 let weight = (edges[k].dot(sum) * inverse_det).max(0.0);
