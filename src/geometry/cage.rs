@@ -20,6 +20,25 @@ impl Cage {
         self.positions.len()
     }
 
+    /// Vertex positions, in the file's `v` order (weights columns follow it).
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Outward-facing triangles, in the order the file's faces were triangulated.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// For each triangle, the face of the file it came from (0-based).
+    pub fn triangle_faces(&self) -> &[u32] {
+        &self.triangle_faces
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
     /// Corner positions of triangle `t`.
     #[inline]
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
