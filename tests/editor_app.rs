@@ -8,7 +8,7 @@ mod common;
 use common::editor::*;
 use egui::{Event, Key, Modifiers, PointerButton, Pos2};
 use egui_kittest::kittest::Queryable;
-use egui_kittest::{Harness, SnapshotOptions};
+use egui_kittest::Harness;
 use pmvc::app::editor::FileRole;
 use pmvc::app::{BindOn, EditorApp};
 use pmvc::coords::Method;
@@ -22,7 +22,7 @@ fn assert_gpu_mesh_moved_as_on_the_cpu(app: &EditorApp, rest_gpu: &[glam::Vec3])
         "the GPU mesh moved"
     );
     let cpu: Vec<glam::Vec3> = app
-        .scene
+        .document()
         .deformed_positions(app.active_method())
         .iter()
         .map(|p| p.as_vec3())
@@ -68,36 +68,31 @@ fn default_scene_binds_with_progress_to_completion() {
     run_until_bound(&mut harness);
     let app = harness.state();
     assert_eq!(
-        app.last_bind_progress,
+        app.last_bind_progress(),
         Some((total, total)),
         "progress reached 100%"
     );
     let weights = app
-        .scene
+        .document()
         .weights(Method::Pmvc)
         .expect("weights exist after the bind");
     assert_eq!(weights.rows, total);
     // Both methods are bound, each once.
-    assert_eq!(app.scene.weights(Method::Mvc).unwrap().rows, total);
-    assert_eq!(app.bind_count, 2);
-    assert!(app.scene.outside.is_empty());
+    assert_eq!(app.document().weights(Method::Mvc).unwrap().rows, total);
+    assert_eq!(app.bind_count(), 2);
+    assert!(app.document().outside().is_empty());
     // At rest the GPU deformation reproduces the mesh (linear precision).
     let deformed = app.read_back_deformed().unwrap().unwrap();
     let rest: Vec<glam::Vec3> = app
-        .scene
-        .mesh
+        .document()
+        .mesh()
         .positions
         .iter()
         .map(|p| p.as_vec3())
         .collect();
     assert!(max_distance(&deformed, &rest) < 1e-3);
     assert_viewport_shows_the_mesh(&mut harness);
-    harness.snapshot_options(
-        "editor_default_scene",
-        &SnapshotOptions::new()
-            .threshold(2.0)
-            .max_failed_pixels(4000),
-    );
+    harness.snapshot_options("editor_default_scene", &snapshot_options());
 }
 
 #[test]
@@ -112,7 +107,8 @@ fn click_selects_drag_moves_and_undo_restores() {
     assert_eq!(
         harness
             .state()
-            .selection
+            .document()
+            .selection()
             .iter()
             .copied()
             .collect::<Vec<_>>(),
@@ -120,7 +116,7 @@ fn click_selects_drag_moves_and_undo_restores() {
     );
 
     // Drag moves the handle and the mesh on the GPU with it.
-    let before = harness.state().scene.pose[handle];
+    let before = harness.state().document().pose()[handle];
     drag(
         &mut harness,
         at,
@@ -128,42 +124,37 @@ fn click_selects_drag_moves_and_undo_restores() {
         Modifiers::NONE,
     );
     let app = harness.state();
-    let after = app.scene.pose[handle];
+    let after = app.document().pose()[handle];
     assert!(after.distance(before) > 1e-3, "the handle moved");
     let others_still = app
-        .scene
-        .pose
+        .document()
+        .pose()
         .iter()
-        .zip(&app.scene.cage.positions)
+        .zip(app.document().cage().positions())
         .enumerate()
         .all(|(i, (p, r))| i == handle || p == r);
     assert!(others_still, "only the selected handle moved");
     assert_gpu_mesh_moved_as_on_the_cpu(app, &rest_gpu);
     assert_viewport_shows_the_mesh(&mut harness);
-    harness.snapshot_options(
-        "editor_after_drag",
-        &SnapshotOptions::new()
-            .threshold(2.0)
-            .max_failed_pixels(4000),
-    );
+    harness.snapshot_options("editor_after_drag", &snapshot_options());
 
     // Undo restores the rest pose, on the CPU and on the GPU.
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     harness.run_steps(2);
     let app = harness.state();
-    assert_eq!(app.scene.pose, app.scene.cage.positions);
+    assert_eq!(app.document().pose(), app.document().cage().positions());
     let undone_gpu = app.read_back_deformed().unwrap().unwrap();
     assert!(max_distance(&undone_gpu, &rest_gpu) < 1e-6);
 
     // Redo brings the drag back.
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     harness.run_steps(2);
-    assert_eq!(harness.state().scene.pose[handle], after);
+    assert_eq!(harness.state().document().pose()[handle], after);
 
     // Escape clears the selection.
     harness.key_press(Key::Escape);
     harness.run_steps(2);
-    assert!(harness.state().selection.is_empty());
+    assert!(harness.state().document().selection().is_empty());
 }
 
 #[test]
@@ -177,10 +168,10 @@ fn box_select_with_ctrl_selects_handles_inside_the_band() {
         at + egui::vec2(8.0, 8.0),
         Modifiers::COMMAND,
     );
-    assert!(harness.state().selection.contains(&handle));
+    assert!(harness.state().document().selection().contains(&handle));
     assert_eq!(
-        harness.state().scene.pose,
-        harness.state().scene.cage.positions
+        harness.state().document().pose(),
+        harness.state().document().cage().positions()
     );
 }
 
@@ -196,22 +187,17 @@ fn malformed_files_show_an_error_and_keep_the_scene() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n",
     )
     .unwrap();
-    let title = harness.state().scene.title.clone();
-    let vertices = harness.state().scene.mesh.positions.len();
-    let ctx = harness.ctx.clone();
+    let title = harness.state().document().title().to_owned();
+    let vertices = harness.state().document().mesh().positions.len();
 
-    assert!(!harness
-        .state_mut()
-        .open_file(&ctx, FileRole::Mesh, &bad_mesh));
+    assert!(!harness.state_mut().open_file(FileRole::Mesh, &bad_mesh));
     let error = harness.state().last_error().unwrap().to_owned();
     assert!(
         error.contains("broken.obj") && error.contains("face"),
         "{error}"
     );
 
-    assert!(!harness
-        .state_mut()
-        .open_file(&ctx, FileRole::Cage, &open_cage));
+    assert!(!harness.state_mut().open_file(FileRole::Cage, &open_cage));
     let error = harness.state().last_error().unwrap().to_owned();
     assert!(
         error.contains("open_cage.obj") && error.contains("edge"),
@@ -219,11 +205,11 @@ fn malformed_files_show_an_error_and_keep_the_scene() {
     );
 
     harness.run_steps(2);
-    assert_eq!(harness.state().scene.title, title);
-    assert_eq!(harness.state().scene.mesh.positions.len(), vertices);
+    assert_eq!(harness.state().document().title(), title);
+    assert_eq!(harness.state().document().mesh().positions.len(), vertices);
     run_until_bound(&mut harness);
     assert!(
-        harness.state().scene.weights(Method::Pmvc).is_some(),
+        harness.state().document().weights(Method::Pmvc).is_some(),
         "the scene still binds"
     );
 }
@@ -234,18 +220,20 @@ fn cancelling_a_bind_keeps_the_previous_state_usable() {
     // Cancel the very first bind: the mesh stays at rest and editable.
     harness.state_mut().cancel_bind();
     run_until_bound(&mut harness);
-    assert!(harness.state().scene.weights(Method::Pmvc).is_none());
-    assert!(harness.state().scene.weights(Method::Mvc).is_none());
+    assert!(harness.state().document().weights(Method::Pmvc).is_none());
+    assert!(harness.state().document().weights(Method::Mvc).is_none());
     let rest = harness.state().read_back_deformed().unwrap().unwrap();
-    assert_eq!(rest.len(), harness.state().scene.mesh.positions.len());
+    assert_eq!(
+        rest.len(),
+        harness.state().document().mesh().positions.len()
+    );
 
     // Bind, then cancel a rebind at another resolution: the old weights stay.
-    let ctx = harness.ctx.clone();
-    harness.state_mut().start_bind(&ctx);
+    harness.state_mut().start_bind();
     run_until_bound(&mut harness);
     let weights = harness
         .state()
-        .scene
+        .document()
         .weights(Method::Pmvc)
         .cloned()
         .expect("bound");
@@ -256,7 +244,7 @@ fn cancelling_a_bind_keeps_the_previous_state_usable() {
     run_until_bound(&mut harness);
     let app = harness.state();
     assert!(std::sync::Arc::ptr_eq(
-        app.scene.weights(Method::Pmvc).unwrap(),
+        app.document().weights(Method::Pmvc).unwrap(),
         &weights
     ));
     assert!(app.read_back_deformed().unwrap().is_ok());
@@ -270,7 +258,7 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
     let pose_path = directory.path().join("pose.obj");
     let export_path = directory.path().join("deformed.obj");
     let app = harness.state_mut();
-    let rest = app.scene.cage.positions.clone();
+    let rest = app.document().cage().positions().to_vec();
     let moved = rest[5] + glam::DVec3::new(0.5, 0.25, 0.0);
     app.set_handle_position(5, moved);
     app.save_pose(&pose_path);
@@ -281,7 +269,7 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
         .unwrap()
         .mesh
         .positions;
-    let expected = app.scene.deformed_positions(app.active_method());
+    let expected = app.document().deformed_positions(app.active_method());
     assert_eq!(exported.len(), expected.len());
     let worst = exported
         .iter()
@@ -291,18 +279,18 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
     assert!(worst < 1e-5, "export matches the deformation ({worst})");
 
     app.reset_pose();
-    assert_eq!(app.scene.pose, rest);
+    assert_eq!(app.document().pose(), rest);
     assert!(app.load_pose(&pose_path));
-    assert!(app.scene.pose[5].distance(moved) < 1e-5);
+    assert!(app.document().pose()[5].distance(moved) < 1e-5);
     app.undo();
-    assert_eq!(app.scene.pose, rest);
+    assert_eq!(app.document().pose(), rest);
 
     // A pose with the wrong vertex count is refused and changes nothing.
     let wrong = directory.path().join("wrong.obj");
     std::fs::write(&wrong, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     assert!(!app.load_pose(&wrong));
     assert!(app.last_error().unwrap().contains("wrong.obj"));
-    assert_eq!(app.scene.pose, rest);
+    assert_eq!(app.document().pose(), rest);
 }
 
 fn button_drag(
@@ -338,7 +326,7 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
     let Some(mut harness) = editor() else { return };
     harness.run_steps(2);
     let empty = Pos2::new(40.0, 80.0);
-    let framed = harness.state().camera;
+    let framed = harness.state().camera();
 
     button_drag(
         &mut harness,
@@ -346,7 +334,7 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
         empty,
         empty + egui::vec2(80.0, 20.0),
     );
-    let orbited = harness.state().camera;
+    let orbited = harness.state().camera();
     assert_ne!(orbited.yaw, framed.yaw, "left-drag on empty space orbits");
     button_drag(
         &mut harness,
@@ -355,11 +343,11 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
         empty + egui::vec2(0.0, 40.0),
     );
     assert_ne!(
-        harness.state().camera.pitch,
+        harness.state().camera().pitch,
         orbited.pitch,
         "middle-drag orbits"
     );
-    let orbited = harness.state().camera;
+    let orbited = harness.state().camera();
 
     button_drag(
         &mut harness,
@@ -368,7 +356,7 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
         empty + egui::vec2(50.0, 0.0),
     );
     assert_ne!(
-        harness.state().camera.target,
+        harness.state().camera().target,
         orbited.target,
         "right-drag pans"
     );
@@ -383,21 +371,22 @@ fn orbit_pan_zoom_and_frame_move_the_camera_not_the_cage() {
     });
     harness.run_steps(20);
     assert!(
-        harness.state().camera.distance < framed.distance,
+        harness.state().camera().distance < framed.distance,
         "wheel up zooms in"
     );
 
     harness.key_press(Key::F);
     harness.run_steps(2);
-    let refocused = harness.state().camera;
+    let refocused = harness.state().camera();
     assert_eq!(refocused.target, framed.target);
     assert_eq!(refocused.distance, framed.distance);
     let app = harness.state();
     assert_eq!(
-        app.scene.pose, app.scene.cage.positions,
+        app.document().pose(),
+        app.document().cage().positions(),
         "the cage never moved"
     );
-    assert!(app.selection.is_empty());
+    assert!(app.document().selection().is_empty());
 }
 
 #[test]
@@ -405,7 +394,7 @@ fn holding_x_constrains_a_drag_to_the_x_axis() {
     let Some(mut harness) = editor() else { return };
     harness.run_steps(2);
     let (handle, at) = isolated_handle(&harness);
-    let before = harness.state().scene.pose[handle];
+    let before = harness.state().document().pose()[handle];
     harness.key_down(Key::X);
     harness.step();
     drag(
@@ -416,7 +405,7 @@ fn holding_x_constrains_a_drag_to_the_x_axis() {
     );
     harness.key_up(Key::X);
     harness.step();
-    let delta = harness.state().scene.pose[handle] - before;
+    let delta = harness.state().document().pose()[handle] - before;
     assert!(delta.x.abs() > 1e-3, "moved along x: {delta}");
     assert!(
         delta.y.abs() < 1e-9 && delta.z.abs() < 1e-9,
@@ -454,9 +443,9 @@ fn dropped_mesh_rebinds_and_reports_outside_vertices() {
     assert!(harness.state().is_binding(), "a dropped mesh rebinds");
     run_until_bound(&mut harness);
     let app = harness.state();
-    assert_eq!(app.scene.mesh.positions.len(), 3);
-    assert_eq!(app.scene.outside, vec![2]);
-    assert_eq!(app.scene.weights(Method::Pmvc).unwrap().rows, 3);
+    assert_eq!(app.document().mesh().positions.len(), 3);
+    assert_eq!(app.document().outside(), vec![2]);
+    assert_eq!(app.document().weights(Method::Pmvc).unwrap().rows, 3);
 }
 
 #[test]
@@ -483,18 +472,19 @@ fn shift_click_toggles_and_the_scenes_menu_switches_scenes() {
         });
         harness.event(Event::ModifiersChanged(Modifiers::NONE));
         harness.run_steps(2);
-        assert_eq!(harness.state().selection.contains(&handle), expected);
+        assert_eq!(
+            harness.state().document().selection().contains(&handle),
+            expected
+        );
     }
-
-    let ctx = harness.ctx.clone();
     harness
         .state_mut()
-        .open_bundled(&ctx, pmvc::app::scenes::BundledScene::Scan);
+        .open_bundled(pmvc::app::scenes::BundledScene::Scan);
     run_until_bound(&mut harness);
     let app = harness.state();
-    assert_eq!(app.scene.mesh.positions.len(), 2775);
-    assert!(app.scene.weights(Method::Pmvc).is_some());
-    assert!(app.scene.outside.is_empty());
+    assert_eq!(app.document().mesh().positions.len(), 2775);
+    assert!(app.document().weights(Method::Pmvc).is_some());
+    assert!(app.document().outside().is_empty());
 }
 
 /// Bound on the editor's own device, the vertex shader reads the weights where the
@@ -507,7 +497,7 @@ fn weights_bound_on_the_editors_device_deform_the_mesh() {
     run_until_bound(&mut harness);
     let device = harness
         .state()
-        .scene
+        .document()
         .bound(Method::Pmvc)
         .expect("bound")
         .device
@@ -543,7 +533,10 @@ fn an_adapter_too_weak_for_the_viewport_gets_a_notice_not_a_panic() {
     );
     run_until_bound(&mut harness);
     let app = harness.state();
-    assert_eq!(app.scene.bound(Method::Pmvc).expect("bound").device, "CPU");
+    assert_eq!(
+        app.document().bound(Method::Pmvc).expect("bound").device,
+        "CPU"
+    );
     assert!(app.read_back_deformed().is_none(), "no GPU mesh to read");
     // The window still draws its panels.
     harness.get_by_label("Side by side");

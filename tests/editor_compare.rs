@@ -8,7 +8,7 @@ mod common;
 use common::editor::*;
 use egui::{Key, Modifiers};
 use egui_kittest::kittest::Queryable;
-use egui_kittest::{Harness, SnapshotOptions, SnapshotResults};
+use egui_kittest::{Harness, SnapshotResults};
 use pmvc::app::compare::{Layout, Overlay, Pane, ViewSettings};
 use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
@@ -39,7 +39,7 @@ fn press(harness: &mut Harness<'static, EditorApp>, key: Key) {
 }
 
 fn cpu_deformed(app: &EditorApp, method: Method) -> Vec<glam::Vec3> {
-    app.scene
+    app.document()
         .deformed_positions(method)
         .iter()
         .map(|p| p.as_vec3())
@@ -51,7 +51,7 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
     let Some(mut harness) = posed_editor(ViewSettings::default()) else {
         return;
     };
-    let binds = harness.state().bind_count;
+    let binds = harness.state().bind_count();
     assert_eq!(binds, 2, "both methods bound once");
     assert_eq!(harness.state().active_method(), Method::Pmvc);
     let pmvc = harness.state().read_back_deformed().unwrap().unwrap();
@@ -60,7 +60,7 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
     let app = harness.state();
     assert_eq!(app.active_method(), Method::Mvc);
     assert!(!app.is_binding(), "no bind started");
-    assert_eq!(app.bind_count, binds);
+    assert_eq!(app.bind_count(), binds);
     let mvc = app.read_back_deformed().unwrap().unwrap();
     // Under the pose the methods deform differently, each as its CPU weights say.
     assert!(max_distance(&mvc, &pmvc) > 1e-2);
@@ -69,13 +69,13 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
 
     press(&mut harness, Key::M);
     assert_eq!(harness.state().active_method(), Method::Pmvc);
-    assert_eq!(harness.state().bind_count, binds);
+    assert_eq!(harness.state().bind_count(), binds);
 
     // The toolbar's control does the same.
     harness.get_by_label("Side by side").click();
     harness.run_steps(2);
-    assert_eq!(harness.state().view.layout, Layout::SideBySide);
-    assert_eq!(harness.state().bind_count, binds);
+    assert_eq!(harness.state().view().layout, Layout::SideBySide);
+    assert_eq!(harness.state().bind_count(), binds);
 }
 
 #[test]
@@ -103,7 +103,7 @@ fn in_side_by_side_view_one_drag_moves_both_meshes() {
 
     // Drag a handle in the right-hand (PMVC) view.
     let app = harness.state();
-    let (handle, at) = (0..app.scene.pose.len())
+    let (handle, at) = (0..app.document().pose().len())
         .filter_map(|i| Some((i, app.handle_screen_position_in(1, i)?)))
         .find(|(_, p)| panes[1].1.shrink(40.0).contains(*p))
         .expect("a handle inside the right view");
@@ -112,7 +112,9 @@ fn in_side_by_side_view_one_drag_moves_both_meshes() {
     assert!((left.x + panes[1].1.left() - panes[0].1.left() - at.x).abs() < 1.0);
     drag_handle(&mut harness, at, at + egui::vec2(40.0, -30.0));
     let app = harness.state();
-    assert!(app.scene.pose[handle].distance(app.scene.cage.positions[handle]) > 1e-3);
+    assert!(
+        app.document().pose()[handle].distance(app.document().cage().positions()[handle]) > 1e-3
+    );
     for method in [Method::Mvc, Method::Pmvc] {
         let shading = Shading {
             method,
@@ -143,10 +145,10 @@ fn heatmaps_colour_known_weights_blue_white_red() {
         return;
     };
     let app = harness.state();
-    let mvc = app.scene.weights(Method::Mvc).unwrap();
+    let mvc = app.document().weights(Method::Mvc).unwrap();
     // The cage vertex whose MVC coordinate is most negative somewhere.
     let (row, column) = app
-        .scene
+        .document()
         .bound(Method::Mvc)
         .unwrap()
         .quality
@@ -207,7 +209,7 @@ fn negativity_shows_mvc_negative_and_pmvc_never() {
         "PMVC: {}",
         lowest(Method::Pmvc)
     );
-    let quality = |method| app.scene.bound(method).unwrap().quality;
+    let quality = |method| app.document().bound(method).unwrap().quality;
     assert!(quality(Method::Mvc).negative_share > 0.0);
     assert_eq!(quality(Method::Pmvc).negative_vertices, 0);
     assert!(quality(Method::Pmvc).max_partition_error < 1e-5);
@@ -222,8 +224,17 @@ fn the_difference_view_shows_the_distance_between_the_deformations() {
         return;
     };
     let app = harness.state_mut();
-    assert_eq!(app.pane_rects()[0].0, Pane::Difference);
-    let shading = app.shading_of(Pane::Difference);
+    assert_eq!(
+        app.pane_rects()[0].0,
+        Pane::Difference {
+            against: Method::Mvc,
+            shown: Method::Pmvc
+        }
+    );
+    let shading = app.shading_of(Pane::Difference {
+        against: Method::Mvc,
+        shown: Method::Pmvc,
+    });
     assert_eq!(shading.colouring, Colouring::MethodDistance);
     let values = app.read_back(&shading).unwrap().unwrap().values;
     let (mvc, pmvc) = (
@@ -251,7 +262,12 @@ fn hovering_the_mesh_reads_out_its_largest_and_most_negative_weights() {
     };
     harness.state_mut().set_active_method(Method::Mvc);
     harness.run_steps(2);
-    let weights = harness.state().scene.weights(Method::Mvc).unwrap().clone();
+    let weights = harness
+        .state()
+        .document()
+        .weights(Method::Mvc)
+        .unwrap()
+        .clone();
     // A vertex with a negative MVC weight, where it is drawn.
     let vertex = (0..weights.rows)
         .find(|&i| {
@@ -268,7 +284,11 @@ fn hovering_the_mesh_reads_out_its_largest_and_most_negative_weights() {
         .unwrap();
     harness.hover_at(at);
     harness.run_steps(3);
-    let (pane, readout) = harness.state().hover_readout.clone().expect("a read-out");
+    let (pane, readout) = harness
+        .state()
+        .hover_readout()
+        .cloned()
+        .expect("a read-out");
     assert_eq!(pane, 0);
     assert_eq!(readout.method, Method::Mvc);
     let row = weights.row(readout.vertex);
@@ -300,9 +320,9 @@ fn clicking_a_handle_in_heatmap_mode_picks_the_coordinate_shown() {
         return;
     };
     let (handle, at) = isolated_handle(&harness);
-    assert_ne!(harness.state().view.heat_vertex, handle);
+    assert_ne!(harness.state().view().heat_vertex, handle);
     click(&mut harness, at);
-    assert_eq!(harness.state().view.heat_vertex, handle);
+    assert_eq!(harness.state().view().heat_vertex, handle);
     let app = harness.state_mut();
     let shading = app.shading_of(Pane::Method(Method::Pmvc));
     assert_eq!(
@@ -313,7 +333,7 @@ fn clicking_a_handle_in_heatmap_mode_picks_the_coordinate_shown() {
     let largest = [Method::Mvc, Method::Pmvc]
         .iter()
         .map(|&m| {
-            let weights = app.scene.weights(m).unwrap();
+            let weights = app.document().weights(m).unwrap();
             (0..weights.rows)
                 .map(|i| weights.row(i)[handle].abs())
                 .fold(0.0, f32::max)
@@ -327,16 +347,21 @@ fn the_resolution_selector_rebinds_pmvc_only() {
     let Some(mut harness) = posed_editor(ViewSettings::default()) else {
         return;
     };
-    let binds = harness.state().bind_count;
-    let mvc = harness.state().scene.weights(Method::Mvc).unwrap().clone();
+    let binds = harness.state().bind_count();
+    let mvc = harness
+        .state()
+        .document()
+        .weights(Method::Mvc)
+        .unwrap()
+        .clone();
     harness.state_mut().set_resolution(16);
     run_until_bound(&mut harness);
     let app = harness.state();
-    assert_eq!(app.bind_count, binds + 1);
-    let bound = app.scene.bound(Method::Pmvc).unwrap();
+    assert_eq!(app.bind_count(), binds + 1);
+    let bound = app.document().bound(Method::Pmvc).unwrap();
     assert_eq!(bound.options.resolution, 16);
     assert!(std::sync::Arc::ptr_eq(
-        app.scene.weights(Method::Mvc).unwrap(),
+        app.document().weights(Method::Mvc).unwrap(),
         &mvc
     ));
 }
@@ -346,31 +371,35 @@ fn subdividing_the_cage_keeps_the_pose_and_rebinds_both_methods() {
     let Some(mut harness) = posed_editor(ViewSettings::default()) else {
         return;
     };
-    let before = harness.state().scene.clone();
-    let binds = harness.state().bind_count;
+    let before = harness.state().document().clone();
+    let binds = harness.state().bind_count();
     assert!(harness.state_mut().subdivide_cage());
     run_until_bound(&mut harness);
     let app = harness.state();
-    let (vertices, triangles) = (before.cage.vertex_count(), before.cage.triangles.len());
+    let (vertices, triangles) = (before.cage().vertex_count(), before.cage().triangle_count());
     let edges = triangles * 3 / 2;
-    assert_eq!(app.scene.cage.vertex_count(), vertices + edges);
-    assert_eq!(app.scene.cage.triangles.len(), 4 * triangles);
-    assert_eq!(&app.scene.pose[..vertices], &before.pose[..]);
-    assert_eq!(app.bind_count, binds + 2);
-    assert!(app.scene.weights(Method::Pmvc).unwrap().cols == vertices + edges);
-    assert!(app.scene.weights(Method::Mvc).unwrap().cols == vertices + edges);
+    assert_eq!(app.document().cage().vertex_count(), vertices + edges);
+    assert_eq!(app.document().cage().triangles().len(), 4 * triangles);
+    assert_eq!(&app.document().pose()[..vertices], before.pose());
+    assert_eq!(app.bind_count(), binds + 2);
+    assert!(app.document().weights(Method::Pmvc).unwrap().cols == vertices + edges);
+    assert!(app.document().weights(Method::Mvc).unwrap().cols == vertices + edges);
     // Subdivision does not move the mesh at rest (linear precision of the new cage).
-    let rest_cage = app.scene.cage.positions.clone();
-    let at_rest = app.scene.weights(Method::Pmvc).unwrap().apply(&rest_cage);
+    let rest_cage = app.document().cage().positions().to_vec();
+    let at_rest = app
+        .document()
+        .weights(Method::Pmvc)
+        .unwrap()
+        .apply(&rest_cage);
     let worst = at_rest
         .iter()
-        .zip(&app.scene.mesh.positions)
+        .zip(&app.document().mesh().positions)
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max);
     assert!(worst < 1e-4, "{worst}");
 }
 
-/// One snapshot per view of the posed default scene.
+/// One snapshot per view of the posed default document().
 #[test]
 fn snapshots_of_each_view() {
     let views = [
@@ -422,14 +451,9 @@ fn snapshots_of_each_view() {
         };
         harness.state_mut().set_active_method(method);
         // Notices name files by their absolute path, which differs between checkouts.
-        harness.state_mut().notices.clear();
+        harness.state_mut().notices_mut().clear();
         harness.run_steps(3);
-        harness.snapshot_options(
-            name,
-            &SnapshotOptions::new()
-                .threshold(2.0)
-                .max_failed_pixels(4000),
-        );
+        harness.snapshot_options(name, &snapshot_options());
         results.extend_harness(&mut harness);
     }
     results.unwrap();

@@ -7,8 +7,7 @@ use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use pmvc::geometry::procedural::{comb_outline, cube_cage, extrude, points_inside, star_outline};
 use pmvc::geometry::{classify_points, Cage, PointClass};
 use pmvc::gpu::{
-    bind_blocking, Backend, BatchSize, BindConfig, BindError, BindInput, Binder, GpuContext,
-    GpuWeights,
+    Backend, BatchSize, BindConfig, BindError, BindInput, Binder, GpuContext, GpuWeights,
 };
 use std::io::Write as _;
 use std::sync::{Arc, OnceLock};
@@ -52,9 +51,9 @@ fn star() -> Cage {
 fn input(cage: &Cage, points: Vec<DVec3>, method: Method) -> BindInput {
     let classes = classify_points(cage, &points).classes;
     BindInput {
-        points,
-        classes,
-        cage: cage.clone(),
+        points: points.into(),
+        classes: classes.into(),
+        cage: Arc::new(cage.clone()),
         options: BindOptions {
             method,
             resolution: 32,
@@ -95,8 +94,10 @@ fn gpu(context: &Arc<GpuContext>, input: &BindInput, batch: BatchSize) -> Weight
         batch,
         ..BindConfig::default()
     };
-    let output =
-        bind_blocking(input, &Backend::Gpu(Arc::clone(context)), config).expect("GPU bind");
+    let output = Binder::new(Backend::Gpu(Arc::clone(context)))
+        .with_config(config)
+        .bind_blocking(input, &BindProgress::default())
+        .expect("GPU bind");
     eprintln!(
         "  {} rows: {} on the GPU, {} on the CPU, {} batches, {:?}",
         input.points.len(),
@@ -227,8 +228,10 @@ fn resident_gpu_weights_match_the_readback() {
         gpu_buffer: true,
         batch: BatchSize::Fixed(50),
     };
-    let output =
-        bind_blocking(&input, &Backend::Gpu(Arc::clone(&context)), config).expect("GPU bind");
+    let output = Binder::new(Backend::Gpu(Arc::clone(&context)))
+        .with_config(config)
+        .bind_blocking(&input, &BindProgress::default())
+        .expect("GPU bind");
     let weights = output.weights.expect("CPU weights requested");
     let resident = output.gpu_weights.expect("GPU weights requested");
     assert_eq!((resident.rows, resident.cols), (weights.rows, weights.cols));
@@ -282,8 +285,10 @@ fn a_handed_in_device_keeps_the_weights_on_the_gpu_only() {
             gpu_buffer: true,
             batch: BatchSize::default(),
         };
-        let output =
-            bind_blocking(&input, &Backend::Gpu(Arc::clone(&context)), config).expect("GPU bind");
+        let output = Binder::new(Backend::Gpu(Arc::clone(&context)))
+            .with_config(config)
+            .bind_blocking(&input, &BindProgress::default())
+            .expect("GPU bind");
         assert!(output.weights.is_none());
         let resident = output.gpu_weights.expect("GPU weights requested");
         let name = format!("handed-in {}", method.name());
@@ -308,15 +313,17 @@ fn progress_is_monotone_and_reaches_the_total() {
         ..BindConfig::default()
     });
     let mut handle = binder.start(input.clone());
+    let progress = Arc::clone(handle.progress());
+    let snapshot = || (progress.done(), progress.total());
     let mut seen = Vec::new();
     let result = loop {
-        seen.push(handle.progress());
+        seen.push(snapshot());
         if let Some(result) = handle.try_take() {
             break result;
         }
         std::thread::sleep(Duration::from_millis(2));
     };
-    seen.push(handle.progress());
+    seen.push(snapshot());
     let output = result.expect("bind finishes");
     assert!(output.stats.batches >= 10);
     assert!(seen.windows(2).all(|w| w[0].0 <= w[1].0), "{seen:?}");
@@ -334,11 +341,11 @@ fn cancel_returns_within_a_batch_without_a_result() {
     let input = input(&cage, points_inside(&cage, 3000, 8, 1e-3), Method::Pmvc);
     // Adaptive batches of about 75 ms.
     let handle = Binder::new(Backend::Gpu(context)).start(input);
-    while handle.progress().0 < 100 && !handle.is_finished() {
+    while handle.progress().done() < 100 && !handle.is_finished() {
         std::thread::sleep(Duration::from_millis(1));
     }
     let cancelled_at = Instant::now();
-    let done_at_cancel = handle.progress().0;
+    let done_at_cancel = handle.progress().done();
     handle.cancel();
     let result = handle.wait();
     let waited = cancelled_at.elapsed();
@@ -353,13 +360,19 @@ fn cancel_returns_within_a_batch_without_a_result() {
 }
 
 #[test]
-fn cpu_backend_runs_through_the_binder() {
+fn the_cpu_backend_reports_progress_and_honours_a_cancel() {
     let cage = cube_cage(1.0);
     let input = input(&cage, points_inside(&cage, 100, 9, 1e-3), Method::Pmvc);
-    let output = Binder::new(Backend::Cpu)
-        .bind_blocking(&input)
-        .expect("CPU bind");
-    assert_eq!(output.weights.expect("weights"), cpu(&input));
+    let binder = Binder::new(Backend::Cpu);
+    let progress = BindProgress::new(100);
+    let output = binder.bind_blocking(&input, &progress).expect("CPU bind");
+    assert_eq!(progress.done(), 100, "every row counted once");
+    assert_eq!(output.stats.cpu_rows, 100);
+    assert_eq!(output.weights.expect("weights").rows, 100);
+    let cancelled = BindProgress::new(100);
+    cancelled.cancel();
+    let result = binder.bind_blocking(&input, &cancelled);
+    assert!(matches!(result, Err(BindError::Cancelled)), "{result:?}");
 }
 
 #[test]
@@ -371,9 +384,9 @@ fn a_resident_matrix_beyond_the_limits_is_an_error() {
     let limit = context.limits.max_storage_buffer_binding_size;
     let rows = (limit / (4 * cage.vertex_count() as u64)) as usize + 1;
     let input = BindInput {
-        points: vec![DVec3::splat(5.0); rows],
-        classes: vec![PointClass::Outside; rows],
-        cage,
+        points: vec![DVec3::splat(5.0); rows].into(),
+        classes: vec![PointClass::Outside; rows].into(),
+        cage: Arc::new(cage),
         options: BindOptions::default(),
     };
     let config = BindConfig {
@@ -381,7 +394,9 @@ fn a_resident_matrix_beyond_the_limits_is_an_error() {
         gpu_buffer: true,
         batch: BatchSize::default(),
     };
-    let result = bind_blocking(&input, &Backend::Gpu(context), config);
+    let result = Binder::new(Backend::Gpu(context))
+        .with_config(config)
+        .bind_blocking(&input, &BindProgress::default());
     assert!(
         matches!(
             result,
@@ -401,7 +416,9 @@ fn a_lost_device_is_an_error_not_a_panic() {
     let cage = cube_cage(1.0);
     let input = input(&cage, points_inside(&cage, 50, 11, 1e-3), Method::Pmvc);
     context.device.destroy();
-    let result = bind_blocking(&input, &Backend::Gpu(context), BindConfig::default());
+    let result = Binder::new(Backend::Gpu(context))
+        .with_config(BindConfig::default())
+        .bind_blocking(&input, &BindProgress::default());
     assert!(matches!(result, Err(BindError::Gpu(_))), "{result:?}");
 }
 
@@ -409,12 +426,21 @@ fn a_lost_device_is_an_error_not_a_panic() {
 fn the_adapters_report_names_the_choice_and_the_limits() {
     let report = pmvc::gpu::adapters_report();
     eprintln!("{report}");
-    assert!(report.contains("chosen:"), "{report}");
-    if let Some(context) = test_context("adapters report") {
-        assert!(report.contains(&context.info.name), "{report}");
-        assert!(
-            report.contains("max storage buffer binding size"),
-            "{report}"
-        );
+    match test_context("adapters report") {
+        // The adapter the binds run on is the one reported as chosen, with the
+        // limits of that adapter.
+        Some(context) => {
+            let chosen = report
+                .lines()
+                .find(|line| line.starts_with("chosen: "))
+                .expect("a chosen line");
+            assert!(chosen.contains(&context.info.name), "{report}");
+            let limit = format!(
+                "max storage buffer binding size: {} bytes",
+                context.limits.max_storage_buffer_binding_size
+            );
+            assert!(report.contains(&limit), "{report}");
+        }
+        None => assert!(report.contains("chosen: none"), "{report}"),
     }
 }

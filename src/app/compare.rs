@@ -1,7 +1,9 @@
-//! What the viewport compares: one method or MVC and PMVC side by side, their
-//! difference, and what the mesh is coloured by (a single coordinate function, the
+//! What the viewport compares: one method, several side by side, the difference
+//! of two, and what the mesh is coloured by (a single coordinate function, the
 //! most negative weight). Also the CPU read-outs behind the colour bars and the
 //! hover box. No GPU or UI code: the editor turns these into panes and widgets.
+//! Methods are data here: nothing below names a coordinate family except the
+//! defaults.
 
 use crate::coords::{quality, Method, Weights};
 use crate::render::colormap::Scale;
@@ -17,9 +19,9 @@ pub enum Layout {
     /// One view, of the active method.
     #[default]
     Single,
-    /// MVC and PMVC next to each other (and their difference, if asked for).
+    /// The compared methods next to each other (and their difference, if asked for).
     SideBySide,
-    /// One view coloured by |p′_MVC − p′_PMVC|.
+    /// One view coloured by |p′_a − p′_b| for the difference pair.
     Difference,
 }
 
@@ -39,8 +41,9 @@ pub enum Overlay {
 pub enum Pane {
     /// The mesh deformed (and coloured) with one method's weights.
     Method(Method),
-    /// The PMVC mesh coloured by its distance to the MVC mesh.
-    Difference,
+    /// The mesh deformed with `shown`, coloured by its distance to the mesh
+    /// deformed with `against`.
+    Difference { against: Method, shown: Method },
 }
 
 impl Pane {
@@ -48,8 +51,54 @@ impl Pane {
     pub fn method(self) -> Method {
         match self {
             Pane::Method(method) => method,
-            Pane::Difference => Method::Pmvc,
+            Pane::Difference { shown, .. } => shown,
         }
+    }
+
+    /// Every method whose weights the pane needs.
+    pub fn methods(self) -> Vec<Method> {
+        match self {
+            Pane::Method(method) => vec![method],
+            Pane::Difference { against, shown } => vec![against, shown],
+        }
+    }
+}
+
+/// A set of coordinate families, iterated in [`Method::ALL`] order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MethodSet(u32);
+
+impl MethodSet {
+    fn bit(method: Method) -> u32 {
+        1 << Method::ALL.iter().position(|&m| m == method).unwrap_or(0)
+    }
+
+    pub fn of(methods: &[Method]) -> Self {
+        Self(methods.iter().map(|&m| Self::bit(m)).fold(0, |a, b| a | b))
+    }
+
+    pub fn contains(self, method: Method) -> bool {
+        self.0 & Self::bit(method) != 0
+    }
+
+    pub fn set(&mut self, method: Method, included: bool) {
+        if included {
+            self.0 |= Self::bit(method);
+        } else {
+            self.0 &= !Self::bit(method);
+        }
+    }
+
+    pub fn iter(self) -> impl Iterator<Item = Method> {
+        Method::ALL.into_iter().filter(move |&m| self.contains(m))
+    }
+
+    pub fn len(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
     }
 }
 
@@ -61,7 +110,13 @@ pub struct ViewSettings {
     /// The cage vertex whose coordinate function the heatmap shows.
     pub heat_vertex: usize,
     pub scale: Scale,
-    /// In the side-by-side layout, a third view of the difference.
+    /// The methods the side-by-side layout shows, left to right in
+    /// [`Method::ALL`] order.
+    pub compared: MethodSet,
+    /// The two methods the difference compares: the mesh is deformed with the
+    /// second and coloured by its distance to the first.
+    pub difference: [Method; 2],
+    /// In the side-by-side layout, one more view of the difference.
     pub difference_pane: bool,
     /// All views share one camera.
     pub cameras_locked: bool,
@@ -76,6 +131,8 @@ impl Default for ViewSettings {
             overlay: Overlay::Shaded,
             heat_vertex: 0,
             scale: Scale::Linear,
+            compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
+            difference: [Method::Mvc, Method::Pmvc],
             difference_pane: false,
             cameras_locked: true,
             hover_in_shaded: false,
@@ -84,24 +141,38 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The views to draw, left to right, with `active` the method of a single view.
-    pub fn panes(&self, active: Method) -> Vec<Pane> {
-        match self.layout {
+    /// The difference pane of [`Self::difference`].
+    pub fn difference_pane_kind(&self) -> Pane {
+        let [against, shown] = self.difference;
+        Pane::Difference { against, shown }
+    }
+
+    /// The views to draw, left to right, with `active` the method of a single
+    /// view; at most `max_panes`.
+    pub fn panes(&self, active: Method, max_panes: usize) -> Vec<Pane> {
+        let mut panes = match self.layout {
             Layout::Single => vec![Pane::Method(active)],
-            Layout::SideBySide if self.difference_pane => vec![
-                Pane::Method(Method::Mvc),
-                Pane::Method(Method::Pmvc),
-                Pane::Difference,
-            ],
-            Layout::SideBySide => vec![Pane::Method(Method::Mvc), Pane::Method(Method::Pmvc)],
-            Layout::Difference => vec![Pane::Difference],
-        }
+            Layout::SideBySide => {
+                let mut panes: Vec<Pane> = self.compared.iter().map(Pane::Method).collect();
+                if panes.is_empty() {
+                    panes.push(Pane::Method(active));
+                }
+                if self.difference_pane {
+                    panes.truncate(max_panes.saturating_sub(1));
+                    panes.push(self.difference_pane_kind());
+                }
+                panes
+            }
+            Layout::Difference => vec![self.difference_pane_kind()],
+        };
+        panes.truncate(max_panes.max(1));
+        panes
     }
 
     /// What `pane` colours the mesh by.
     pub fn colouring(&self, pane: Pane) -> Colouring {
         match (pane, self.overlay) {
-            (Pane::Difference, _) => Colouring::MethodDistance,
+            (Pane::Difference { .. }, _) => Colouring::MethodDistance,
             (Pane::Method(_), Overlay::Shaded) => Colouring::Shaded,
             (Pane::Method(_), Overlay::Heatmap) => {
                 Colouring::CageVertexWeight(self.heat_vertex as u32)
@@ -180,9 +251,14 @@ pub fn cage_size(cage: &[DVec3]) -> f64 {
     (hi - lo).length().max(1e-12)
 }
 
-/// Mesh positions deformed by `weights` and the posed cage, in f32 as drawn.
-pub fn deform(weights: &Weights, pose: &[DVec3]) -> Vec<Vec3> {
-    weights.apply(pose).iter().map(|p| p.as_vec3()).collect()
+/// Mesh positions `rest` moved by `weights` and the columns' displacements, in f32
+/// as drawn.
+pub fn deform(weights: &Weights, rest: &[DVec3], moves: &[DVec3]) -> Vec<Vec3> {
+    weights
+        .apply_displacements(rest, moves)
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect()
 }
 
 /// What the hover box shows for one mesh vertex.
@@ -251,17 +327,28 @@ mod tests {
     #[test]
     fn panes_follow_the_layout() {
         let mut settings = ViewSettings::default();
-        assert_eq!(settings.panes(Method::Mvc), vec![Pane::Method(Method::Mvc)]);
-        settings.layout = Layout::SideBySide;
-        assert_eq!(settings.panes(Method::Mvc).len(), 2);
-        settings.difference_pane = true;
-        assert_eq!(settings.panes(Method::Pmvc)[2], Pane::Difference);
-        settings.layout = Layout::Difference;
-        assert_eq!(settings.panes(Method::Mvc), vec![Pane::Difference]);
         assert_eq!(
-            settings.colouring(Pane::Difference),
-            Colouring::MethodDistance
+            settings.panes(Method::Mvc, 3),
+            vec![Pane::Method(Method::Mvc)]
         );
+        settings.layout = Layout::SideBySide;
+        assert_eq!(
+            settings.panes(Method::Mvc, 3),
+            vec![Pane::Method(Method::Mvc), Pane::Method(Method::Pmvc)]
+        );
+        settings.difference_pane = true;
+        let difference = Pane::Difference {
+            against: Method::Mvc,
+            shown: Method::Pmvc,
+        };
+        assert_eq!(settings.panes(Method::Pmvc, 3)[2], difference);
+        // With room for two views, the difference keeps its place.
+        assert_eq!(settings.panes(Method::Pmvc, 2)[1], difference);
+        settings.layout = Layout::Difference;
+        assert_eq!(settings.panes(Method::Mvc, 3), vec![difference]);
+        assert_eq!(settings.colouring(difference), Colouring::MethodDistance);
+        settings.compared.set(Method::Mvc, false);
+        assert_eq!(settings.compared.iter().collect::<Vec<_>>(), [Method::Pmvc]);
     }
 
     #[test]

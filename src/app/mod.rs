@@ -1,23 +1,32 @@
 //! The desktop editor: an eframe/egui application that binds a mesh to a cage in
-//! the background, deforms it on the GPU every frame, and edits the cage.
+//! the background, deforms it on the GPU every frame, and edits the cage. Laid
+//! out as egui's demo app is: one state struct, one file per panel.
 //!
-//! - [`editor`]: the application state and its UI; talks only to [`jobs`] and
-//!   [`crate::render`].
-//! - [`compare`]: what the views compare (MVC, PMVC, their difference) and how the
-//!   mesh is coloured; the read-outs behind colour bars and the hover box.
-//! - [`scene`]: the loaded mesh, cage, pose and weights, and the pose history.
-//! - [`jobs`]: binding on a background thread with progress and cancel.
-//! - [`scenes`]: the bundled scenes and their generators.
-//! - [`widgets`]: the colour bar and the hover box drawn over the views.
+//! - [`document`]: what is edited (mesh, cage, pose, selection, weights, undo);
+//!   private state whose mutators report every change.
+//! - [`bind_queue`]: binding in the background, one job at a time.
+//! - [`editor`]: the [`EditorApp`] that ties them to the viewport; `binding`,
+//!   `files` and `readouts` add its actions.
+//! - `viewport`: panes, input and picking; `ui`: menu, toolbar, side panel,
+//!   quality table, notices and statistics.
+//! - [`compare`]: what the views compare and how the mesh is coloured.
+//! - [`scenes`]: the bundled scenes; [`widgets`]: the colour bar and hover box.
 
+pub mod bind_queue;
+mod binding;
 pub mod compare;
+pub mod document;
 pub mod editor;
-pub mod jobs;
-pub mod scene;
+mod files;
+pub mod history;
+mod readouts;
 pub mod scenes;
+mod screenshot;
+pub mod ui;
+mod viewport;
 pub mod widgets;
 
-pub use editor::EditorApp;
+pub use editor::{EditorApp, FileRole};
 
 use std::path::PathBuf;
 
@@ -39,6 +48,9 @@ pub struct EditorOptions {
     pub bind_on: BindOn,
     /// The views and colouring to start with (`--view`, `--heatmap`, `--negativity`).
     pub view: compare::ViewSettings,
+    /// Show no timings (bind and elapsed times), so that frames are deterministic
+    /// (snapshot tests).
+    pub hide_timings: bool,
 }
 
 /// Where the editor binds. On a GPU it binds on the editor's own device, and the
@@ -52,12 +64,12 @@ pub enum BindOn {
     Gpu,
 }
 
-/// Open the editor window and run until it is closed.
 /// The editor window could not run.
 #[derive(Debug, thiserror::Error)]
 #[error("the editor window failed: {0}")]
 pub struct EditorError(String);
 
+/// Open the editor window and run until it is closed.
 pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
     let mut native_options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()

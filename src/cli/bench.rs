@@ -2,9 +2,9 @@
 //! and on the shared evaluation data, on the CPU and on a GPU adapter. Reports medians over repeated runs, as markdown on
 //! stdout and optionally as JSON.
 
-use crate::coords::{BindOptions, Method};
+use crate::coords::{BindOptions, BindProgress, Method};
 use crate::geometry::{self, classify_points, procedural, Cage};
-use crate::gpu::{bind_blocking, Backend, BindConfig, BindInput, GpuContext};
+use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::Result;
 use glam::DVec3;
 use std::path::PathBuf;
@@ -134,22 +134,27 @@ fn bench_scene(
     let mut rows = Vec::new();
     for timed in backends {
         for &(method, resolution) in configurations {
+            let mut options = BindOptions::for_method(method);
+            if let Some(parameter) = method.spec().parameter {
+                options.set(parameter.key, resolution);
+            }
             let input = BindInput {
-                points: points.to_vec(),
-                classes: classes.classes.clone(),
-                cage: cage.clone(),
-                options: BindOptions { method, resolution },
+                points: points.into(),
+                classes: classes.classes.as_slice().into(),
+                cage: Arc::new(cage.clone()),
+                options,
             };
+            let binder = Binder::new(timed.backend.clone());
             let mut times = Vec::with_capacity(runs);
             for _ in 0..runs.max(1) {
                 // Wall time of the whole bind: uploads and readbacks included.
                 let start = Instant::now();
-                bind_blocking(&input, &timed.backend, BindConfig::default())?;
+                binder.bind_blocking(&input, &BindProgress::default())?;
                 times.push(start.elapsed().as_secs_f64());
             }
-            let label = match method {
-                Method::Mvc => "MVC".to_owned(),
-                Method::Pmvc => format!("PMVC {resolution}²"),
+            let label = match options.parameter() {
+                Some((spec, value)) => format!("{} {}", method.name(), (spec.format)(value)),
+                None => method.name().to_owned(),
             };
             let row = BenchRow {
                 scene: name.to_owned(),

@@ -73,25 +73,22 @@ fn compute_weights_on(
     choice: &MethodChoice,
     backend: Backend,
 ) -> Result<Weights> {
-    let options = BindOptions {
-        method: choice.method.into(),
-        resolution: choice.resolution,
-    };
+    let options = choice.options();
     let points = &input.mesh.mesh.positions;
     let bar = progress_bar(points.len() as u64, options.method);
     let bind_input = BindInput {
-        points: points.clone(),
-        classes: input.classes.classes.clone(),
-        cage: input.cage.clone(),
+        points: points.as_slice().into(),
+        classes: input.classes.classes.as_slice().into(),
+        cage: Arc::new(input.cage.clone()),
         options,
     };
     let output = if bar.is_hidden() {
         // Nothing to show: wait on the bind directly, not in steps of the poll below.
-        Binder::new(backend).bind_blocking(&bind_input)?
+        Binder::new(backend).bind_blocking(&bind_input, &BindProgress::default())?
     } else {
         let handle = Binder::new(backend).start(bind_input);
         while !handle.is_finished() {
-            bar.set_position(handle.progress().0 as u64);
+            bar.set_position(handle.progress().done() as u64);
             std::thread::sleep(Duration::from_millis(50));
         }
         bar.finish_and_clear();

@@ -38,21 +38,15 @@ pub enum Command {
     Info,
 }
 
-/// Which coordinates to compute.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Mean value coordinates, closed form (may be negative in non-convex cages).
-    Mvc,
-    /// Positive mean value coordinates, integrated over a cube map.
-    Pmvc,
-}
+/// `--method` takes the identifier of any registered coordinate family
+/// ([`crate::coords::Method::ALL`]), with its summary as help.
+impl ValueEnum for crate::coords::Method {
+    fn value_variants<'a>() -> &'a [Self] {
+        &crate::coords::Method::ALL
+    }
 
-impl From<MethodArg> for crate::coords::Method {
-    fn from(method: MethodArg) -> Self {
-        match method {
-            MethodArg::Mvc => Self::Mvc,
-            MethodArg::Pmvc => Self::Pmvc,
-        }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.id()).help(self.spec().summary))
     }
 }
 
@@ -81,8 +75,8 @@ pub struct CageInput {
 #[derive(Debug, clap::Args)]
 pub struct MethodChoice {
     /// Coordinates to compute.
-    #[arg(long, value_enum, default_value_t = MethodArg::Pmvc)]
-    pub method: MethodArg,
+    #[arg(long, value_enum, default_value_t = crate::coords::Method::Pmvc)]
+    pub method: crate::coords::Method,
     /// PMVC cube-map resolution: texels along one face edge (1–1024).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub resolution: u32,
@@ -92,6 +86,16 @@ pub struct MethodChoice {
     /// Treat mesh vertices outside the cage as an error instead of giving them MVC weights.
     #[arg(long)]
     pub strict: bool,
+}
+
+impl MethodChoice {
+    /// The bind options these flags ask for.
+    pub fn options(&self) -> crate::coords::BindOptions {
+        crate::coords::BindOptions {
+            method: self.method,
+            resolution: self.resolution,
+        }
+    }
 }
 
 #[derive(Debug, clap::Args)]
@@ -146,16 +150,17 @@ pub struct EditArgs {
     pub resolution: Option<u32>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
-    pub method: Option<MethodArg>,
+    pub method: Option<crate::coords::Method>,
     /// Wait for the bind, render, save the window as PNG and exit.
     #[arg(long, value_name = "PATH")]
     pub screenshot: Option<PathBuf>,
     /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
-    /// What the viewport shows: one method, both side by side, or the distance
-    /// between their deformations.
-    #[arg(long, value_enum)]
+    /// What the viewport shows: one method (give its name, e.g. `mvc`), methods
+    /// side by side (`side-by-side`), or the distance between two methods'
+    /// deformations (`difference`).
+    #[arg(long, value_parser = parse_view)]
     pub view: Option<ViewArg>,
     /// Colour the mesh by the coordinate function of this cage vertex (0-based).
     #[arg(long, value_name = "CAGE_VERTEX", conflicts_with = "negativity")]
@@ -169,27 +174,41 @@ pub struct EditArgs {
 }
 
 /// What the editor's viewport shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewArg {
-    /// The mesh deformed with MVC.
-    Mvc,
-    /// The mesh deformed with PMVC.
-    Pmvc,
-    /// MVC and PMVC next to each other, cameras locked.
+    /// The mesh deformed with one method.
+    Single(crate::coords::Method),
+    /// Methods next to each other, cameras locked.
     SideBySide,
-    /// |p′_MVC − p′_PMVC| per mesh vertex, relative to the cage size.
+    /// The distance between two methods' deformations per mesh vertex, relative
+    /// to the cage size.
     Difference,
+}
+
+fn parse_view(value: &str) -> Result<ViewArg, String> {
+    match value {
+        "side-by-side" => Ok(ViewArg::SideBySide),
+        "difference" => Ok(ViewArg::Difference),
+        other => crate::coords::Method::from_id(other)
+            .map(ViewArg::Single)
+            .ok_or_else(|| {
+                let methods: Vec<&str> =
+                    crate::coords::Method::ALL.iter().map(|m| m.id()).collect();
+                format!(
+                    "expected side-by-side, difference or a method ({})",
+                    methods.join(", ")
+                )
+            }),
+    }
 }
 
 impl EditArgs {
     fn editor_options(self) -> crate::app::EditorOptions {
         use crate::app::compare::{Layout, Overlay, ViewSettings};
-        use crate::coords::Method;
         let mut view = ViewSettings::default();
-        let mut method = self.method.map(Method::from);
+        let mut method = self.method;
         match self.view {
-            Some(ViewArg::Mvc) => method = Some(Method::Mvc),
-            Some(ViewArg::Pmvc) => method = Some(Method::Pmvc),
+            Some(ViewArg::Single(shown)) => method = Some(shown),
             Some(ViewArg::SideBySide) => view.layout = Layout::SideBySide,
             Some(ViewArg::Difference) => view.layout = Layout::Difference,
             None => {}
@@ -217,6 +236,7 @@ impl EditArgs {
                 BackendArg::Gpu => crate::app::BindOn::Gpu,
             },
             view,
+            hide_timings: false,
         }
     }
 }

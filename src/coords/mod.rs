@@ -13,36 +13,17 @@
 //!   the surface because both reduce to the triangle's barycentrics there.
 
 pub mod cubemap;
+pub mod family;
 pub mod mvc;
 pub mod pmvc;
 pub mod quality;
 
 use crate::geometry::{Cage, PointClass};
+pub use family::{FamilySpec, Method, Parameter, ParameterSpec, DEFAULT_RESOLUTION};
 use glam::DVec3;
 pub use quality::WeightQuality;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
-/// Which coordinates to compute.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Mean value coordinates (Ju, Schaefer, Warren 2005), closed form.
-    Mvc,
-    /// Positive mean value coordinates (Lipman et al. 2007), by cube-map integration.
-    Pmvc,
-}
-
-impl Method {
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Mvc => "MVC",
-            Method::Pmvc => "PMVC",
-        }
-    }
-}
-
-/// Default cube-map resolution (texels along one face edge).
-pub const DEFAULT_RESOLUTION: u32 = 32;
 
 /// What to bind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,6 +31,43 @@ pub struct BindOptions {
     pub method: Method,
     /// Cube-map resolution for PMVC; ignored by MVC.
     pub resolution: u32,
+}
+
+impl BindOptions {
+    /// The options for `method` with every parameter at its default.
+    pub fn for_method(method: Method) -> Self {
+        Self {
+            method,
+            ..Self::default()
+        }
+    }
+
+    /// The value of `parameter` in these options.
+    pub fn get(&self, parameter: Parameter) -> u32 {
+        match parameter {
+            Parameter::Resolution => self.resolution,
+        }
+    }
+
+    pub fn set(&mut self, parameter: Parameter, value: u32) {
+        match parameter {
+            Parameter::Resolution => self.resolution = value,
+        }
+    }
+
+    /// The parameter of this method and its value, if it has one.
+    pub fn parameter(&self) -> Option<(ParameterSpec, u32)> {
+        let spec = self.method.spec().parameter?;
+        Some((spec, self.get(spec.key)))
+    }
+
+    /// Whether weights bound with `self` are the ones `other` asks for: the same
+    /// method and the same values of the parameters that method reads.
+    pub fn same_weights_as(&self, other: &BindOptions) -> bool {
+        let key =
+            |options: &BindOptions| options.parameter().map(|(spec, value)| (spec.key, value));
+        self.method == other.method && key(self) == key(other)
+    }
 }
 
 impl Default for BindOptions {
@@ -101,23 +119,76 @@ impl Weights {
             .collect()
     }
 
+    /// `rest` moved by `Σₖ wₖ dₖ` per row, with `moves` one displacement per
+    /// column, accumulated in f64. The displacement form reproduces the rest pose
+    /// exactly for any weights and keeps full precision far from the origin.
+    pub fn apply_displacements(&self, rest: &[DVec3], moves: &[DVec3]) -> Vec<DVec3> {
+        assert_eq!(
+            moves.len(),
+            self.cols,
+            "one displacement per weights column"
+        );
+        assert_eq!(rest.len(), self.rows, "one rest position per weights row");
+        self.values
+            .par_chunks(self.cols.max(1))
+            .take(self.rows)
+            .zip(rest.par_iter())
+            .map(|(row, &p)| {
+                p + row
+                    .iter()
+                    .zip(moves)
+                    .map(|(&w, &d)| f64::from(w) * d)
+                    .sum::<DVec3>()
+            })
+            .collect()
+    }
+
     /// Smallest weight in the matrix; infinity for an empty one.
     pub fn min(&self) -> f32 {
         self.values.iter().copied().fold(f32::INFINITY, f32::min)
     }
 }
 
-/// Progress and cancellation shared between a running bind and its observers.
+/// Progress and cancellation shared between a running bind and its observers:
+/// the one progress type of every bind, CPU or GPU, command line or editor.
 #[derive(Debug, Default)]
 pub struct BindProgress {
+    total: usize,
     done: AtomicUsize,
     cancel: AtomicBool,
 }
 
 impl BindProgress {
-    /// Mesh vertices finished so far; never decreases.
+    /// Progress of a bind of `total` rows.
+    pub fn new(total: usize) -> Self {
+        Self {
+            total,
+            ..Self::default()
+        }
+    }
+
+    /// Rows finished so far; never decreases, never exceeds [`Self::total`] once
+    /// a total is set.
     pub fn done(&self) -> usize {
-        self.done.load(Ordering::Relaxed)
+        let done = self.done.load(Ordering::Relaxed);
+        if self.total > 0 {
+            done.min(self.total)
+        } else {
+            done
+        }
+    }
+
+    pub fn total(&self) -> usize {
+        self.total
+    }
+
+    /// Share done, in [0, 1]; 1 for an empty bind.
+    pub fn fraction(&self) -> f32 {
+        if self.total == 0 {
+            1.0
+        } else {
+            self.done() as f32 / self.total as f32
+        }
     }
 
     pub fn cancel(&self) {
@@ -128,8 +199,8 @@ impl BindProgress {
         self.cancel.load(Ordering::Relaxed)
     }
 
-    pub fn advance(&self, vertices: usize) {
-        self.done.fetch_add(vertices, Ordering::Relaxed);
+    pub fn advance(&self, rows: usize) {
+        self.done.fetch_add(rows, Ordering::Relaxed);
     }
 }
 
@@ -153,17 +224,45 @@ pub fn bind_cpu(
     options: BindOptions,
     progress: &BindProgress,
 ) -> Result<Weights, Cancelled> {
+    let mut weights = Weights::zeros(points.len(), cage.vertex_count());
+    let rows: Vec<usize> = (0..points.len()).collect();
+    bind_rows(
+        points,
+        classes,
+        cage,
+        options,
+        &rows,
+        &mut weights.values,
+        progress,
+    )?;
+    Ok(weights)
+}
+
+/// The one row loop of every CPU bind: fill `out` (`rows.len()` × cage vertices,
+/// row-major) with the weights of `points[rows[k]]`, in parallel, advancing
+/// `progress` and stopping early when it is cancelled.
+pub fn bind_rows(
+    points: &[DVec3],
+    classes: &[PointClass],
+    cage: &Cage,
+    options: BindOptions,
+    rows: &[usize],
+    out: &mut [f32],
+    progress: &BindProgress,
+) -> Result<(), Cancelled> {
     assert_eq!(points.len(), classes.len(), "one class per point");
     let cols = cage.vertex_count();
-    let mut weights = Weights::zeros(points.len(), cols);
-    if cols == 0 || points.is_empty() {
-        return Ok(weights);
+    assert_eq!(
+        out.len(),
+        rows.len() * cols,
+        "one output row per row asked for"
+    );
+    if cols == 0 || rows.is_empty() {
+        return Ok(());
     }
     let table = cubemap::TexelTable::new(options.resolution.max(1));
-    weights
-        .values
-        .par_chunks_mut(cols * ROWS_PER_TASK)
-        .enumerate()
+    out.par_chunks_mut(cols * ROWS_PER_TASK)
+        .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
             || {
                 (
@@ -172,13 +271,11 @@ pub fn bind_cpu(
                     pmvc::PmvcScratch::default(),
                 )
             },
-            |(row_f64, mvc_scratch, pmvc_scratch), (chunk, rows)| {
+            |(row_f64, mvc_scratch, pmvc_scratch), (block, block_rows)| {
                 if progress.is_cancelled() {
                     return Err(Cancelled);
                 }
-                let first = chunk * ROWS_PER_TASK;
-                for (offset, row) in rows.chunks_mut(cols).enumerate() {
-                    let i = first + offset;
+                for (row, &i) in block.chunks_mut(cols).zip(block_rows) {
                     weights_at(
                         points[i],
                         classes[i],
@@ -193,11 +290,10 @@ pub fn bind_cpu(
                         *out = value as f32;
                     }
                 }
-                progress.advance(rows.len() / cols);
+                progress.advance(block_rows.len());
                 Ok(())
             },
-        )?;
-    Ok(weights)
+        )
 }
 
 /// Coordinates of one point, following the policy of the module doc.
@@ -218,7 +314,7 @@ pub fn weights_at(
             barycentric,
         } => {
             out.fill(0.0);
-            let corners = cage.triangles[triangle as usize];
+            let corners = cage.triangles()[triangle as usize];
             for (k, &corner) in corners.iter().enumerate() {
                 out[corner as usize] += barycentric[k];
             }

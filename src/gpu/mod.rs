@@ -4,7 +4,7 @@
 //! - [`GpuContext`]: device, queue and adapter facts, made here ([`GpuContext::new`],
 //!   adapter policy in its doc) or handed in ([`GpuContext::from_device`]).
 //! - [`Binder`]: a bind on a background thread, CPU or GPU, with progress and cancel;
-//!   [`bind_blocking`] for synchronous callers and benchmarks.
+//!   [`Binder::bind_blocking`] for synchronous callers and benchmarks.
 //! - Kernels in `shaders/bind_pmvc.wgsl` and `shaders/bind_mvc.wgsl`.
 
 mod binder;
@@ -12,8 +12,8 @@ mod context;
 mod kernels;
 
 pub use binder::{
-    bind_blocking, Backend, BatchSize, BindConfig, BindError, BindHandle, BindInput, BindOutput,
-    BindStats, Binder, GpuWeights,
+    Backend, BatchSize, BindConfig, BindError, BindHandle, BindInput, BindOutput, BindStats,
+    Binder, GpuWeights,
 };
 pub use context::{adapters_report, GpuContext};
 

@@ -88,11 +88,21 @@ pub fn editor_on(
                 cc,
                 EditorOptions {
                     resolution: Some(options.resolution.unwrap_or(TEST_RESOLUTION)),
+                    // Bind times differ from run to run; snapshots must not.
+                    hide_timings: true,
                     ..options
                 },
             )
         });
     harness
+}
+
+/// Snapshot tolerances near egui_kittest's defaults: the frames are deterministic
+/// (no timings shown), so a handle that vanishes fails the comparison.
+pub fn snapshot_options() -> egui_kittest::SnapshotOptions {
+    egui_kittest::SnapshotOptions::new()
+        .threshold(1.0)
+        .max_failed_pixels(200)
 }
 
 /// Step the app until the bind finishes, checking that progress is reported.
@@ -109,7 +119,7 @@ pub fn run_until_bound(harness: &mut Harness<'static, EditorApp>) {
 /// A cage handle with no other handle near it on screen, and its position.
 pub fn isolated_handle(harness: &Harness<'static, EditorApp>) -> (usize, Pos2) {
     let app = harness.state();
-    let screen: Vec<Option<Pos2>> = (0..app.scene.pose.len())
+    let screen: Vec<Option<Pos2>> = (0..app.document().pose().len())
         .map(|i| app.handle_screen_position(i))
         .collect();
     screen

@@ -1,376 +1,45 @@
-//! A bind as a job: CPU (via [`coords::bind_cpu`]) or GPU, on a background thread,
-//! with monotone progress, cancellation and no partial results.
-//!
-//! GPU binds run in batches of rows sized to about [`DEFAULT_BATCH_TARGET`] each on
-//! the adapter in use (each batch is timed and the next one resized), so progress
-//! moves smoothly and a cancel takes effect within one batch. Every batch is read
-//! back into the CPU matrix and/or copied into a resident GPU matrix, so device
-//! buffers stay within `max_storage_buffer_binding_size` whatever the mesh size.
-//!
-//! The GPU computes the rows of `Inside` points. The CPU (f64, [`coords::weights_at`])
-//! fills the rows of points on the surface or outside, and redoes the rows the
-//! kernels flag: PMVC points whose rays escape, MVC points too close to a cage
-//! vertex, triangle or triangle plane for f32.
+//! One bind on a GPU: device buffers, batches of rows, flagged rows redone on the
+//! CPU, and typed readback.
 
-use super::context::GpuContext;
-use super::kernels::{Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
-use super::GpuError;
-use crate::coords::{self, cubemap::TexelTable, BindOptions, BindProgress, Method, Weights};
+use super::{BatchSize, BindConfig, BindError, BindInput, BindOutput, BindStats, GpuWeights};
+use crate::coords::{self, cubemap::TexelTable, BindProgress, Method, Weights};
 use crate::geometry::{bounds_of, Cage, PointClass};
+use crate::gpu::context::GpuContext;
+use crate::gpu::kernels::{Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
+use crate::gpu::GpuError;
 use glam::DVec3;
-use rayon::prelude::*;
-use std::sync::Arc;
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-/// Wall time per GPU batch that adaptive batching aims for.
-pub const DEFAULT_BATCH_TARGET: Duration = Duration::from_millis(75);
 /// Largest share of the device limits one batch buffer may take.
 const MAX_BATCH_BUFFER_BYTES: u64 = 64 << 20;
 
-/// Where a bind runs.
-#[derive(Clone, Debug)]
-pub enum Backend {
-    Cpu,
-    Gpu(Arc<GpuContext>),
-}
-
-/// How many rows each GPU batch binds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BatchSize {
-    /// Time each batch and resize the next towards this wall time.
-    Adaptive { target: Duration },
-    /// Exactly this many rows per batch (clamped to the device limits); for tests.
-    Fixed(usize),
-}
-
-impl Default for BatchSize {
-    fn default() -> Self {
-        BatchSize::Adaptive {
-            target: DEFAULT_BATCH_TARGET,
-        }
-    }
-}
-
-/// What a bind keeps, and how it batches.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BindConfig {
-    /// Read the weights back into [`BindOutput::weights`].
-    pub cpu_weights: bool,
-    /// Keep the weights in a GPU storage buffer ([`BindOutput::gpu_weights`]); GPU
-    /// backend only.
-    pub gpu_buffer: bool,
-    pub batch: BatchSize,
-}
-
-impl Default for BindConfig {
-    fn default() -> Self {
-        Self {
-            cpu_weights: true,
-            gpu_buffer: false,
-            batch: BatchSize::default(),
-        }
-    }
-}
-
-/// Everything a bind reads; owned so that it can move to the worker thread.
-#[derive(Clone, Debug)]
-pub struct BindInput {
-    pub points: Vec<DVec3>,
-    /// From [`crate::geometry::classify_points`] for the same points and cage.
-    pub classes: Vec<PointClass>,
-    pub cage: Cage,
-    pub options: BindOptions,
-}
-
-/// Dense row-major f32 weights (same layout as [`Weights`]) in a GPU buffer with
-/// `STORAGE | COPY_SRC | COPY_DST` usage.
-#[derive(Clone, Debug)]
-pub struct GpuWeights {
-    pub buffer: wgpu::Buffer,
-    pub rows: usize,
-    pub cols: usize,
-}
-
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct BindStats {
-    /// Wall time of the whole bind, uploads and readbacks included.
-    pub elapsed: Duration,
-    pub batches: usize,
-    /// Rows computed by the GPU kernels.
-    pub gpu_rows: usize,
-    /// Rows computed on the CPU: on the surface, outside, or flagged by a kernel.
-    pub cpu_rows: usize,
-    /// Where it ran.
-    pub device: String,
-}
-
-#[derive(Debug)]
-pub struct BindOutput {
-    pub weights: Option<Weights>,
-    pub gpu_weights: Option<GpuWeights>,
-    pub stats: BindStats,
-}
-
-#[derive(Debug, thiserror::Error)]
-pub enum BindError {
-    #[error("binding was cancelled")]
-    Cancelled,
-    #[error(transparent)]
-    Gpu(#[from] GpuError),
-    #[error("invalid bind input: {0}")]
-    InvalidInput(String),
-    #[error("the binding thread panicked")]
-    Panicked,
-}
-
-impl From<coords::Cancelled> for BindError {
-    fn from(_: coords::Cancelled) -> Self {
-        BindError::Cancelled
-    }
-}
-
-/// Starts binds on a backend.
-#[derive(Clone, Debug)]
-pub struct Binder {
-    pub backend: Backend,
-    pub config: BindConfig,
-}
-
-impl Binder {
-    pub fn new(backend: Backend) -> Self {
-        Self {
-            backend,
-            config: BindConfig::default(),
-        }
-    }
-
-    pub fn with_config(mut self, config: BindConfig) -> Self {
-        self.config = config;
-        self
-    }
-
-    /// Start binding on a background thread.
-    pub fn start(&self, input: BindInput) -> BindHandle {
-        let progress = Arc::new(BindProgress::default());
-        let total = input.points.len();
-        let worker_progress = Arc::clone(&progress);
-        let backend = self.backend.clone();
-        let config = self.config;
-        let thread = std::thread::Builder::new()
-            .name("pmvc-bind".into())
-            .spawn(move || run(&input, &backend, config, &worker_progress));
-        match thread {
-            Ok(thread) => BindHandle {
-                progress,
-                total,
-                thread: Some(thread),
-                early: None,
-            },
-            Err(error) => BindHandle {
-                progress,
-                total,
-                thread: None,
-                early: Some(Err(BindError::InvalidInput(format!(
-                    "could not start the binding thread: {error}"
-                )))),
-            },
-        }
-    }
-
-    /// Bind on the calling thread.
-    pub fn bind_blocking(&self, input: &BindInput) -> Result<BindOutput, BindError> {
-        run(input, &self.backend, self.config, &BindProgress::default())
-    }
-}
-
-/// Bind synchronously; for the command line and `pmvc bench` (the elapsed time in
-/// [`BindStats`] includes uploads and readbacks).
-pub fn bind_blocking(
-    input: &BindInput,
-    backend: &Backend,
-    config: BindConfig,
-) -> Result<BindOutput, BindError> {
-    run(input, backend, config, &BindProgress::default())
-}
-
-/// A running bind. Dropping it cancels the bind.
-#[derive(Debug)]
-pub struct BindHandle {
-    progress: Arc<BindProgress>,
-    total: usize,
-    thread: Option<JoinHandle<Result<BindOutput, BindError>>>,
-    /// A result known before any thread ran.
-    early: Option<Result<BindOutput, BindError>>,
-}
-
-impl BindHandle {
-    /// `(done, total)` mesh vertices; `done` never decreases.
-    pub fn progress(&self) -> (usize, usize) {
-        (self.progress.done().min(self.total), self.total)
-    }
-
-    /// Ask the bind to stop; it ends with [`BindError::Cancelled`] within one batch.
-    pub fn cancel(&self) {
-        self.progress.cancel();
-    }
-
-    pub fn is_finished(&self) -> bool {
-        self.thread.as_ref().is_none_or(JoinHandle::is_finished)
-    }
-
-    /// The result once finished; `None` while running or after it was taken.
-    pub fn try_take(&mut self) -> Option<Result<BindOutput, BindError>> {
-        if let Some(result) = self.early.take() {
-            return Some(result);
-        }
-        if !self.thread.as_ref()?.is_finished() {
-            return None;
-        }
-        self.thread.take().map(join)
-    }
-
-    /// Wait for the result.
-    pub fn wait(mut self) -> Result<BindOutput, BindError> {
-        if let Some(result) = self.early.take() {
-            return result;
-        }
-        match self.thread.take() {
-            Some(thread) => join(thread),
-            None => Err(BindError::InvalidInput(
-                "the result was already taken".into(),
-            )),
-        }
-    }
-}
-
-impl Drop for BindHandle {
-    fn drop(&mut self) {
-        if self.thread.is_some() {
-            self.progress.cancel();
-        }
-    }
-}
-
-fn join(thread: JoinHandle<Result<BindOutput, BindError>>) -> Result<BindOutput, BindError> {
-    thread.join().unwrap_or(Err(BindError::Panicked))
-}
-
-fn run(
-    input: &BindInput,
-    backend: &Backend,
-    config: BindConfig,
-    progress: &BindProgress,
-) -> Result<BindOutput, BindError> {
-    validate(input)?;
-    let started = Instant::now();
-    match backend {
-        Backend::Cpu => {
-            let weights = coords::bind_cpu(
-                &input.points,
-                &input.classes,
-                &input.cage,
-                input.options,
-                progress,
-            )?;
-            Ok(BindOutput {
-                weights: Some(weights),
-                gpu_weights: None,
-                stats: BindStats {
-                    elapsed: started.elapsed(),
-                    batches: 1,
-                    gpu_rows: 0,
-                    cpu_rows: input.points.len(),
-                    device: "CPU".into(),
-                },
-            })
-        }
-        Backend::Gpu(_) if !config.cpu_weights && !config.gpu_buffer => Err(
-            BindError::InvalidInput("the bind keeps neither CPU nor GPU weights".into()),
-        ),
-        Backend::Gpu(context) => {
-            let mut output = GpuBind::new(context, input, config)?.run(progress)?;
-            output.stats.elapsed = started.elapsed();
-            Ok(output)
-        }
-    }
-}
-
-fn validate(input: &BindInput) -> Result<(), BindError> {
-    let invalid = |message: String| Err(BindError::InvalidInput(message));
-    if input.points.len() != input.classes.len() {
-        return invalid(format!(
-            "{} points but {} classes",
-            input.points.len(),
-            input.classes.len()
-        ));
-    }
-    let vertices = input.cage.vertex_count();
-    let triangles = input.cage.triangles.len();
-    if let Some(t) = input
-        .cage
-        .triangles
-        .iter()
-        .position(|corners| corners.iter().any(|&c| c as usize >= vertices))
-    {
-        return invalid(format!("cage triangle {t} has a corner out of range"));
-    }
-    let on_missing_triangle = input.classes.iter().any(
-        |c| matches!(c, PointClass::OnSurface { triangle, .. } if *triangle as usize >= triangles),
+/// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
+/// the same row loop as a CPU bind.
+fn cpu_rows(input: &BindInput, rows: &[usize]) -> Vec<f32> {
+    let mut out = vec![0.0f32; rows.len() * input.cage.vertex_count()];
+    // A batch's own progress: the bind advances once per batch.
+    let batch_progress = BindProgress::default();
+    let finished = coords::bind_rows(
+        &input.points,
+        &input.classes,
+        &input.cage,
+        input.options,
+        rows,
+        &mut out,
+        &batch_progress,
     );
-    if on_missing_triangle {
-        return invalid("a point is classed on a triangle the cage does not have".into());
-    }
-    if input.options.method == Method::Pmvc && input.options.resolution == 0 {
-        return invalid("the cube-map resolution must be positive".into());
-    }
-    if input.points.iter().any(|p| !p.is_finite())
-        || input.cage.positions.iter().any(|p| !p.is_finite())
-    {
-        return invalid("coordinates must be finite".into());
-    }
-    Ok(())
-}
-
-/// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`].
-fn cpu_rows(input: &BindInput, table: &TexelTable, rows: &[usize]) -> Vec<f32> {
-    let cols = input.cage.vertex_count();
-    let mut out = vec![0.0f32; rows.len() * cols];
-    out.par_chunks_mut(cols.max(1))
-        .zip(rows.par_iter())
-        .for_each_init(
-            || {
-                (
-                    vec![0.0f64; cols],
-                    coords::mvc::MvcScratch::default(),
-                    coords::pmvc::PmvcScratch::default(),
-                )
-            },
-            |(row_f64, mvc, pmvc), (out_row, &row)| {
-                coords::weights_at(
-                    input.points[row],
-                    input.classes[row],
-                    &input.cage,
-                    input.options.method,
-                    table,
-                    row_f64,
-                    mvc,
-                    pmvc,
-                );
-                for (out, &value) in out_row.iter_mut().zip(row_f64.iter()) {
-                    *out = value as f32;
-                }
-            },
-        );
+    debug_assert!(
+        finished.is_ok(),
+        "a batch's own progress is never cancelled"
+    );
     out
 }
 
 /// Device buffers and state of one GPU bind.
-struct GpuBind<'a> {
+pub(super) struct GpuBind<'a> {
     context: &'a GpuContext,
     input: &'a BindInput,
     config: BindConfig,
-    table: TexelTable,
     centre: DVec3,
     rows: usize,
     cols: usize,
@@ -415,7 +84,7 @@ fn scoped<T>(
 }
 
 impl<'a> GpuBind<'a> {
-    fn new(
+    pub(super) fn new(
         context: &'a GpuContext,
         input: &'a BindInput,
         config: BindConfig,
@@ -426,13 +95,14 @@ impl<'a> GpuBind<'a> {
         }
         let rows = input.points.len();
         let cols = input.cage.vertex_count();
-        let triangles = input.cage.triangles.len();
+        let triangles = input.cage.triangle_count();
         let method = input.options.method;
         let resolution = input.options.resolution.max(1);
         if method == Method::Pmvc && resolution > BAND_TEXELS {
-            return Err(BindError::InvalidInput(format!(
-                "the GPU supports cube-map resolutions up to {BAND_TEXELS}, not {resolution}"
-            )));
+            return Err(BindError::ResolutionTooHigh {
+                asked: resolution,
+                max: BAND_TEXELS,
+            });
         }
         let limits = &context.limits;
         let limit = limits
@@ -481,11 +151,10 @@ impl<'a> GpuBind<'a> {
             .min(rows)
             .max(1);
 
-        let (lo, hi) = bounds_of(&input.cage.positions);
+        let (lo, hi) = bounds_of(input.cage.positions());
         // Relative to the cage centre, so f32 keeps the precision of the differences.
         let centre = 0.5 * (lo + hi);
         let table = TexelTable::new(resolution);
-
         scoped(&context.device, || {
             let device = &context.device;
             // Not `create_buffer_init`: it panics when the device is lost.
@@ -501,7 +170,7 @@ impl<'a> GpuBind<'a> {
             };
             let positions: Vec<[f32; 4]> = input
                 .cage
-                .positions
+                .positions()
                 .iter()
                 .map(|&p| {
                     let p = (p - centre).as_vec3();
@@ -596,7 +265,6 @@ impl<'a> GpuBind<'a> {
                 context,
                 input,
                 config,
-                table,
                 centre,
                 rows,
                 cols,
@@ -615,7 +283,7 @@ impl<'a> GpuBind<'a> {
         .map_err(BindError::from)
     }
 
-    fn run(self, progress: &BindProgress) -> Result<BindOutput, BindError> {
+    pub(super) fn run(self, progress: &BindProgress) -> Result<BindOutput, BindError> {
         let mut weights = self
             .config
             .cpu_weights
@@ -630,7 +298,7 @@ impl<'a> GpuBind<'a> {
             // a row costs about one triangle loop (MVC) or a few hundred per
             // triangle (PMVC: bounds walks over the cube map).
             BatchSize::Adaptive { .. } => {
-                let triangles = self.input.cage.triangles.len().max(1);
+                let triangles = self.input.cage.triangle_count().max(1);
                 match self.input.options.method {
                     Method::Pmvc => 2048 / triangles,
                     Method::Mvc => 65536 / triangles,
@@ -700,7 +368,7 @@ impl<'a> GpuBind<'a> {
         let (inside, cpu): (Vec<usize>, Vec<usize>) = range
             .clone()
             .partition(|&row| matches!(input.classes[row], PointClass::Inside));
-        let cpu_values = cpu_rows(input, &self.table, &cpu);
+        let cpu_values = cpu_rows(input, &cpu);
         stats.cpu_rows += cpu.len();
         stats.gpu_rows += inside.len();
         if let Some(weights) = weights.as_deref_mut() {
@@ -797,11 +465,11 @@ impl<'a> GpuBind<'a> {
             if inside.is_empty() {
                 return self.wait().map(|()| Vec::new());
             }
-            let status = read_back(self, &self.status_readback, status_bytes)?;
+            let status: Vec<u32> = read_back(self, &self.status_readback, status_bytes)?;
             if let (Some(readback), Some(weights)) =
                 (&self.weights_readback, weights.as_deref_mut())
             {
-                let block = read_back(self, readback, block_bytes)?;
+                let block: Vec<f32> = read_back(self, readback, block_bytes)?;
                 for &row in &inside {
                     let local = row - range.start;
                     weights.values[row * cols..(row + 1) * cols]
@@ -811,13 +479,13 @@ impl<'a> GpuBind<'a> {
             Ok(inside
                 .iter()
                 .zip(&status)
-                .filter(|(_, &s)| s.to_bits() & FALLBACK != 0)
+                .filter(|(_, &status)| status & FALLBACK != 0)
                 .map(|(&row, _)| row)
                 .collect::<Vec<usize>>())
         })?;
 
         if !flagged.is_empty() {
-            let values = cpu_rows(input, &self.table, &flagged);
+            let values = cpu_rows(input, &flagged);
             stats.cpu_rows += flagged.len();
             stats.gpu_rows -= flagged.len();
             for (k, &row) in flagged.iter().enumerate() {
@@ -856,12 +524,12 @@ fn padded<T: Default + Clone>(mut values: Vec<T>) -> Vec<T> {
 /// Triangle corners, then the vertex → incident-corner CSR, and the kernel params
 /// that locate them.
 fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u32>, Params) {
-    let triangles = cage.triangles.len();
+    let triangles = cage.triangle_count();
     let vertices = cage.vertex_count();
-    let mut topology: Vec<u32> = cage.triangles.iter().flatten().copied().collect();
+    let mut topology: Vec<u32> = cage.triangles().iter().flatten().copied().collect();
     let offsets_at = topology.len();
     let mut counts = vec![0u32; vertices + 1];
-    for &corner in cage.triangles.iter().flatten() {
+    for &corner in cage.triangles().iter().flatten() {
         counts[corner as usize + 1] += 1;
     }
     for v in 0..vertices {
@@ -871,7 +539,7 @@ fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u
     let entries_at = topology.len();
     topology.resize(entries_at + 3 * triangles, 0);
     let mut next = counts;
-    for (t, corners) in cage.triangles.iter().enumerate() {
+    for (t, corners) in cage.triangles().iter().enumerate() {
         for (k, &corner) in corners.iter().enumerate() {
             let slot = &mut next[corner as usize];
             topology[entries_at + *slot as usize] = (3 * t + k) as u32;
@@ -896,8 +564,12 @@ fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u
     (topology, params)
 }
 
-/// Map `buffer`, wait for the device, and copy out its first `bytes` as f32.
-fn read_back(bind: &GpuBind<'_>, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<f32>, GpuError> {
+/// Map `buffer`, wait for the device, and copy out its first `bytes` as `T`s.
+fn read_back<T: bytemuck::Pod>(
+    bind: &GpuBind<'_>,
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<T>, GpuError> {
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..bytes, move |result| {
         let _ = sender.send(result);
@@ -912,7 +584,7 @@ fn read_back(bind: &GpuBind<'_>, buffer: &wgpu::Buffer, bytes: u64) -> Result<Ve
         let view = buffer
             .get_mapped_range(0..bytes)
             .map_err(|e| GpuError::Readback(e.to_string()))?;
-        bytemuck::pod_collect_to_vec::<u8, f32>(&view)
+        bytemuck::pod_collect_to_vec::<u8, T>(&view)
     };
     buffer.unmap();
     Ok(values)

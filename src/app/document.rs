@@ -1,0 +1,372 @@
+//! What the editor edits: a mesh bound to a cage, the cage's pose, the selected
+//! handles, each method's weights once bound, and the undo history of poses.
+//!
+//! The fields are private. Every mutator records what it changed in [`Changes`],
+//! which the editor takes once per frame to update the GPU, and bumps a revision
+//! that the CPU caches compare against, so no code can change the pose or the
+//! weights without the GPU copy and the caches learning about it.
+
+use super::history::PoseHistory;
+use crate::coords::{BindOptions, Method, WeightQuality, Weights};
+use crate::geometry::{Cage, MeshFile, TriMesh};
+use glam::DVec3;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// One method's weights for the document's mesh and cage, and how they were made.
+#[derive(Clone, Debug)]
+pub struct WeightSet {
+    pub weights: Arc<Weights>,
+    pub options: BindOptions,
+    pub bind_time: Duration,
+    /// Where the bind ran ("CPU" or the GPU's description).
+    pub device: String,
+    pub quality: WeightQuality,
+}
+
+/// What changed since the editor last took the changes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Changes {
+    /// A new mesh or cage: every GPU buffer must be rebuilt.
+    pub scene: bool,
+    pub pose: bool,
+    pub selection: bool,
+    /// Methods whose weights arrived.
+    pub weights: BTreeSet<Method>,
+}
+
+/// A mesh, its cage, the pose and the weights.
+#[derive(Clone, Debug)]
+pub struct Document {
+    title: String,
+    mesh: Arc<TriMesh>,
+    /// The file the mesh came from: exports keep its faces, groups and materials.
+    mesh_file: Option<MeshFile>,
+    /// The cage at rest, as bound.
+    cage: Arc<Cage>,
+    cage_path: Option<PathBuf>,
+    /// The deformed cage: one position per cage vertex.
+    pose: Vec<DVec3>,
+    selection: BTreeSet<usize>,
+    weight_sets: BTreeMap<Method, WeightSet>,
+    /// Mesh vertices outside the cage, ascending; known once classified.
+    outside: Arc<[u32]>,
+    history: PoseHistory,
+    changes: Changes,
+    /// Bumped by every pose change, so caches of deformed positions can tell.
+    pose_revision: u64,
+}
+
+impl Document {
+    pub fn new(title: impl Into<String>, mesh: TriMesh, cage: Cage) -> Self {
+        Self {
+            title: title.into(),
+            pose: cage.positions().to_vec(),
+            mesh: Arc::new(mesh),
+            mesh_file: None,
+            cage: Arc::new(cage),
+            cage_path: None,
+            selection: BTreeSet::new(),
+            weight_sets: BTreeMap::new(),
+            outside: Arc::from([]),
+            history: PoseHistory::default(),
+            changes: Changes {
+                scene: true,
+                pose: true,
+                selection: true,
+                weights: BTreeSet::new(),
+            },
+            pose_revision: 0,
+        }
+    }
+
+    /// The same document with the file paths it was loaded from.
+    pub fn with_files(mut self, mesh_file: Option<MeshFile>, cage_path: Option<PathBuf>) -> Self {
+        self.mesh_file = mesh_file;
+        self.cage_path = cage_path;
+        self
+    }
+
+    /// The same mesh with another rest cage, posed as `pose`; weights, selection
+    /// and history start afresh, since they belong to the old cage.
+    pub fn with_cage(&self, cage: Cage, cage_path: Option<PathBuf>, pose: Vec<DVec3>) -> Self {
+        let mut document = Document::new(self.title.clone(), (*self.mesh).clone(), cage);
+        document.mesh_file = self.mesh_file.clone();
+        document.cage_path = cage_path;
+        if pose.len() == document.pose.len() {
+            document.pose = pose;
+        }
+        document
+    }
+
+    pub fn title(&self) -> &str {
+        &self.title
+    }
+
+    pub fn mesh(&self) -> &Arc<TriMesh> {
+        &self.mesh
+    }
+
+    pub fn mesh_file(&self) -> Option<&MeshFile> {
+        self.mesh_file.as_ref()
+    }
+
+    /// The cage at rest.
+    pub fn cage(&self) -> &Arc<Cage> {
+        &self.cage
+    }
+
+    pub fn cage_path(&self) -> Option<&Path> {
+        self.cage_path.as_deref()
+    }
+
+    pub fn pose(&self) -> &[DVec3] {
+        &self.pose
+    }
+
+    pub fn pose_revision(&self) -> u64 {
+        self.pose_revision
+    }
+
+    pub fn selection(&self) -> &BTreeSet<usize> {
+        &self.selection
+    }
+
+    pub fn outside(&self) -> &[u32] {
+        &self.outside
+    }
+
+    pub fn history(&self) -> &PoseHistory {
+        &self.history
+    }
+
+    /// `method`'s weights and their bind, once bound.
+    pub fn bound(&self, method: Method) -> Option<&WeightSet> {
+        self.weight_sets.get(&method)
+    }
+
+    /// `method`'s weights, once bound.
+    pub fn weights(&self, method: Method) -> Option<&Arc<Weights>> {
+        self.bound(method).map(|set| &set.weights)
+    }
+
+    /// The methods bound so far, in [`Method::ALL`] order.
+    pub fn bound_methods(&self) -> impl Iterator<Item = Method> + '_ {
+        self.weight_sets.keys().copied()
+    }
+
+    /// The mesh deformed with `method` on the CPU in f64 (for export), or the
+    /// rest mesh before that method is bound. Displacement form: exact at rest.
+    pub fn deformed_positions(&self, method: Method) -> Vec<DVec3> {
+        match self.weights(method) {
+            Some(weights) => {
+                let moves = method.column_displacements(&self.cage, &self.pose);
+                weights.apply_displacements(&self.mesh.positions, &moves)
+            }
+            None => self.mesh.positions.clone(),
+        }
+    }
+
+    /// Centre and radius of a sphere around the mesh and the posed cage.
+    pub fn bounding_sphere(&self) -> (DVec3, f64) {
+        let points: Vec<DVec3> = self
+            .mesh
+            .positions
+            .iter()
+            .chain(&self.pose)
+            .copied()
+            .collect();
+        let (lo, hi) = crate::geometry::bounds_of(&points);
+        ((lo + hi) / 2.0, ((hi - lo).length() / 2.0).max(1e-6))
+    }
+
+    /// What changed since the last call; the editor applies it to the GPU.
+    pub fn take_changes(&mut self) -> Changes {
+        std::mem::take(&mut self.changes)
+    }
+
+    // ---- pose -----------------------------------------------------------------
+
+    /// Show `pose` without recording an undo step (a drag in progress, whose
+    /// start is recorded once with [`Self::record_undo_point`]).
+    pub fn preview_pose(&mut self, pose: Vec<DVec3>) {
+        if pose.len() == self.pose.len() && pose != self.pose {
+            self.pose = pose;
+            self.pose_changed();
+        }
+    }
+
+    /// Change the pose as one undo step.
+    pub fn edit_pose(&mut self, pose: Vec<DVec3>) {
+        if pose.len() == self.pose.len() && pose != self.pose {
+            self.history.record(self.pose.clone());
+            self.pose = pose;
+            self.pose_changed();
+        }
+    }
+
+    /// Record `before` as the pose to return to: the start of a drag that has
+    /// since moved the pose with [`Self::preview_pose`].
+    pub fn record_undo_point(&mut self, before: Vec<DVec3>) {
+        if before != self.pose {
+            self.history.record(before);
+        }
+    }
+
+    pub fn undo(&mut self) {
+        if let Some(pose) = self.history.undo(&self.pose) {
+            self.pose = pose;
+            self.pose_changed();
+        }
+    }
+
+    pub fn redo(&mut self) {
+        if let Some(pose) = self.history.redo(&self.pose) {
+            self.pose = pose;
+            self.pose_changed();
+        }
+    }
+
+    pub fn reset_pose(&mut self) {
+        let rest = self.cage.positions().to_vec();
+        self.edit_pose(rest);
+    }
+
+    /// Move one handle to `position` as one undo step.
+    pub fn set_handle_position(&mut self, handle: usize, position: DVec3) {
+        if let Some(&current) = self.pose.get(handle) {
+            if current != position {
+                let mut pose = self.pose.clone();
+                pose[handle] = position;
+                self.edit_pose(pose);
+            }
+        }
+    }
+
+    fn pose_changed(&mut self) {
+        self.changes.pose = true;
+        self.pose_revision += 1;
+    }
+
+    // ---- selection ------------------------------------------------------------
+
+    pub fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
+        let count = self.pose.len();
+        let selection: BTreeSet<usize> = handles.into_iter().filter(|&h| h < count).collect();
+        if selection != self.selection {
+            self.selection = selection;
+            self.changes.selection = true;
+        }
+    }
+
+    /// Add `handles` to the selection.
+    pub fn select_more(&mut self, handles: impl IntoIterator<Item = usize>) {
+        let mut selection = self.selection.clone();
+        selection.extend(handles);
+        self.select_only(selection);
+    }
+
+    /// Select `handle` if it is not selected, else deselect it.
+    pub fn toggle_selected(&mut self, handle: usize) {
+        let mut selection = self.selection.clone();
+        if !selection.remove(&handle) {
+            selection.insert(handle);
+        }
+        self.select_only(selection);
+    }
+
+    // ---- weights --------------------------------------------------------------
+
+    /// Install `method`'s weights, if they fit this document's mesh and cage
+    /// (a bind for a scene that has since been replaced does not).
+    pub fn install_weights(&mut self, method: Method, set: WeightSet, outside: Arc<[u32]>) -> bool {
+        let fits = set.weights.rows == self.mesh.positions.len()
+            && set.weights.cols == method.columns(&self.cage);
+        if fits {
+            self.weight_sets.insert(method, set);
+            self.outside = outside;
+            self.changes.weights.insert(method);
+        }
+        fits
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::procedural::cube_cage;
+
+    fn document() -> Document {
+        let mesh = TriMesh {
+            positions: vec![DVec3::ZERO],
+            ..TriMesh::default()
+        };
+        let mut document = Document::new("test", mesh, cube_cage(1.0));
+        document.take_changes();
+        document
+    }
+
+    #[test]
+    fn every_pose_change_is_reported_and_bumps_the_revision() {
+        let mut document = document();
+        let mut pose = document.pose().to_vec();
+        pose[0] += DVec3::X;
+        document.edit_pose(pose);
+        assert!(document.take_changes().pose);
+        assert_eq!(document.pose_revision(), 1);
+        document.undo();
+        assert!(document.take_changes().pose);
+        assert_eq!(document.pose(), document.cage().positions());
+        document.redo();
+        assert_eq!(document.pose_revision(), 3);
+        assert!(document.take_changes().pose);
+        // A no-op edit changes nothing and records no undo step.
+        document.edit_pose(document.pose().to_vec());
+        assert_eq!(document.take_changes(), Changes::default());
+    }
+
+    #[test]
+    fn a_drag_is_one_undo_step() {
+        let mut document = document();
+        let start = document.pose().to_vec();
+        for step in 1..=5 {
+            let mut pose = start.clone();
+            pose[2].y += f64::from(step);
+            document.preview_pose(pose);
+        }
+        document.record_undo_point(start.clone());
+        document.undo();
+        assert_eq!(document.pose(), start.as_slice());
+        assert!(!document.history().can_undo());
+    }
+
+    #[test]
+    fn weights_of_another_shape_are_refused() {
+        let mut document = document();
+        let set = |rows, cols| WeightSet {
+            weights: Arc::new(Weights::zeros(rows, cols)),
+            options: BindOptions::default(),
+            bind_time: Duration::ZERO,
+            device: "CPU".into(),
+            quality: WeightQuality::default(),
+        };
+        assert!(!document.install_weights(Method::Pmvc, set(2, 8), Arc::from([])));
+        assert!(document.bound(Method::Pmvc).is_none());
+        assert!(document.install_weights(Method::Pmvc, set(1, 8), Arc::from([])));
+        assert!(document.take_changes().weights.contains(&Method::Pmvc));
+    }
+
+    #[test]
+    fn selection_ignores_handles_the_cage_does_not_have() {
+        let mut document = document();
+        document.select_only([1, 99]);
+        assert_eq!(
+            document.selection().iter().copied().collect::<Vec<_>>(),
+            [1]
+        );
+        document.toggle_selected(1);
+        assert!(document.selection().is_empty());
+    }
+}

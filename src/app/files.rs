@@ -1,0 +1,205 @@
+//! File actions: opening meshes, cages and bundled scenes, poses, export, and
+//! dropped files. A file that fails to load or validate changes nothing.
+
+use super::document::Document;
+use super::editor::{EditorApp, FileRole};
+use super::scenes::BundledScene;
+use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
+use std::path::{Path, PathBuf};
+
+/// Recent files kept in the File menu.
+const RECENT_LIMIT: usize = 8;
+
+fn file_title(path: &Path) -> String {
+    path.file_name()
+        .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned())
+}
+
+impl EditorApp {
+    fn remember(&mut self, role: FileRole, path: &Path) {
+        let entry = (role, path.to_owned());
+        self.recent.retain(|e| *e != entry);
+        self.recent.insert(0, entry);
+        self.recent.truncate(RECENT_LIMIT);
+    }
+
+    /// Open a mesh and cage together; on any failure the current scene stays.
+    pub(super) fn open_pair(&mut self, mesh_path: &Path, cage_path: &Path) -> bool {
+        let mesh = match load_mesh(mesh_path) {
+            Ok(mesh) => mesh,
+            Err(error) => {
+                self.error(error.to_string());
+                return false;
+            }
+        };
+        let (cage, report) = match load_cage(cage_path) {
+            Ok(cage) => cage,
+            Err(error) => {
+                self.error(error.to_string());
+                return false;
+            }
+        };
+        for message in report.messages() {
+            self.info(message);
+        }
+        let document = Document::new(file_title(mesh_path), mesh.mesh.clone(), cage)
+            .with_files(Some(mesh), Some(cage_path.to_owned()));
+        self.install_document(document);
+        self.remember(FileRole::Mesh, mesh_path);
+        self.remember(FileRole::Cage, cage_path);
+        true
+    }
+
+    /// Replace the mesh (keeping the cage) or the cage (keeping the mesh), then
+    /// rebind. A file that fails to load or validate changes nothing.
+    pub fn open_file(&mut self, role: FileRole, path: &Path) -> bool {
+        let document = match role {
+            FileRole::Mesh => match load_mesh(path) {
+                Ok(file) => Document::new(
+                    file_title(path),
+                    file.mesh.clone(),
+                    (**self.document.cage()).clone(),
+                )
+                .with_files(Some(file), self.document.cage_path().map(Into::into)),
+                Err(error) => {
+                    self.error(error.to_string());
+                    return false;
+                }
+            },
+            FileRole::Cage => match load_cage(path) {
+                Ok((cage, report)) => {
+                    for message in report.messages() {
+                        self.info(message);
+                    }
+                    let rest = cage.positions().to_vec();
+                    self.document.with_cage(cage, Some(path.to_owned()), rest)
+                }
+                Err(error) => {
+                    self.error(error.to_string());
+                    return false;
+                }
+            },
+        };
+        self.install_document(document);
+        self.remember(role, path);
+        self.info(format!("opened {}", path.display()));
+        self.start_bind();
+        true
+    }
+
+    pub fn open_bundled(&mut self, bundled: BundledScene) {
+        let (mesh, cage) = bundled.build();
+        self.install_document(Document::new(bundled.title(), mesh, cage));
+        self.start_bind();
+    }
+
+    /// Load a pose: a cage-shaped OBJ/OFF with one vertex per cage vertex.
+    pub fn load_pose(&mut self, path: &Path) -> bool {
+        let cage_vertices = self.document.pose().len();
+        match load_mesh(path) {
+            Ok(file) if file.mesh.positions.len() == cage_vertices => {
+                self.document.edit_pose(file.mesh.positions);
+                self.info(format!("loaded pose {}", path.display()));
+                true
+            }
+            Ok(file) => {
+                self.error(format!(
+                    "{}: the pose has {} vertices but the cage has {cage_vertices}",
+                    path.display(),
+                    file.mesh.positions.len(),
+                ));
+                false
+            }
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
+        }
+    }
+
+    pub fn save_pose(&mut self, path: &Path) {
+        let cage = self.document.cage();
+        let posed = TriMesh {
+            positions: self.document.pose().to_vec(),
+            triangles: cage.triangles().to_vec(),
+            triangle_faces: cage.triangle_faces().to_vec(),
+        };
+        match write_obj(path, &posed) {
+            Ok(()) => self.info(format!("saved pose {}", path.display())),
+            Err(error) => self.error(error.to_string()),
+        }
+    }
+
+    /// Write the mesh deformed with the active method.
+    pub fn export_deformed(&mut self, path: &Path) {
+        let positions = self.document.deformed_positions(self.active_method());
+        let result = match self.document.mesh_file() {
+            Some(file) => write_deformed_mesh(file, &positions, path),
+            None => write_obj(
+                path,
+                &TriMesh {
+                    positions,
+                    ..(**self.document.mesh()).clone()
+                },
+            ),
+        };
+        match result {
+            Ok(()) => self.info(format!("exported {}", path.display())),
+            Err(error) => self.error(error.to_string()),
+        }
+    }
+
+    /// Rest the cage in its current pose and rebind.
+    pub(super) fn pose_as_rest(&mut self) {
+        let cage = self
+            .document
+            .cage()
+            .with_positions(self.document.pose().to_vec());
+        let rest = cage.positions().to_vec();
+        let document =
+            self.document
+                .with_cage(cage, self.document.cage_path().map(Into::into), rest);
+        self.install_document(document);
+        self.start_bind();
+    }
+
+    pub(super) fn handle_dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_owned())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for path in dropped {
+            // A file whose name mentions "cage" replaces the cage; anything else the mesh.
+            let is_cage = path
+                .file_name()
+                .is_some_and(|n| n.to_string_lossy().to_lowercase().contains("cage"));
+            let role = if is_cage {
+                FileRole::Cage
+            } else {
+                FileRole::Mesh
+            };
+            self.open_file(role, &path);
+        }
+    }
+}
+
+/// The system's file dialog for opening a mesh-like file.
+pub(super) fn pick_file(title: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .set_title(title)
+        .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
+        .pick_file()
+}
+
+/// The system's file dialog for saving an OBJ.
+pub(super) fn save_file(title: &str, name: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .set_title(title)
+        .set_file_name(name)
+        .add_filter("OBJ", &["obj"])
+        .save_file()
+}

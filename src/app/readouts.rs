@@ -1,0 +1,158 @@
+//! The CPU read-outs behind the views: the mesh deformed per method (hover
+//! picking, the difference's colour bar) and the ranges the colour bars report.
+//! Cached, and invalidated by the document's changes, so a drag frame computes
+//! nothing here unless a colour bar needs it.
+
+use super::compare::{self, Pane, ValueRange};
+use super::document::Changes;
+use super::editor::EditorApp;
+use crate::coords::Method;
+use crate::render::{Colouring, Shading};
+use glam::Vec3;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// A range is keyed by what it shows and the methods it reads.
+type RangeKey = (Colouring, Method, Option<Method>);
+
+#[derive(Default)]
+pub(super) struct ReadoutCache {
+    /// The mesh deformed per method, with the pose revision it was made for.
+    deformed: BTreeMap<Method, (u64, Arc<Vec<Vec3>>)>,
+    /// Colour-bar ranges (a row-minimum scan of a large matrix is too slow to
+    /// repeat every frame).
+    ranges: Vec<(RangeKey, Option<ValueRange>)>,
+}
+
+impl ReadoutCache {
+    pub fn clear(&mut self) {
+        self.deformed.clear();
+        self.ranges.clear();
+    }
+
+    /// Forget what `changes` make stale.
+    pub fn invalidate(&mut self, changes: &Changes) {
+        if changes.scene {
+            self.clear();
+            return;
+        }
+        for method in &changes.weights {
+            self.deformed.remove(method);
+        }
+        let weights_changed = |key: &RangeKey| {
+            changes.weights.contains(&key.1) || key.2.is_some_and(|m| changes.weights.contains(&m))
+        };
+        // Distances depend on the pose; weights and their ranges do not.
+        self.ranges.retain(|(key, _)| {
+            !weights_changed(key) && !(changes.pose && key.0 == Colouring::MethodDistance)
+        });
+    }
+}
+
+impl EditorApp {
+    /// The mesh deformed with `method` on the CPU for the current pose (cached).
+    pub(super) fn deformed_on_cpu(&mut self, method: Method) -> Option<Arc<Vec<Vec3>>> {
+        let revision = self.document.pose_revision();
+        if let Some((made_for, positions)) = self.readouts.deformed.get(&method) {
+            if *made_for == revision {
+                return Some(Arc::clone(positions));
+            }
+        }
+        let weights = self.document.weights(method)?;
+        let moves = method.column_displacements(self.document.cage(), self.document.pose());
+        let positions = Arc::new(compare::deform(
+            weights,
+            &self.document.mesh().positions,
+            &moves,
+        ));
+        self.readouts
+            .deformed
+            .insert(method, (revision, Arc::clone(&positions)));
+        Some(positions)
+    }
+
+    /// Screen position of mesh vertex `vertex` as drawn in view `pane`.
+    pub fn mesh_vertex_screen_position(
+        &mut self,
+        pane: usize,
+        vertex: usize,
+    ) -> Option<egui::Pos2> {
+        let (kind, projection) = self.viewport.pane(pane)?;
+        let positions = self.deformed_on_cpu(kind.method())?;
+        let screen = projection.project(*positions.get(vertex)?)?;
+        Some(egui::Pos2::new(screen.x, screen.y))
+    }
+
+    /// The range of the values `colouring` shows in `pane`.
+    pub fn value_range(&mut self, colouring: Colouring, pane: Pane) -> Option<ValueRange> {
+        let against = match pane {
+            Pane::Difference { against, .. } => Some(against),
+            Pane::Method(_) => None,
+        };
+        let key = (colouring, pane.method(), against);
+        if let Some((_, range)) = self.readouts.ranges.iter().find(|(k, _)| *k == key) {
+            return *range;
+        }
+        let range = self.compute_value_range(colouring, pane);
+        self.readouts.ranges.push((key, range));
+        range
+    }
+
+    fn compute_value_range(&mut self, colouring: Colouring, pane: Pane) -> Option<ValueRange> {
+        let method = pane.method();
+        match colouring {
+            Colouring::Shaded => None,
+            Colouring::CageVertexWeight(vertex) => {
+                compare::column_range(self.document.weights(method)?, vertex as usize)
+            }
+            Colouring::MostNegativeWeight => {
+                compare::row_minimum_range(self.document.weights(method)?)
+            }
+            Colouring::MethodDistance => {
+                let Pane::Difference { against, shown } = pane else {
+                    return None;
+                };
+                let a = self.deformed_on_cpu(against)?;
+                let b = self.deformed_on_cpu(shown)?;
+                let size = compare::cage_size(self.document.cage().positions()) as f32;
+                compare::distance_range(&b, &a, size)
+            }
+        }
+    }
+
+    /// The magnitude at which `colouring`'s colours saturate: the same for every
+    /// method in view, so methods are compared on one scale, side by side or when
+    /// switching.
+    fn colour_limit(&mut self, colouring: Colouring, pane: Pane) -> f32 {
+        let panes: Vec<Pane> = match colouring {
+            Colouring::MethodDistance => vec![pane],
+            _ => self
+                .wanted_methods()
+                .into_iter()
+                .map(Pane::Method)
+                .collect(),
+        };
+        let limit = panes
+            .into_iter()
+            .filter_map(|pane| self.value_range(colouring, pane))
+            .map(|range| range.magnitude())
+            .fold(0.0f32, f32::max);
+        if limit > 0.0 {
+            limit
+        } else {
+            1.0
+        }
+    }
+
+    /// How view `pane` is shaded this frame (method, colouring and colour scale).
+    pub fn shading_of(&mut self, pane: Pane) -> Shading {
+        let colouring = self.view.colouring(pane);
+        Shading {
+            method: pane.method(),
+            colouring,
+            scale: self.view.scale,
+            colour_limit: self.colour_limit(colouring, pane),
+            cage_size: compare::cage_size(self.document.cage().positions()) as f32,
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! `--screenshot`: wait for the binds, let a few frames settle, capture the
+//! window as PNG, quit.
+
+use super::editor::EditorApp;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Frames drawn after the bind before `--screenshot` captures.
+const SCREENSHOT_FRAMES: u32 = 90;
+
+pub struct ScreenshotState {
+    path: PathBuf,
+    frames_after_bind: u32,
+    requested: bool,
+    saved: Arc<AtomicBool>,
+}
+
+impl ScreenshotState {
+    pub fn new(path: PathBuf) -> Self {
+        Self {
+            path,
+            frames_after_bind: 0,
+            requested: false,
+            saved: Arc::new(AtomicBool::new(false)),
+        }
+    }
+}
+
+impl EditorApp {
+    pub(super) fn drive_screenshot(&mut self, ctx: &egui::Context) {
+        if self.screenshot.is_none() {
+            return;
+        }
+        if self.is_binding() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+            return;
+        }
+        let Some(state) = &mut self.screenshot else {
+            return;
+        };
+        if state.saved.swap(false, Ordering::Relaxed) {
+            if let Some(average) = self.stats.average() {
+                eprintln!("pmvc editor: average frame time {:.1} ms", average * 1000.0);
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        }
+        state.frames_after_bind += 1;
+        if state.frames_after_bind == 1 {
+            // Measure frame times of the idle scene only, not of the bind.
+            self.stats.restart();
+        }
+        // Frames before the capture let the GPU upload settle and give a frame-time
+        // sample of the continuously redrawn viewport.
+        if state.frames_after_bind >= SCREENSHOT_FRAMES && !state.requested {
+            state.requested = true;
+            let path = state.path.clone();
+            let saved = Arc::clone(&state.saved);
+            let repaint = ctx.clone();
+            ctx.request_screenshot(move |image| {
+                if let Err(error) = save_png(&path, &image) {
+                    eprintln!("pmvc editor: cannot save {}: {error}", path.display());
+                }
+                saved.store(true, Ordering::Relaxed);
+                repaint.request_repaint();
+            });
+        }
+        ctx.request_repaint();
+    }
+}
+
+fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageError> {
+    let [width, height] = image.size;
+    let bytes: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+    image::save_buffer(
+        path,
+        &bytes,
+        width as u32,
+        height as u32,
+        image::ColorType::Rgba8,
+    )
+}

@@ -1,0 +1,135 @@
+//! The menu bar: File, Edit, View and Scenes.
+
+use crate::app::editor::{EditorApp, FileRole};
+use crate::app::files::{pick_file, save_file};
+use crate::app::scenes::BundledScene;
+use crate::render::viewport::MSAA_SAMPLES;
+use std::path::PathBuf;
+
+impl EditorApp {
+    pub(in crate::app) fn menu_bar(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| self.file_menu(ui, &ctx));
+            ui.menu_button("Edit", |ui| self.edit_menu(ui));
+            ui.menu_button("View", |ui| self.view_menu(ui));
+            ui.menu_button("Scenes", |ui| {
+                for bundled in BundledScene::ALL {
+                    if ui.button(bundled.title()).clicked() {
+                        self.open_bundled(bundled);
+                    }
+                }
+            });
+        });
+    }
+
+    fn file_menu(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+        if ui.button("Open mesh…").clicked() {
+            if let Some(path) = pick_file("Open mesh") {
+                self.open_file(FileRole::Mesh, &path);
+            }
+        }
+        if ui.button("Open cage…").clicked() {
+            if let Some(path) = pick_file("Open cage") {
+                self.open_file(FileRole::Cage, &path);
+            }
+        }
+        ui.horizontal(|ui| {
+            ui.label("Path:");
+            ui.text_edit_singleline(&mut self.path_input);
+        });
+        ui.horizontal(|ui| {
+            let path = PathBuf::from(self.path_input.trim());
+            if ui.button("Open as mesh").clicked() {
+                self.open_file(FileRole::Mesh, &path);
+            }
+            if ui.button("Open as cage").clicked() {
+                self.open_file(FileRole::Cage, &path);
+            }
+        });
+        ui.menu_button("Recent files", |ui| {
+            if self.recent.is_empty() {
+                ui.label("(none)");
+            }
+            for (role, path) in self.recent.clone() {
+                let kind = match role {
+                    FileRole::Mesh => "mesh",
+                    FileRole::Cage => "cage",
+                };
+                if ui.button(format!("{kind} {}", path.display())).clicked() {
+                    self.open_file(role, &path);
+                }
+            }
+        });
+        ui.separator();
+        if ui.button("Load pose…").clicked() {
+            if let Some(path) = pick_file("Load pose") {
+                self.load_pose(&path);
+            }
+        }
+        if ui.button("Save pose…").clicked() {
+            if let Some(path) = save_file("Save pose", "pose.obj") {
+                self.save_pose(&path);
+            }
+        }
+        if ui.button("Export deformed mesh…").clicked() {
+            if let Some(path) = save_file("Export deformed mesh", "deformed.obj") {
+                self.export_deformed(&path);
+            }
+        }
+        ui.separator();
+        if ui.button("Quit").clicked() {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+
+    fn edit_menu(&mut self, ui: &mut egui::Ui) {
+        let history = self.document.history();
+        let (can_undo, can_redo) = (history.can_undo(), history.can_redo());
+        if ui
+            .add_enabled(can_undo, egui::Button::new("Undo (Ctrl+Z)"))
+            .clicked()
+        {
+            self.undo();
+        }
+        if ui
+            .add_enabled(can_redo, egui::Button::new("Redo (Ctrl+Shift+Z)"))
+            .clicked()
+        {
+            self.redo();
+        }
+        if ui.button("Reset pose").clicked() {
+            self.reset_pose();
+        }
+        if ui.button("Use pose as rest shape (rebind)").clicked() {
+            self.pose_as_rest();
+        }
+    }
+
+    fn view_menu(&mut self, ui: &mut egui::Ui) {
+        if ui
+            .checkbox(&mut self.show_statistics, "Statistics")
+            .changed()
+        {
+            self.stats.restart();
+        }
+        ui.checkbox(
+            &mut self.view.hover_in_shaded,
+            "Weights under the cursor (always)",
+        );
+        ui.checkbox(&mut self.highlight_outside, "Highlight outside vertices");
+        let mut antialiased = self
+            .with_renderer(|renderer, _, _| renderer.sample_count() > 1)
+            .unwrap_or(false);
+        if ui
+            .checkbox(&mut antialiased, "Anti-aliasing (4x MSAA)")
+            .changed()
+        {
+            let samples = if antialiased { MSAA_SAMPLES } else { 1 };
+            self.with_renderer(|renderer, device, _| renderer.set_sample_count(device, samples));
+        }
+        if ui.button("Frame scene (F)").clicked() {
+            self.frame_scene();
+        }
+    }
+}

@@ -1,0 +1,80 @@
+//! Messages for the user: what happened (info) and what went wrong (errors).
+
+use crate::app::editor::EditorApp;
+use egui::Color32;
+
+/// How many notices the side panel lists.
+const SHOWN: usize = 6;
+
+/// A message shown in the status area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Notice {
+    pub text: String,
+    pub is_error: bool,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Notices {
+    list: Vec<Notice>,
+}
+
+impl Notices {
+    pub fn info(&mut self, text: impl Into<String>) {
+        self.list.push(Notice {
+            text: text.into(),
+            is_error: false,
+        });
+    }
+
+    pub fn error(&mut self, text: impl Into<String>) {
+        self.list.push(Notice {
+            text: text.into(),
+            is_error: true,
+        });
+    }
+
+    pub fn all(&self) -> &[Notice] {
+        &self.list
+    }
+
+    pub fn clear(&mut self) {
+        self.list.clear();
+    }
+
+    /// The latest error, if any.
+    pub fn last_error(&self) -> Option<&str> {
+        self.list
+            .iter()
+            .rev()
+            .find(|n| n.is_error)
+            .map(|n| n.text.as_str())
+    }
+}
+
+impl EditorApp {
+    /// The latest notices, newest first, each with a button to dismiss it.
+    pub(in crate::app) fn notices_panel(&mut self, ui: &mut egui::Ui) {
+        let mut dismiss = None;
+        for (index, notice) in self.notices.list.iter().enumerate().rev().take(SHOWN) {
+            // Not horizontal_wrapped: there a text just wider than the space left
+            // beside the button widens the whole panel. Here it wraps in that space.
+            ui.horizontal_top(|ui| {
+                let colour = if notice.is_error {
+                    Color32::LIGHT_RED
+                } else {
+                    ui.visuals().text_color()
+                };
+                if ui.small_button("x").clicked() {
+                    dismiss = Some(index);
+                }
+                ui.add(
+                    egui::Label::new(egui::RichText::new(&notice.text).color(colour))
+                        .wrap_mode(egui::TextWrapMode::Wrap),
+                );
+            });
+        }
+        if let Some(index) = dismiss {
+            self.notices.list.remove(index);
+        }
+    }
+}

@@ -1,0 +1,63 @@
+//! The quality table: one column per bound method, one row per measure.
+
+use crate::app::document::WeightSet;
+use crate::app::editor::EditorApp;
+
+/// A row of the table: its name and how a method's weights show in it.
+type QualityRow = (&'static str, fn(&WeightSet) -> String);
+
+const ROWS: [QualityRow; 5] = [
+    ("vertices with λ < 0", |set| {
+        format!("{:.1} %", 100.0 * set.quality.negative_share)
+    }),
+    ("most negative λ", |set| {
+        format!("{:.4}", set.quality.most_negative)
+    }),
+    ("max |Σλ - 1|", |set| {
+        format!("{:.1e}", set.quality.max_partition_error)
+    }),
+    ("max |Σλc - x| / size", |set| {
+        format!("{:.1e}", set.quality.max_linear_precision_error)
+    }),
+    ("bind time", |set| {
+        format!("{:.2} s", set.bind_time.as_secs_f32())
+    }),
+];
+
+impl EditorApp {
+    /// Per bound method: negativity, partition of unity, linear precision.
+    pub(in crate::app) fn quality_table(&self, ui: &mut egui::Ui) {
+        ui.label("Quality");
+        let methods: Vec<_> = self.document.bound_methods().collect();
+        if methods.is_empty() {
+            ui.label("(nothing bound yet)");
+            return;
+        }
+        let outside = self.document.outside().len();
+        egui::Grid::new("quality")
+            .num_columns(methods.len() + 1)
+            .striped(true)
+            .show(ui, |ui| {
+                ui.label("");
+                for method in &methods {
+                    ui.strong(method.name());
+                }
+                ui.end_row();
+                for (name, value) in ROWS {
+                    if self.hide_timings && name == "bind time" {
+                        continue;
+                    }
+                    ui.label(name);
+                    for &method in &methods {
+                        ui.label(self.document.bound(method).map_or("—".into(), value));
+                    }
+                    ui.end_row();
+                }
+                ui.label("outside vertices");
+                for _ in &methods {
+                    ui.label(outside.to_string());
+                }
+                ui.end_row();
+            });
+    }
+}

@@ -1,0 +1,169 @@
+//! The side panel: the scene, binding (each family's parameter, progress and
+//! cancel), quality, the selected handle's position, and the notices.
+
+use crate::app::editor::EditorApp;
+use crate::coords::Method;
+use std::time::Duration;
+
+impl EditorApp {
+    pub(in crate::app) fn side_panel(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        ui.heading(self.document.title());
+        ui.label(format!(
+            "{} mesh vertices, {} cage vertices",
+            self.document.mesh().positions.len(),
+            self.document.pose().len()
+        ));
+        ui.separator();
+        self.binding_section(ui, &ctx);
+        ui.separator();
+        self.quality_table(ui);
+        ui.separator();
+        self.selection_section(ui);
+        ui.separator();
+        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · F: frame · M: next method · Esc: deselect");
+        if self.show_statistics {
+            ui.separator();
+            self.statistics(ui);
+        }
+        ui.separator();
+        self.notices_panel(ui);
+    }
+
+    fn binding_section(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+        ui.label("Binding");
+        for family in Method::ALL {
+            let Some(spec) = family.spec().parameter else {
+                continue;
+            };
+            let mut value = self.bind_options.get(spec.key);
+            egui::ComboBox::from_label(spec.label)
+                .selected_text((spec.format)(value))
+                .show_ui(ui, |ui| {
+                    for &choice in spec.choices {
+                        ui.selectable_value(&mut value, choice, (spec.format)(choice));
+                    }
+                });
+            if value != self.bind_options.get(spec.key) {
+                self.set_parameter(spec.key, value);
+            }
+        }
+        if ui
+            .button("Subdivide cage")
+            .on_hover_text(
+                "1-to-4 midpoint subdivision, keeping the pose; smooths the coordinates near sharp reflex edges. Rebinds.",
+            )
+            .clicked()
+        {
+            self.subdivide_cage();
+        }
+        if let Some(status) = self.bind_status() {
+            ui.add(
+                egui::ProgressBar::new(status.fraction)
+                    .text(format!("{} / {} vertices", status.done, status.total)),
+            );
+            let remaining = status.remaining.map_or("estimating…".into(), |r| {
+                format!("{:.1} s left", r.as_secs_f32())
+            });
+            let elapsed = if self.hide_timings {
+                String::new()
+            } else {
+                format!(
+                    " — {:.1} s elapsed, {remaining}",
+                    status.elapsed.as_secs_f32()
+                )
+            };
+            ui.label(format!(
+                "{} {}{elapsed}",
+                if status.cancelling {
+                    "Cancelling"
+                } else {
+                    "Binding"
+                },
+                status.options.method.name(),
+            ));
+            if ui.button("Cancel").clicked() {
+                self.cancel_bind();
+            }
+            ctx.request_repaint_after(Duration::from_millis(100));
+        } else {
+            let unbound = self
+                .wanted_methods()
+                .into_iter()
+                .any(|m| self.document.bound(m).is_none());
+            if unbound && ui.button("Bind").clicked() {
+                self.start_bind();
+            }
+        }
+        if let Some(set) = self.document.bound(self.active_method()) {
+            ui.label(format!("Bound on {}", set.device));
+        }
+        if self.document.bound_methods().next().is_some() {
+            let outside = self.document.outside().len();
+            ui.label(format!("{outside} mesh vertices outside the cage"));
+            if outside > 0 {
+                ui.checkbox(&mut self.highlight_outside, "Highlight them");
+            }
+        }
+    }
+
+    fn selection_section(&mut self, ui: &mut egui::Ui) {
+        let selection = self.document.selection();
+        ui.label(format!("Selection: {} handle(s)", selection.len()));
+        if let (1, Some(&handle)) = (selection.len(), selection.iter().next()) {
+            let mut position = self.document.pose()[handle];
+            let (mut changed, mut drag_started, mut drag_stopped) = (false, false, false);
+            ui.horizontal(|ui| {
+                ui.label(format!("Handle {handle}"));
+                for (label, value) in [
+                    ("x", &mut position.x),
+                    ("y", &mut position.y),
+                    ("z", &mut position.z),
+                ] {
+                    let label = ui.label(label);
+                    let field = ui
+                        .add(egui::DragValue::new(value).speed(0.01).max_decimals(4))
+                        .labelled_by(label.id);
+                    changed |= field.changed();
+                    drag_started |= field.drag_started();
+                    drag_stopped |= field.drag_stopped();
+                }
+            });
+            // Dragging a field is one undo step; typing a value is one each.
+            if drag_started {
+                self.numeric_drag_start = Some(self.document.pose().to_vec());
+            }
+            if changed && self.numeric_drag_start.is_some() {
+                let mut pose = self.document.pose().to_vec();
+                pose[handle] = position;
+                self.document.preview_pose(pose);
+            } else if changed {
+                self.set_handle_position(handle, position);
+            }
+            if drag_stopped {
+                if let Some(start) = self.numeric_drag_start.take() {
+                    self.document.record_undo_point(start);
+                }
+            }
+        }
+        let history = self.document.history();
+        let (can_undo, can_redo) = (history.can_undo(), history.can_redo());
+        ui.horizontal(|ui| {
+            if ui.button("Reset pose").clicked() {
+                self.reset_pose();
+            }
+            if ui
+                .add_enabled(can_undo, egui::Button::new("Undo"))
+                .clicked()
+            {
+                self.undo();
+            }
+            if ui
+                .add_enabled(can_redo, egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.redo();
+            }
+        });
+    }
+}

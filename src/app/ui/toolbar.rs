@@ -1,0 +1,83 @@
+//! The comparison controls above the viewport: the method shown, the layout,
+//! which methods are compared, and the colouring.
+
+use crate::app::compare::{Layout, Overlay};
+use crate::app::editor::EditorApp;
+use crate::coords::Method;
+use crate::render::colormap::Scale;
+
+impl EditorApp {
+    pub(in crate::app) fn toolbar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Method (M):");
+            let mut method = self.active_method();
+            for family in Method::ALL {
+                ui.selectable_value(&mut method, family, family.name())
+                    .on_hover_text(family.spec().summary);
+            }
+            self.set_active_method(method);
+            ui.separator();
+            ui.label("View:");
+            let layout = &mut self.view.layout;
+            ui.selectable_value(layout, Layout::Single, "Single");
+            ui.selectable_value(layout, Layout::SideBySide, "Side by side");
+            ui.selectable_value(layout, Layout::Difference, "Difference");
+            match self.view.layout {
+                Layout::SideBySide => self.comparison_controls(ui),
+                Layout::Difference => self.difference_controls(ui),
+                Layout::Single => {}
+            }
+            ui.separator();
+            ui.label("Colour:");
+            let overlay = &mut self.view.overlay;
+            ui.selectable_value(overlay, Overlay::Shaded, "Shaded");
+            ui.selectable_value(overlay, Overlay::Heatmap, "Heatmap λi");
+            ui.selectable_value(overlay, Overlay::Negativity, "Negativity");
+            if self.view.overlay == Overlay::Heatmap {
+                let last = self.document.pose().len().saturating_sub(1);
+                let label = ui.label("i =");
+                ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
+                    .labelled_by(label.id)
+                    .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+            }
+            if self.view.overlay != Overlay::Shaded || self.view.layout != Layout::Single {
+                ui.selectable_value(&mut self.view.scale, Scale::Linear, "Linear");
+                ui.selectable_value(&mut self.view.scale, Scale::LogMagnitude, "Log");
+            }
+        });
+    }
+
+    /// Which methods the side-by-side layout shows.
+    fn comparison_controls(&mut self, ui: &mut egui::Ui) {
+        if Method::ALL.len() > 2 {
+            ui.menu_button("Compare…", |ui| {
+                for family in Method::ALL {
+                    let mut shown = self.view.compared.contains(family);
+                    if ui.checkbox(&mut shown, family.name()).changed() {
+                        self.view.compared.set(family, shown);
+                    }
+                }
+            });
+        }
+        ui.checkbox(&mut self.view.difference_pane, "+ difference");
+        let mut locked = self.view.cameras_locked;
+        if ui.checkbox(&mut locked, "Lock cameras").changed() {
+            self.set_cameras_locked(locked);
+        }
+    }
+
+    /// Which two methods the difference compares: "[MVC] vs [PMVC] shown".
+    fn difference_controls(&mut self, ui: &mut egui::Ui) {
+        for (index, label) in ["vs", "shown"].into_iter().enumerate() {
+            let mut chosen = self.view.difference[index];
+            egui::ComboBox::from_label(label)
+                .selected_text(chosen.name())
+                .show_ui(ui, |ui| {
+                    for family in Method::ALL {
+                        ui.selectable_value(&mut chosen, family, family.name());
+                    }
+                });
+            self.view.difference[index] = chosen;
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! Mouse and keyboard in the viewport: the drag state machine (orbit, pan, move
+//! handles, box select), the wheel, clicks, and the editor's shortcuts.
+
+use crate::app::compare::Overlay;
+use crate::app::editor::EditorApp;
+use egui::{Key, KeyboardShortcut, Modifiers, PointerButton, Pos2, Rect};
+use glam::{DVec3, Vec2};
+
+/// What a mouse drag in the viewport is doing.
+#[derive(Clone, Debug)]
+pub(in crate::app) enum Drag {
+    Orbit,
+    Pan,
+    /// Moving the selected handles: the pose when the drag began, and the total
+    /// pointer motion since then (so axis constraints can change mid-drag).
+    Move {
+        start_pose: Vec<DVec3>,
+        motion: egui::Vec2,
+    },
+    /// Rubber-band selection from `origin`; `additive` keeps the old selection.
+    Box {
+        origin: Pos2,
+        additive: bool,
+    },
+}
+
+/// The axis held down (X, Y or Z) that constrains a move.
+fn held_axis(ui: &egui::Ui) -> Option<DVec3> {
+    ui.input(|i| {
+        if i.key_down(Key::X) {
+            Some(DVec3::X)
+        } else if i.key_down(Key::Y) {
+            Some(DVec3::Y)
+        } else if i.key_down(Key::Z) {
+            Some(DVec3::Z)
+        } else {
+            None
+        }
+    })
+}
+
+impl EditorApp {
+    pub(super) fn viewport_input(
+        &mut self,
+        ui: &egui::Ui,
+        pane: usize,
+        response: &egui::Response,
+        rect: Rect,
+    ) {
+        let locked = self.view.cameras_locked;
+        let (modifiers, press_origin, scroll, hover) = ui.input(|i| {
+            (
+                i.modifiers,
+                i.pointer.press_origin(),
+                i.smooth_scroll_delta.y,
+                i.pointer.hover_pos(),
+            )
+        });
+
+        // Hover highlight (not while dragging, so the highlight does not flicker, and
+        // not in `--screenshot` runs, where the pointer rests wherever the display
+        // server put it).
+        if self.viewport.drag.is_none() && self.screenshot.is_none() && response.hovered() {
+            let hovered = response.hover_pos().and_then(|p| self.pick(p));
+            self.viewport.set_hovered(hovered);
+        }
+
+        if response.hovered() && scroll != 0.0 {
+            if let (Some(pointer), Some(projection)) = (hover, self.viewport.projection(pane)) {
+                let ndc = projection.to_ndc(Vec2::new(pointer.x, pointer.y));
+                let factor = (-scroll * 0.0015).exp();
+                self.viewport.camera_mut(pane, locked).zoom_towards(
+                    factor,
+                    ndc,
+                    rect.width() / rect.height().max(1.0),
+                );
+            }
+        }
+
+        if response.clicked_by(PointerButton::Primary) {
+            let picked = response.interact_pointer_pos().and_then(|p| self.pick(p));
+            // In heatmap mode a click on a handle shows that vertex's coordinate.
+            if let (Some(handle), Overlay::Heatmap) = (picked, self.view.overlay) {
+                self.view.heat_vertex = handle;
+            }
+            match (picked, modifiers.shift) {
+                (Some(handle), true) => self.document.toggle_selected(handle),
+                (Some(handle), false) => self.document.select_only([handle]),
+                (None, false) => self.document.select_only([]),
+                (None, true) => {}
+            }
+        }
+
+        if response.drag_started() {
+            let origin = press_origin.unwrap_or(rect.center());
+            self.viewport.drag = Some(if response.dragged_by(PointerButton::Primary) {
+                if modifiers.command || ui.input(|i| i.key_down(Key::B)) {
+                    Drag::Box {
+                        origin,
+                        additive: modifiers.shift,
+                    }
+                } else if let Some(handle) = self.pick(origin) {
+                    if !self.document.selection().contains(&handle) {
+                        if modifiers.shift {
+                            self.document.toggle_selected(handle);
+                        } else {
+                            self.document.select_only([handle]);
+                        }
+                    }
+                    Drag::Move {
+                        start_pose: self.document.pose().to_vec(),
+                        motion: egui::Vec2::ZERO,
+                    }
+                } else {
+                    Drag::Orbit
+                }
+            } else if response.dragged_by(PointerButton::Middle) {
+                if modifiers.shift {
+                    Drag::Pan
+                } else {
+                    Drag::Orbit
+                }
+            } else {
+                Drag::Pan
+            });
+        }
+
+        if response.dragged() {
+            let delta = response.drag_delta();
+            match self.viewport.drag.take() {
+                Some(Drag::Orbit) => {
+                    self.viewport
+                        .camera_mut(pane, locked)
+                        .orbit(Vec2::new(delta.x, delta.y));
+                    self.viewport.drag = Some(Drag::Orbit);
+                }
+                Some(Drag::Pan) => {
+                    self.viewport
+                        .camera_mut(pane, locked)
+                        .pan(Vec2::new(delta.x, delta.y), rect.height().min(rect.width()));
+                    self.viewport.drag = Some(Drag::Pan);
+                }
+                Some(Drag::Move { start_pose, motion }) => {
+                    let motion = motion + delta;
+                    let pose = self.moved_pose(pane, &start_pose, motion, held_axis(ui), rect);
+                    self.document.preview_pose(pose);
+                    self.viewport.drag = Some(Drag::Move { start_pose, motion });
+                }
+                other => self.viewport.drag = other,
+            }
+        }
+
+        if response.drag_stopped() {
+            match self.viewport.drag.take() {
+                Some(Drag::Move { start_pose, .. }) => {
+                    self.document.record_undo_point(start_pose);
+                }
+                Some(Drag::Box { origin, additive }) => {
+                    let end = response.interact_pointer_pos().unwrap_or(origin);
+                    self.box_select(pane, Rect::from_two_pos(origin, end), additive);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    pub(in crate::app) fn handle_shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+        let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+        let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+        let (redo, undo, escape, frame, next_method) = ctx.input_mut(|i| {
+            (
+                i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y),
+                i.consume_shortcut(&undo),
+                i.key_pressed(Key::Escape),
+                i.key_pressed(Key::F) && i.modifiers.is_none(),
+                i.key_pressed(Key::M) && i.modifiers.is_none(),
+            )
+        });
+        if next_method {
+            self.toggle_method();
+        }
+        if redo {
+            self.redo();
+        }
+        if undo {
+            self.undo();
+        }
+        if escape {
+            self.select_only([]);
+        }
+        if frame {
+            self.frame_scene();
+        }
+    }
+}

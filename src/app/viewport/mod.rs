@@ -1,0 +1,356 @@
+//! The viewport: its panes (one per compared view), their cameras and drawing.
+//! Mouse and keyboard handling is in [`input`], handle and vertex picking in
+//! [`picking`].
+
+mod input;
+mod picking;
+
+use super::compare::{HoverReadout, Pane};
+use super::editor::EditorApp;
+use super::widgets::draw_colour_bar;
+use crate::render::{
+    Colouring, FrameParams, OrbitCamera, ScreenProjection, ViewportCallback, MAX_VIEWS,
+};
+use eframe::egui_wgpu;
+use egui::{Color32, Pos2, Rect, Sense, Stroke};
+use glam::{DVec3, Vec2, Vec3};
+pub(super) use input::Drag;
+
+/// Handle half-size in points.
+const HANDLE_RADIUS: f32 = 4.0;
+/// Gap between side-by-side views, in points.
+const PANE_GAP: f32 = 2.0;
+
+/// What the viewport keeps between frames.
+#[derive(Default)]
+pub struct ViewportState {
+    /// Index 0: the first view's camera, and every view's while they are locked.
+    cameras: [OrbitCamera; MAX_VIEWS],
+    /// The views drawn last frame, each with its screen rectangle and projection.
+    panes: Vec<(Pane, Rect, ScreenProjection)>,
+    pub(super) drag: Option<Drag>,
+    /// The handle under the cursor.
+    pub(super) hovered: Option<usize>,
+    hover_changed: bool,
+    /// The weights under the cursor, and the view they were read in.
+    pub(super) hover_readout: Option<(usize, HoverReadout)>,
+}
+
+impl ViewportState {
+    pub fn camera_of(&self, pane: usize, locked: bool) -> OrbitCamera {
+        if locked {
+            self.cameras[0]
+        } else {
+            self.cameras[pane.min(MAX_VIEWS - 1)]
+        }
+    }
+
+    fn camera_mut(&mut self, pane: usize, locked: bool) -> &mut OrbitCamera {
+        if locked {
+            &mut self.cameras[0]
+        } else {
+            &mut self.cameras[pane.min(MAX_VIEWS - 1)]
+        }
+    }
+
+    /// Every camera looks at a sphere of `radius` around `centre`.
+    pub fn frame(&mut self, centre: Vec3, radius: f32) {
+        self.cameras[0].frame(centre, radius);
+        self.unify_cameras();
+    }
+
+    /// Every view takes the first view's camera.
+    pub fn unify_cameras(&mut self) {
+        self.cameras = [self.cameras[0]; MAX_VIEWS];
+    }
+
+    pub fn cameras(&self) -> [OrbitCamera; MAX_VIEWS] {
+        self.cameras
+    }
+
+    pub fn set_cameras(&mut self, cameras: [OrbitCamera; MAX_VIEWS]) {
+        self.cameras = cameras;
+    }
+
+    /// A new document: no drag, no hover.
+    pub fn reset_interaction(&mut self) {
+        self.drag = None;
+        self.set_hovered(None);
+        self.hover_readout = None;
+    }
+
+    fn set_hovered(&mut self, hovered: Option<usize>) {
+        if hovered != self.hovered {
+            self.hovered = hovered;
+            self.hover_changed = true;
+        }
+    }
+
+    /// Whether the hovered handle changed since the last call.
+    pub fn take_hover_changed(&mut self) -> bool {
+        std::mem::take(&mut self.hover_changed)
+    }
+
+    /// View `index` as drawn last frame: what it shows and its projection.
+    pub fn pane(&self, index: usize) -> Option<(Pane, ScreenProjection)> {
+        self.panes.get(index).map(|(kind, _, p)| (*kind, *p))
+    }
+
+    fn projection(&self, index: usize) -> Option<ScreenProjection> {
+        self.panes.get(index).map(|(_, _, projection)| *projection)
+    }
+
+    /// The view under `pointer`.
+    fn pane_at(&self, pointer: Pos2) -> Option<usize> {
+        self.panes
+            .iter()
+            .position(|(_, rect, _)| rect.contains(pointer))
+    }
+
+    pub fn pane_rects(&self) -> Vec<(Pane, Rect)> {
+        self.panes
+            .iter()
+            .map(|(pane, rect, _)| (*pane, *rect))
+            .collect()
+    }
+}
+
+impl EditorApp {
+    /// Screen position (in points) of a cage handle in the first view.
+    pub fn handle_screen_position(&self, handle: usize) -> Option<Pos2> {
+        self.handle_screen_position_in(0, handle)
+    }
+
+    /// Screen position (in points) of a cage handle in view `pane`.
+    pub fn handle_screen_position_in(&self, pane: usize, handle: usize) -> Option<Pos2> {
+        let screen = self
+            .viewport
+            .projection(pane)?
+            .project(self.document.pose().get(handle)?.as_vec3())?;
+        Some(Pos2::new(screen.x, screen.y))
+    }
+
+    fn pane_projection(&self, pane: usize, rect: Rect) -> ScreenProjection {
+        let aspect = rect.width() / rect.height().max(1.0);
+        ScreenProjection {
+            view_projection: self.camera_of(pane).view_projection(aspect),
+            origin: Vec2::new(rect.min.x, rect.min.y),
+            size: Vec2::new(rect.width(), rect.height()),
+        }
+    }
+
+    pub(super) fn viewport(&mut self, ui: &mut egui::Ui) {
+        let full = ui.available_rect_before_wrap();
+        let kinds = self.view.panes(self.active_method(), MAX_VIEWS);
+        let width = (full.width() - PANE_GAP * (kinds.len() as f32 - 1.0)) / kinds.len() as f32;
+        let rects: Vec<Rect> = (0..kinds.len())
+            .map(|i| {
+                let left = full.left() + i as f32 * (width + PANE_GAP);
+                Rect::from_min_max(
+                    Pos2::new(left, full.top()),
+                    Pos2::new(left + width, full.bottom()),
+                )
+            })
+            .collect();
+        // Projections first, so that picking sees every view with this frame's layout.
+        self.viewport.panes = kinds
+            .iter()
+            .zip(&rects)
+            .enumerate()
+            .map(|(i, (&kind, &rect))| (kind, rect, self.pane_projection(i, rect)))
+            .collect();
+        let mut hovered_pane = None;
+        for (index, (&kind, &rect)) in kinds.iter().zip(&rects).enumerate() {
+            let response = ui.interact(
+                rect,
+                ui.scope_id().with(("view", index)),
+                Sense::click_and_drag(),
+            );
+            self.viewport_input(ui, index, &response, rect);
+            // The input may have moved the camera; draw with the final one.
+            let projection = self.pane_projection(index, rect);
+            self.viewport.panes[index].2 = projection;
+            if response.hovered() {
+                hovered_pane = Some((index, response.hover_pos()));
+            }
+            self.draw_pane(ui, index, kind, rect, projection);
+        }
+        ui.advance_cursor_after_rect(full);
+        if hovered_pane.is_none() && self.viewport.drag.is_none() {
+            self.viewport.set_hovered(None);
+        }
+        self.update_hover(ui, hovered_pane);
+        if let Some(Drag::Box { origin, .. }) = &self.viewport.drag {
+            if let Some(current) = ui.input(|i| i.pointer.interact_pos()) {
+                let band = Rect::from_two_pos(*origin, current);
+                ui.painter()
+                    .rect_filled(band, 0.0, Color32::from_white_alpha(20));
+                ui.painter().rect_stroke(
+                    band,
+                    0.0,
+                    Stroke::new(1.0, Color32::WHITE),
+                    egui::StrokeKind::Inside,
+                );
+            }
+        }
+    }
+
+    /// One view: the 3D image, its label, its colour bar and any notice.
+    fn draw_pane(
+        &mut self,
+        ui: &egui::Ui,
+        index: usize,
+        kind: Pane,
+        rect: Rect,
+        projection: ScreenProjection,
+    ) {
+        self.sync_gpu();
+        let shading = self.shading_of(kind);
+        let painter = ui.painter_at(rect);
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        if self.gpu.is_some() {
+            let params = FrameParams {
+                view: index,
+                shading,
+                view_projection: projection.view_projection,
+                eye: self.camera_of(index).eye(),
+                size_px: [
+                    (rect.width() * pixels_per_point).round().max(1.0) as u32,
+                    (rect.height() * pixels_per_point).round().max(1.0) as u32,
+                ],
+                handle_radius_px: HANDLE_RADIUS * pixels_per_point,
+                highlight_outside: self.highlight_outside,
+            };
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                ViewportCallback { params },
+            ));
+        } else {
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "No wgpu device: the viewport is unavailable",
+                egui::FontId::proportional(16.0),
+                Color32::LIGHT_RED,
+            );
+        }
+        let font = egui::FontId::proportional(14.0);
+        painter.text(
+            rect.left_top() + egui::vec2(10.0, 8.0),
+            egui::Align2::LEFT_TOP,
+            self.pane_title(kind),
+            font.clone(),
+            Color32::from_gray(230),
+        );
+        if kind
+            .methods()
+            .iter()
+            .any(|&m| self.document.bound(m).is_none())
+        {
+            let message = if self.is_binding() {
+                "Binding… the mesh is shown at rest until the weights are ready"
+            } else {
+                "Not bound: the mesh is shown at rest (Bind in the side panel)"
+            };
+            painter.text(
+                rect.left_top() + egui::vec2(10.0, 28.0),
+                egui::Align2::LEFT_TOP,
+                message,
+                font,
+                Color32::from_gray(200),
+            );
+        }
+        if shading.colouring != Colouring::Shaded {
+            if let Some(range) = self.value_range(shading.colouring, kind) {
+                draw_colour_bar(&painter, rect, &shading, range, self.colour_bar_title(kind));
+            }
+        }
+    }
+
+    /// "PMVC · 32² · bound in 0.41 s" and the like.
+    fn pane_title(&self, kind: Pane) -> String {
+        match kind {
+            Pane::Method(method) => match self.document.bound(method) {
+                Some(set) => {
+                    let parameter = set
+                        .options
+                        .parameter()
+                        .map(|(spec, value)| format!(" · {}", (spec.format)(value)))
+                        .unwrap_or_default();
+                    let seconds = if self.hide_timings {
+                        String::new()
+                    } else {
+                        format!(" · bound in {:.2} s", set.bind_time.as_secs_f32())
+                    };
+                    format!("{}{parameter}{seconds}", method.name())
+                }
+                None => format!("{} · not bound", method.name()),
+            },
+            Pane::Difference { against, shown } => {
+                format!("{against} vs {shown}: distance / cage size")
+            }
+        }
+    }
+
+    fn colour_bar_title(&self, kind: Pane) -> String {
+        let method = kind.method().name();
+        match (self.view.colouring(kind), kind) {
+            (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
+            (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
+            (Colouring::MethodDistance, Pane::Difference { against, shown }) => {
+                format!("|p'({against}) - p'({shown})| / cage size")
+            }
+            _ => String::new(),
+        }
+    }
+
+    /// `start_pose` with the selection moved by a pointer motion of `motion` points:
+    /// in the view plane, or along `axis` by the motion's component along the axis's
+    /// screen direction.
+    fn moved_pose(
+        &self,
+        pane: usize,
+        start_pose: &[DVec3],
+        motion: egui::Vec2,
+        axis: Option<DVec3>,
+        rect: Rect,
+    ) -> Vec<DVec3> {
+        let mut pose = start_pose.to_vec();
+        let selection = self.document.selection();
+        if selection.is_empty() {
+            return pose;
+        }
+        let centre = selection
+            .iter()
+            .filter_map(|&i| start_pose.get(i))
+            .sum::<DVec3>()
+            / selection.len() as f64;
+        let camera = self.camera_of(pane);
+        let short_side = rect.height().min(rect.width());
+        let scale = camera.units_per_pixel(camera.depth_of(centre.as_vec3()), short_side);
+        let (right, up) = camera.right_up();
+        let in_plane = (right * motion.x - up * motion.y) * scale;
+        let offset = match (axis, self.viewport.projection(pane)) {
+            (Some(axis), Some(projection)) => {
+                let from = projection.project(centre.as_vec3());
+                let to = projection.project((centre + axis).as_vec3());
+                match (from, to) {
+                    (Some(from), Some(to)) if (to - from).length_squared() > 1e-6 => {
+                        let screen_axis = to - from;
+                        let along = Vec2::new(motion.x, motion.y).dot(screen_axis)
+                            / screen_axis.length_squared();
+                        axis * f64::from(along)
+                    }
+                    _ => axis * in_plane.as_dvec3().dot(axis),
+                }
+            }
+            _ => in_plane.as_dvec3(),
+        };
+        for &i in selection {
+            if let Some(p) = pose.get_mut(i) {
+                *p += offset;
+            }
+        }
+        pose
+    }
+}

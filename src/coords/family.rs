@@ -1,0 +1,190 @@
+//! The coordinate families the product offers, described as data. The command
+//! line's `--method`, the bind queue, the GPU upload, the quality table, the
+//! heatmaps and the view selector all iterate over [`Method::ALL`] and read
+//! [`Method::spec`]; none of them names a family.
+//!
+//! Adding a family: write its module in `coords`, add a variant here with its
+//! [`FamilySpec`], and dispatch to it in [`super::weights_at`] (and, if it has more
+//! columns than cage vertices, in [`Method::columns`] and
+//! [`Method::column_displacements`]).
+
+use crate::geometry::Cage;
+use glam::DVec3;
+
+/// A family of generalised barycentric coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Method {
+    /// Mean value coordinates (Ju, Schaefer, Warren 2005), closed form.
+    Mvc,
+    /// Positive mean value coordinates (Lipman et al. 2007), by cube-map integration.
+    Pmvc,
+}
+
+/// A family's one integer parameter (a resolution, a grid size).
+#[derive(Clone, Copy, Debug)]
+pub struct ParameterSpec {
+    /// Which field of [`super::BindOptions`] holds it.
+    pub key: Parameter,
+    /// Shown beside its control, e.g. "PMVC resolution".
+    pub label: &'static str,
+    /// The command-line flag, e.g. "--resolution".
+    pub flag: &'static str,
+    /// The values the editor offers.
+    pub choices: &'static [u32],
+    pub default: u32,
+    /// How a value reads in titles, e.g. "32²".
+    pub format: fn(u32) -> String,
+}
+
+/// The parameters families can have; each is a field of [`super::BindOptions`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Parameter {
+    /// Cube-map texels along one face edge (PMVC).
+    Resolution,
+}
+
+/// What a family's weights matrix holds per mesh vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColumnLayout {
+    /// One weight per cage vertex.
+    CageVertices,
+}
+
+/// Everything the product needs to know about a family to offer it.
+#[derive(Clone, Copy, Debug)]
+pub struct FamilySpec {
+    /// Lower-case identifier: the `--method` value and the name in saved files.
+    pub id: &'static str,
+    /// Display name, e.g. "PMVC".
+    pub name: &'static str,
+    /// One line for menus and `--help`.
+    pub summary: &'static str,
+    pub parameter: Option<ParameterSpec>,
+    pub columns: ColumnLayout,
+    /// Whether the family promises non-negative weights inside the cage (so a
+    /// negative weight there is a defect, not a property).
+    pub positive_inside: bool,
+    /// How a mesh vertex outside the cage is treated, in one sentence.
+    pub outside_policy: &'static str,
+}
+
+/// PMVC's default cube-map resolution (texels along one face edge).
+pub const DEFAULT_RESOLUTION: u32 = 32;
+
+const OUTSIDE_BY_MVC: &str =
+    "vertices outside the cage get MVC weights, which reproduce the rest pose exactly";
+
+const MVC: FamilySpec = FamilySpec {
+    id: "mvc",
+    name: "MVC",
+    summary: "mean value coordinates, closed form; negative in non-convex cages",
+    parameter: None,
+    columns: ColumnLayout::CageVertices,
+    positive_inside: false,
+    outside_policy: OUTSIDE_BY_MVC,
+};
+
+const PMVC: FamilySpec = FamilySpec {
+    id: "pmvc",
+    name: "PMVC",
+    summary: "positive mean value coordinates: only the visible cage counts (cube map)",
+    parameter: Some(ParameterSpec {
+        key: Parameter::Resolution,
+        label: "PMVC resolution",
+        flag: "--resolution",
+        choices: &[16, 32, 64, 128],
+        default: DEFAULT_RESOLUTION,
+        format: |value| format!("{value}²"),
+    }),
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+};
+
+impl Method {
+    /// Every family, in the order menus list them.
+    pub const ALL: [Method; 2] = [Method::Mvc, Method::Pmvc];
+
+    pub fn spec(self) -> &'static FamilySpec {
+        match self {
+            Method::Mvc => &MVC,
+            Method::Pmvc => &PMVC,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        self.spec().name
+    }
+
+    pub fn id(self) -> &'static str {
+        self.spec().id
+    }
+
+    /// The family with identifier `id` (case-insensitive).
+    pub fn from_id(id: &str) -> Option<Method> {
+        Method::ALL
+            .into_iter()
+            .find(|method| method.id().eq_ignore_ascii_case(id))
+    }
+
+    /// The family after this one in [`Method::ALL`], wrapping around (the M key).
+    pub fn next(self) -> Method {
+        let index = Method::ALL.iter().position(|&m| m == self).unwrap_or(0);
+        Method::ALL[(index + 1) % Method::ALL.len()]
+    }
+
+    /// Weights columns per mesh vertex for `cage`.
+    pub fn columns(self, cage: &Cage) -> usize {
+        match self.spec().columns {
+            ColumnLayout::CageVertices => cage.vertex_count(),
+        }
+    }
+
+    /// Per weights column, how far its vector moved from `rest` to `pose`; a mesh
+    /// vertex then moves by Σₖ wₖ dₖ (the displacement form, exact at rest for any
+    /// weights). For one column per cage vertex this is `pose − rest`.
+    pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+        match self.spec().columns {
+            ColumnLayout::CageVertices => pose
+                .iter()
+                .zip(rest.positions())
+                .map(|(posed, rested)| *posed - *rested)
+                .collect(),
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identifiers_are_unique_and_round_trip() {
+        for method in Method::ALL {
+            assert_eq!(Method::from_id(method.id()), Some(method));
+            assert_eq!(
+                Method::ALL.iter().filter(|m| m.id() == method.id()).count(),
+                1
+            );
+        }
+        assert_eq!(Method::from_id("PMVC"), Some(Method::Pmvc));
+        assert_eq!(Method::from_id("nope"), None);
+    }
+
+    #[test]
+    fn next_visits_every_family_once_per_cycle() {
+        let mut seen = vec![Method::ALL[0]];
+        for _ in 1..Method::ALL.len() {
+            seen.push(seen.last().unwrap().next());
+        }
+        seen.sort();
+        assert_eq!(seen, Method::ALL.to_vec());
+        assert_eq!(Method::ALL.last().unwrap().next(), Method::ALL[0]);
+    }
+}
