@@ -53,13 +53,16 @@ pub struct Finished {
     pub result: Result<BindOutcome, JobError>,
 }
 
+/// Each point's class and the points outside, shared by every job of a scene.
+type Classified = (Arc<[PointClass]>, Arc<[u32]>);
+
 /// The scene every job binds, prepared once.
 #[derive(Clone)]
 struct Prepared {
     points: Arc<[DVec3]>,
     cage: Arc<Cage>,
     /// Filled in by the first job that classifies the points.
-    classes: Arc<Mutex<Option<(Arc<[PointClass]>, Arc<[u32]>)>>>,
+    classes: Arc<Mutex<Option<Classified>>>,
 }
 
 struct Running {

@@ -44,7 +44,8 @@ impl ReadoutCache {
         };
         // Distances depend on the pose; weights and their ranges do not.
         self.ranges.retain(|(key, _)| {
-            !weights_changed(key) && !(changes.pose && key.0 == Colouring::MethodDistance)
+            let distance_moved = changes.pose && key.0 == Colouring::MethodDistance;
+            !(weights_changed(key) || distance_moved)
         });
     }
 }
