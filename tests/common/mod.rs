@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests: writing scenes to files and running the binary.
 #![allow(dead_code)]
 
+#[cfg(feature = "ui-tests")]
 pub mod editor;
 
 use pmvc::geometry::{procedural, Cage};
@@ -40,6 +41,7 @@ pub fn comb_scene(dir: &Path, points: usize) -> (PathBuf, PathBuf, Cage, Vec<gla
     (mesh, cage_path, cage, inside)
 }
 
+#[cfg(feature = "editor")]
 pub fn pmvc(args: &[&str]) -> Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
         .args(args)
