@@ -188,13 +188,17 @@ fn deform_keeps_faces_texture_coordinates_and_groups_and_drops_normals() {
 fn deform_with_stored_weights_matches_deform_that_binds() {
     let dir = tempfile::tempdir().unwrap();
     let (mesh, cage_path, cage, _) = comb_scene(dir.path(), 100);
-    let mut pose = cage.clone();
-    for p in &mut pose.positions {
+    let mut pose = cage.positions().to_vec();
+    for p in &mut pose {
         if p.y > 2.0 && p.x < 1.0 {
             p.x += 0.7; // bend the first prong
         }
     }
-    let pose_path = write(dir.path(), "pose.obj", &cage_obj(&pose));
+    let pose_path = write(
+        dir.path(),
+        "pose.obj",
+        &triangles_obj(&pose, cage.triangles()),
+    );
     let weights = dir.path().join("w.npy");
     let common = ["--mesh", path_str(&mesh), "--cage", path_str(&cage_path)];
     assert!(

@@ -56,7 +56,7 @@ fn mvc_f64(cage: &Cage, x: DVec3) -> Vec<f64> {
 
 /// Partition of unity and linear precision of every row; returns the worst errors.
 fn check_affine(cage: &Cage, points: &[DVec3], weights: &Weights) -> (f64, f64) {
-    let reproduced = weights.apply(&cage.positions);
+    let reproduced = weights.apply(cage.positions());
     let mut worst_sum = 0.0f64;
     let mut worst_position = 0.0f64;
     for (i, x) in points.iter().enumerate() {
@@ -164,7 +164,7 @@ fn both_methods_interpolate_as_a_point_approaches_a_face() {
             let x = foot + distance * inward;
             for (method, weights) in [("PMVC", pmvc_f64(&cage, x, 32)), ("MVC", mvc_f64(&cage, x))]
             {
-                let corners = cage.triangles[t];
+                let corners = cage.triangles()[t];
                 let error: f64 = (0..cage.vertex_count())
                     .map(|j| {
                         let expected = corners
@@ -227,14 +227,14 @@ fn points_on_the_surface_get_barycentrics_and_never_nan() {
             weights.values.iter().all(|w| w.is_finite()),
             "{method:?}: non-finite weight"
         );
-        let reproduced = weights.apply(&cage.positions);
+        let reproduced = weights.apply(cage.positions());
         for (x, p) in points.iter().zip(&reproduced) {
             assert!(
                 x.distance(*p) <= 1e-6 * cage.diagonal(),
                 "{method:?}: {x} reproduced as {p}"
             );
         }
-        let corners = cage.triangles[5];
+        let corners = cage.triangles()[5];
         assert!((f64::from(weights.row(0)[corners[2] as usize]) - 0.5).abs() < 1e-6);
     }
 }
@@ -247,7 +247,7 @@ fn skipping_triangles_facing_away_from_inside_points_changes_nothing() {
     let table = TexelTable::new(16);
     for (name, cage) in [("convex", convex()), ("comb", comb()), ("star", star())] {
         let mut points = procedural::points_inside(&cage, 200, 11, 1e-3);
-        for t in 0..cage.triangles.len() {
+        for t in 0..cage.triangles().len() {
             let [a, b, c] = cage.triangle(t);
             let inward = -(b - a).cross(c - a).normalize();
             points.push((a + b + c) / 3.0 + 1e-8 * cage.diagonal() * inward);

@@ -31,9 +31,9 @@ fn neighbour_drag(method: Method) -> f64 {
     )
     .unwrap();
     let tip = |p: &DVec3| p.y > 5.0 && p.x > 2.6 && p.x < 4.0;
-    assert_eq!(cage.positions.iter().filter(|p| tip(p)).count(), 4);
+    assert_eq!(cage.positions().iter().filter(|p| tip(p)).count(), 4);
     let pose: Vec<DVec3> = cage
-        .positions
+        .positions()
         .iter()
         .map(|p| {
             if tip(p) {
@@ -83,7 +83,7 @@ fn on_the_default_scene_mvc_is_negative_and_pmvc_is_not() {
             &BindProgress::default(),
         )
         .expect("not cancelled");
-        WeightQuality::measure(&weights, &mesh.positions, &cage.positions)
+        WeightQuality::measure(&weights, &mesh.positions, cage.positions())
     };
     let mvc = quality(Method::Mvc);
     let pmvc = quality(Method::Pmvc);

@@ -64,14 +64,14 @@ fn input(cage: &Cage, points: Vec<DVec3>, method: Method) -> BindInput {
 /// Uniform points in the cage's bounding box grown by 10% (inside and outside),
 /// plus every cage vertex and triangle centroid (on the surface).
 fn mixed_points(cage: &Cage, count: usize, seed: u64) -> Vec<DVec3> {
-    let (lo, hi) = pmvc::geometry::bounds_of(&cage.positions);
+    let (lo, hi) = pmvc::geometry::bounds_of(cage.positions());
     let (lo, hi) = (lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo));
     let mut random = pmvc::geometry::procedural::SplitMix64(seed);
     let mut points: Vec<DVec3> = (0..count)
         .map(|_| lo + (hi - lo) * DVec3::new(random.unit(), random.unit(), random.unit()))
         .collect();
-    points.extend(&cage.positions);
-    points.extend((0..cage.triangles.len()).map(|t| {
+    points.extend(cage.positions());
+    points.extend((0..cage.triangles().len()).map(|t| {
         let [a, b, c] = cage.triangle(t);
         (a + b + c) / 3.0
     }));

@@ -37,7 +37,7 @@ fn quads_are_cut_along_the_shorter_diagonal() {
         "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
                 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
     let (cage, report) = load_cage(&write(dir.path(), "cube.obj", cube)).unwrap();
-    assert_eq!(cage.triangles.len(), 12);
+    assert_eq!(cage.triangles().len(), 12);
     assert!(!report.flipped);
     assert!((report.volume - 8.0).abs() < 1e-12);
 }
@@ -77,14 +77,19 @@ fn off_and_obj_give_the_same_cage() {
 fn an_inward_facing_cage_is_flipped_and_binds_exactly_like_its_outward_twin() {
     let dir = tempfile::tempdir().unwrap();
     let outward = procedural::extrude(&procedural::star_outline(5, 0.4, 1.0), -0.3, 0.3);
-    let mut inward = outward.clone();
-    for triangle in &mut inward.triangles {
-        triangle.reverse();
-    }
+    let reversed: Vec<[u32; 3]> = outward
+        .triangles()
+        .iter()
+        .map(|&[a, b, c]| [a, c, b])
+        .collect();
     let (outward_cage, outward_report) =
         load_cage(&write(dir.path(), "out.obj", &cage_obj(&outward))).unwrap();
-    let (inward_cage, inward_report) =
-        load_cage(&write(dir.path(), "in.obj", &cage_obj(&inward))).unwrap();
+    let (inward_cage, inward_report) = load_cage(&write(
+        dir.path(),
+        "in.obj",
+        &triangles_obj(outward.positions(), &reversed),
+    ))
+    .unwrap();
     assert!(!outward_report.flipped);
     assert!(inward_report.flipped);
     assert!(inward_report.messages()[0].contains("flipped"));
@@ -120,4 +125,84 @@ fn unreferenced_cage_vertices_are_a_warning() {
     let (_, report) = load_cage(&write(dir.path(), "t.obj", text)).unwrap();
     assert_eq!(report.unreferenced, vec![4]);
     assert!(report.messages()[0].starts_with("warning"));
+}
+
+/// The only way to a `Cage` is validation: each defect is its own error variant,
+/// and the message names the element without inventing a file.
+#[test]
+fn cage_new_rejects_each_defect_with_its_own_error() {
+    use pmvc::geometry::{Cage, CageError, TriMesh};
+    let cube = procedural::cube_cage(1.0);
+    let with = |edit: &dyn Fn(&mut TriMesh)| {
+        let mut mesh = TriMesh {
+            positions: cube.positions().to_vec(),
+            triangles: cube.triangles().to_vec(),
+            triangle_faces: cube.triangle_faces().to_vec(),
+        };
+        edit(&mut mesh);
+        Cage::new(mesh).map(|_| ()).unwrap_err()
+    };
+    let open = with(&|mesh| {
+        mesh.triangles.pop();
+        mesh.triangle_faces.pop();
+    });
+    assert!(matches!(open, CageError::OpenEdge { .. }), "{open}");
+    let out_of_range = with(&|mesh| mesh.triangles[2][1] = 8);
+    assert!(
+        matches!(
+            out_of_range,
+            CageError::IndexOutOfRange {
+                face: 2,
+                index: 8,
+                count: 8
+            }
+        ),
+        "{out_of_range}"
+    );
+    let degenerate = with(&|mesh| mesh.positions[3] = mesh.positions[1]);
+    assert!(
+        matches!(degenerate, CageError::DegenerateTriangle { .. }),
+        "{degenerate}"
+    );
+    let inconsistent = with(&|mesh| mesh.triangles[0].swap(0, 1));
+    assert!(
+        matches!(inconsistent, CageError::InconsistentOrientation { .. }),
+        "{inconsistent}"
+    );
+    let non_manifold = with(&|mesh| {
+        let (first, second) = (mesh.triangles[0], mesh.triangles[1]);
+        mesh.triangles
+            .extend([first, second].map(|[a, b, c]| [a, c, b]));
+        mesh.triangle_faces.extend([12, 13]);
+    });
+    assert!(
+        matches!(non_manifold, CageError::NonManifoldEdge { .. }),
+        "{non_manifold}"
+    );
+    let not_finite = with(&|mesh| mesh.positions[5].y = f64::NAN);
+    assert!(
+        matches!(not_finite, CageError::NonFinite { vertex: 5 }),
+        "{not_finite}"
+    );
+    for error in [
+        open,
+        out_of_range,
+        degenerate,
+        inconsistent,
+        non_manifold,
+        not_finite,
+    ] {
+        assert!(!error.to_string().contains(".obj"), "{error}");
+    }
+}
+
+/// Text parsed under a name (as the bundled scenes are) reports that name and the
+/// 1-based line of a bad number instead of reading it as 0.
+#[test]
+fn a_bad_number_names_the_file_and_line() {
+    use pmvc::geometry::parse_mesh;
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1.5x 0\nf 1 2 3\n".to_owned();
+    let error = parse_mesh(std::path::Path::new("assets/example.obj"), text).unwrap_err();
+    let message = error.to_string();
+    assert!(message.starts_with("assets/example.obj:3:"), "{message}");
 }

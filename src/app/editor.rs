@@ -8,7 +8,7 @@ use super::bind_queue::BindQueue;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::readouts::ReadoutCache;
-use super::scenes::BundledScene;
+use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::notices::Notices;
 use super::ui::statistics::FrameStats;
@@ -96,7 +96,8 @@ impl EditorApp {
             bind_backend_for(state, options.bind_on)
         });
         let wake_ctx = cc.egui_ctx.clone();
-        let (mesh, cage) = BundledScene::Comb.build();
+        // The comb is generated, so it cannot fail to load.
+        let (mesh, cage) = (scenes::comb_mesh(), scenes::comb_cage());
         let mut bind_options = BindOptions::for_method(options.method.unwrap_or(Method::Pmvc));
         if let Some(resolution) = options.resolution {
             bind_options.resolution = resolution.max(1);

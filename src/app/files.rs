@@ -87,10 +87,15 @@ impl EditorApp {
         true
     }
 
+    /// Open a bundled scene; if it cannot be loaded the current scene stays.
     pub fn open_bundled(&mut self, bundled: BundledScene) {
-        let (mesh, cage) = bundled.build();
-        self.install_document(Document::new(bundled.title(), mesh, cage));
-        self.start_bind();
+        match bundled.build() {
+            Ok((mesh, cage)) => {
+                self.install_document(Document::new(bundled.title(), mesh, cage));
+                self.start_bind();
+            }
+            Err(error) => self.error(error.to_string()),
+        }
     }
 
     /// Load a pose: a cage-shaped OBJ/OFF with one vertex per cage vertex.

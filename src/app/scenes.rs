@@ -8,7 +8,9 @@
 //! under PMVC.
 
 use crate::geometry::procedural::{comb_outline, extrude};
-use crate::geometry::{validate_cage, Cage, TriMesh};
+use crate::geometry::{
+    cage_from_file, parse_mesh, Cage, CageLoadError, LoadError, MeshFile, TriMesh,
+};
 use glam::{DVec2, DVec3};
 use std::path::Path;
 
@@ -44,14 +46,20 @@ impl BundledScene {
         }
     }
 
-    /// The scene's mesh and cage.
-    pub fn build(self) -> (TriMesh, Cage) {
+    /// The scene's mesh and cage. The scan is embedded text that goes through the
+    /// same loader as a user's files, so a bad number is an error, never 0.0
+    /// (`tests/editor_assets.rs` checks that it loads).
+    pub fn build(self) -> Result<(TriMesh, Cage), CageLoadError> {
         match self {
-            BundledScene::Comb => (comb_mesh(), comb_cage()),
-            BundledScene::Scan => (
-                parse_bundled_obj(include_str!("../../assets/scan_mesh.obj")),
-                bundled_cage(include_str!("../../assets/scan_cage.obj")),
-            ),
+            BundledScene::Comb => Ok((comb_mesh(), comb_cage())),
+            BundledScene::Scan => {
+                const MESH: &str = "assets/scan_mesh.obj";
+                const CAGE: &str = "assets/scan_cage.obj";
+                let mesh = bundled_mesh(MESH, include_str!("../../assets/scan_mesh.obj"))?;
+                let cage = bundled_mesh(CAGE, include_str!("../../assets/scan_cage.obj"))?;
+                let (cage, _report) = cage_from_file(Path::new(CAGE), cage)?;
+                Ok((mesh.mesh, cage))
+            }
         }
     }
 }
@@ -162,126 +170,8 @@ fn append_superellipsoid(
         .extend(faces..mesh.triangles.len() as u32);
 }
 
-/// Parse a bundled OBJ (only `v` and triangular or polygonal `f` lines, written by
-/// this crate or checked by a test), so bundled scenes need no file system.
-fn parse_bundled_obj(text: &str) -> TriMesh {
-    let mut mesh = TriMesh::default();
-    for line in text.lines() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let mut xyz = words.filter_map(|w| w.parse::<f64>().ok());
-                let (x, y, z) = (xyz.next(), xyz.next(), xyz.next());
-                mesh.positions.push(DVec3::new(
-                    x.unwrap_or(0.0),
-                    y.unwrap_or(0.0),
-                    z.unwrap_or(0.0),
-                ));
-            }
-            Some("f") => {
-                let corners: Vec<u32> = words
-                    .filter_map(|w| w.split('/').next()?.parse::<u32>().ok())
-                    .map(|i| i.saturating_sub(1))
-                    .collect();
-                let before = mesh.triangles.len();
-                crate::geometry::triangulate_polygon(
-                    &corners,
-                    &mesh.positions,
-                    &mut mesh.triangles,
-                );
-                let face = mesh.triangle_faces.last().map_or(0, |f| f + 1);
-                for _ in before..mesh.triangles.len() {
-                    mesh.triangle_faces.push(face);
-                }
-            }
-            _ => {}
-        }
-    }
-    mesh
-}
-
-fn bundled_cage(text: &str) -> Cage {
-    let mesh = parse_bundled_obj(text);
-    // The bundled cages are checked by `tests/editor_assets.rs`; validation here only
-    // orients them, so a failure is a packaging bug.
-    validate_cage(Path::new("bundled cage"), mesh)
-        .map(|(cage, _)| cage)
-        .expect("bundled cage is valid (checked by tests/editor_assets.rs)")
-}
-
-/// OBJ text of a mesh: `v` lines then 1-based `f` lines, six decimals.
-pub fn obj_text(positions: &[DVec3], triangles: &[[u32; 3]]) -> String {
-    use std::fmt::Write;
-    let mut text = String::new();
-    for p in positions {
-        let _ = writeln!(text, "v {:.6} {:.6} {:.6}", p.x, p.y, p.z);
-    }
-    for [a, b, c] in triangles {
-        let _ = writeln!(text, "f {} {} {}", a + 1, b + 1, c + 1);
-    }
-    text
-}
-
-/// A coarse cage enclosing `points`: an icosphere stretched to their bounding box,
-/// with each vertex pulled in along its ray from the centre to just outside the
-/// farthest point in a cone around that ray. Moving vertices only along rays from
-/// one centre keeps the sphere star-shaped, so the cage never self-intersects; the
-/// margin grows until every point is inside.
-pub fn star_cage(points: &[DVec3], subdivisions: u32, cone_degrees: f64, margin: f64) -> Cage {
-    let (lo, hi) = crate::geometry::bounds_of(points);
-    let centre = (lo + hi) / 2.0;
-    let half = ((hi - lo) / 2.0).max(DVec3::splat(1e-9));
-    let sphere = crate::geometry::procedural::icosphere(1.0, subdivisions);
-    let cone_cos = cone_degrees.to_radians().cos();
-    // Work in the box-normalised space so that the cone is fair along every axis.
-    let normalised: Vec<DVec3> = points.iter().map(|p| (*p - centre) / half).collect();
-    let reach: Vec<f64> = sphere
-        .positions
-        .iter()
-        .map(|direction| {
-            let direction = direction.normalize();
-            normalised
-                .iter()
-                .filter_map(|q| {
-                    let length = q.length();
-                    (length > 0.0 && q.dot(direction) >= cone_cos * length).then_some(length)
-                })
-                .fold(0.0, f64::max)
-        })
-        .collect();
-    // Directions with no point in their cone would dent the cage down to the
-    // centre; lift every vertex at least to the mean of its neighbours.
-    let mut neighbours = vec![Vec::new(); sphere.positions.len()];
-    for [a, b, c] in &sphere.triangles {
-        for (u, v) in [(a, b), (b, c), (c, a)] {
-            neighbours[*u as usize].push(*v as usize);
-        }
-    }
-    let mut reach = reach;
-    for _ in 0..3 {
-        reach = reach
-            .iter()
-            .zip(&neighbours)
-            .map(|(r, around)| {
-                let mean =
-                    around.iter().map(|&n| reach[n]).sum::<f64>() / around.len().max(1) as f64;
-                r.max(mean)
-            })
-            .collect();
-    }
-    let mut scale = 1.0 + margin;
-    loop {
-        let positions = sphere
-            .positions
-            .iter()
-            .zip(&reach)
-            .map(|(direction, r)| centre + direction.normalize() * (r * scale) * half)
-            .collect();
-        let cage = sphere.with_positions(positions);
-        let classes = crate::geometry::classify_points(&cage, points);
-        if classes.outside.is_empty() || scale > 4.0 {
-            return cage;
-        }
-        scale += margin;
-    }
+/// A bundled file, read through the same parser and validation as a user's file,
+/// under its path in the source tree (which the messages name).
+fn bundled_mesh(path: &str, text: &str) -> Result<MeshFile, LoadError> {
+    parse_mesh(Path::new(path), text.to_owned())
 }

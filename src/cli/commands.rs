@@ -1,12 +1,12 @@
 //! The work behind each subcommand.
 
 use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
+use crate::coords::npy::{read_npy, write_npy};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{self, classify_points, Cage, MeshFile, PointClasses};
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -194,7 +194,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         "cage  {}: {} vertices, {} triangles, closed, edge-manifold, consistently oriented",
         args.input.cage.display(),
         cage.vertex_count(),
-        cage.triangles.len()
+        cage.triangles().len()
     );
     println!(
         "      volume {:.6}, faces point {}, diagonal {:.6}",
@@ -271,8 +271,8 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
         ..Default::default()
     };
     let cage = geometry::TriMesh {
-        positions: scene.cage.positions,
-        triangles: scene.cage.triangles,
+        positions: scene.cage.positions().to_vec(),
+        triangles: scene.cage.triangles().to_vec(),
         ..Default::default()
     };
     geometry::write_obj(&args.mesh, &points)?;
@@ -284,63 +284,6 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
         cage.positions.len()
     );
     Ok(())
-}
-
-/// Write weights as .npy v1: little-endian float32, C order, shape (rows, cols).
-pub fn write_npy(path: &Path, weights: &Weights) -> Result<()> {
-    let mut header = format!(
-        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {}), }}",
-        weights.rows, weights.cols
-    );
-    // Magic, version, length and header end on a 64-byte boundary, with a newline.
-    let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
-    header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
-    header.push('\n');
-    let header_len = u16::try_from(header.len()).context("weights shape too long for .npy")?;
-    geometry::write_atomically(path, |out| {
-        out.write_all(b"\x93NUMPY\x01\x00")?;
-        out.write_all(&header_len.to_le_bytes())?;
-        out.write_all(header.as_bytes())?;
-        // In blocks rather than element by element, which took tens of milliseconds.
-        let mut block = Vec::with_capacity(1 << 16);
-        for values in weights.values.chunks(1 << 14) {
-            block.clear();
-            block.extend(values.iter().flat_map(|v| v.to_le_bytes()));
-            out.write_all(&block)?;
-        }
-        Ok(())
-    })?;
-    Ok(())
-}
-
-/// Read weights written by [`write_npy`] (or NumPy): float32, C order, two dimensions.
-pub fn read_npy(path: &Path) -> Result<Weights> {
-    let file =
-        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let npy = npyz::NpyFile::new(std::io::BufReader::new(file))
-        .with_context(|| format!("{}: not a .npy file", path.display()))?;
-    let shape = npy.shape().to_vec();
-    let [rows, cols] = shape[..] else {
-        bail!(
-            "{}: expected a 2-D weights array, found shape {shape:?}",
-            path.display()
-        );
-    };
-    if npy.order() != npyz::Order::C {
-        bail!("{}: expected C (row-major) order", path.display());
-    }
-    let dtype = npy.dtype().descr();
-    let values: Vec<f32> = npy.into_vec().with_context(|| {
-        format!(
-            "{}: expected float32 weights, found dtype {dtype}",
-            path.display()
-        )
-    })?;
-    Ok(Weights {
-        rows: rows as usize,
-        cols: cols as usize,
-        values,
-    })
 }
 
 pub(super) fn info() -> Result<()> {

@@ -15,6 +15,7 @@
 pub mod cubemap;
 pub mod family;
 pub mod mvc;
+pub mod npy;
 pub mod pmvc;
 pub mod quality;
 

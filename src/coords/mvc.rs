@@ -28,7 +28,7 @@ pub fn mvc_weights(x: DVec3, cage: &Cage, out: &mut [f64], scratch: &mut MvcScra
     let tolerance = ON_SURFACE * cage.diagonal().max(f64::MIN_POSITIVE);
     scratch.distances.clear();
     scratch.directions.clear();
-    for (j, &p) in cage.positions.iter().enumerate() {
+    for (j, &p) in cage.positions().iter().enumerate() {
         let offset = p - x;
         let distance = offset.length();
         if distance <= tolerance {
@@ -40,7 +40,7 @@ pub fn mvc_weights(x: DVec3, cage: &Cage, out: &mut [f64], scratch: &mut MvcScra
     }
 
     let mut total = 0.0;
-    for (t, corners) in cage.triangles.iter().enumerate() {
+    for (t, corners) in cage.triangles().iter().enumerate() {
         let index = corners.map(|i| i as usize);
         let d = index.map(|i| scratch.distances[i]);
         let u = index.map(|i| scratch.directions[i]);
@@ -101,7 +101,7 @@ mod tests {
         let cage = procedural::cube_cage(1.0);
         let mut out = vec![0.0; cage.vertex_count()];
         mvc_weights(
-            cage.positions[3],
+            cage.positions()[3],
             &cage,
             &mut out,
             &mut MvcScratch::default(),

@@ -250,7 +250,8 @@ mod tests {
     fn mvc_inside_a_convex_cage_is_nonnegative_and_precise() {
         let cage = procedural::cube_cage(1.0);
         let points = procedural::points_inside(&cage, 300, 7, 1e-3);
-        let quality = WeightQuality::measure(&mvc_matrix(&cage, &points), &points, &cage.positions);
+        let quality =
+            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions());
         assert_eq!(quality.negative_vertices, 0, "{quality:?}");
         assert_eq!(quality.negative_share, 0.0);
         assert!(quality.max_partition_error < 1e-5, "{quality:?}");
@@ -261,7 +262,8 @@ mod tests {
     fn mvc_inside_a_comb_has_negative_rows() {
         let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
         let points = procedural::points_inside(&cage, 300, 5, 1e-3);
-        let quality = WeightQuality::measure(&mvc_matrix(&cage, &points), &points, &cage.positions);
+        let quality =
+            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions());
         assert!(quality.negative_share > 0.0, "{quality:?}");
         assert!(quality.most_negative < -NEGATIVE_TOLERANCE);
         let (row, col) = quality.most_negative_at.unwrap();

@@ -4,18 +4,25 @@
 use super::{CageError, TriMesh};
 use glam::DVec3;
 use std::collections::HashMap;
-use std::path::Path;
 
-/// A validated cage: closed, edge-manifold, outward-facing triangles.
+/// A validated cage: closed, edge-manifold, outward-facing triangles. The fields
+/// are private so that the only way to get one is [`Cage::new`], and every binder
+/// can rely on these properties without checking them again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cage {
-    pub positions: Vec<DVec3>,
-    pub triangles: Vec<[u32; 3]>,
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
     /// For each triangle, the face of the file it came from.
-    pub triangle_faces: Vec<u32>,
+    triangle_faces: Vec<u32>,
 }
 
 impl Cage {
+    /// Validate `mesh` as a cage and return it outward-facing, with what validation
+    /// noticed without rejecting it. See the module doc for the rules.
+    pub fn new(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
+        validate(mesh)
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
@@ -57,6 +64,8 @@ impl Cage {
     }
 
     /// The same cage with other vertex positions (a pose), keeping its topology.
+    /// Not validated again: a pose may fold the cage, and binding only ever uses
+    /// the rest cage, which was.
     pub fn with_positions(&self, positions: Vec<DVec3>) -> Cage {
         assert_eq!(positions.len(), self.positions.len());
         Cage {
@@ -120,30 +129,21 @@ fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
         / 6.0
 }
 
-/// Check that `mesh` is a usable cage and return it outward-facing.
-pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
-    let path_buf = || path.to_owned();
+fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
     let count = mesh.positions.len();
     if count < 4 {
-        return Err(CageError::TooFewVertices {
-            path: path_buf(),
-            count,
-        });
+        return Err(CageError::TooFewVertices { count });
     }
     if let Some(vertex) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(CageError::NonFinite {
-            path: path_buf(),
-            vertex,
-        });
+        return Err(CageError::NonFinite { vertex });
     }
     if mesh.triangles.is_empty() {
-        return Err(CageError::NoFaces { path: path_buf() });
+        return Err(CageError::NoFaces);
     }
     let face_of = |t: usize| mesh.triangle_faces.get(t).map_or(t, |&f| f as usize);
     for (t, triangle) in mesh.triangles.iter().enumerate() {
         if let Some(&index) = triangle.iter().find(|&&i| i as usize >= count) {
             return Err(CageError::IndexOutOfRange {
-                path: path_buf(),
                 face: face_of(t),
                 index,
                 count,
@@ -160,7 +160,6 @@ pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), C
         let doubled_area = (pb - pa).cross(pc - pa).length();
         if a == b || b == c || a == c || doubled_area <= 1e-12 * diagonal * diagonal {
             return Err(CageError::DegenerateTriangle {
-                path: path_buf(),
                 face: face_of(t),
                 a,
                 b,
@@ -187,7 +186,6 @@ pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), C
         match uses.as_slice() {
             [(t, _)] => {
                 return Err(CageError::OpenEdge {
-                    path: path_buf(),
                     a: *a,
                     b: *b,
                     face: face_of(*t),
@@ -197,7 +195,6 @@ pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), C
                 if first_forward == second_forward {
                     let (from, to) = if *first_forward { (*a, *b) } else { (*b, *a) };
                     return Err(CageError::InconsistentOrientation {
-                        path: path_buf(),
                         a: from,
                         b: to,
                         first: face_of(*first),
@@ -209,7 +206,6 @@ pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), C
                 let mut faces: Vec<usize> = uses.iter().map(|(t, _)| face_of(*t)).collect();
                 faces.dedup();
                 return Err(CageError::NonManifoldEdge {
-                    path: path_buf(),
                     a: *a,
                     b: *b,
                     count: uses.len(),
@@ -226,7 +222,7 @@ pub fn validate_cage(path: &Path, mesh: TriMesh) -> Result<(Cage, CageReport), C
     let mut triangles = mesh.triangles;
     let mut volume = signed_volume(&mesh.positions, &triangles);
     if volume.abs() <= 1e-12 * diagonal.powi(3) {
-        return Err(CageError::ZeroVolume { path: path_buf() });
+        return Err(CageError::ZeroVolume);
     }
     let flipped = volume < 0.0;
     if flipped {

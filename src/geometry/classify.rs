@@ -36,7 +36,7 @@ pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
     // Unit normal and offset of each triangle's plane: a point farther than the
     // tolerance from the plane cannot be on the triangle, which spares most
     // closest-point computations.
-    let planes: Vec<(DVec3, f64)> = (0..cage.triangles.len())
+    let planes: Vec<(DVec3, f64)> = (0..cage.triangles().len())
         .map(|t| {
             let [a, b, c] = cage.triangle(t);
             let normal = (b - a).cross(c - a).normalize_or_zero();
@@ -101,7 +101,7 @@ type Corner = (DVec3, f64);
 /// spares most of the square roots.
 fn set_corners(cage: &Cage, x: DVec3, corners: &mut Vec<Corner>) {
     corners.clear();
-    corners.extend(cage.positions.iter().map(|&p| {
+    corners.extend(cage.positions().iter().map(|&p| {
         let relative = p - x;
         (relative, relative.length())
     }));
@@ -122,7 +122,7 @@ fn is_enclosed(cage: &Cage, x: DVec3, corners: &mut Vec<Corner>) -> bool {
 #[inline(always)]
 fn winding_number_with(cage: &Cage, corners: &[Corner], atan2: impl Fn(f64, f64) -> f64) -> f64 {
     let mut total = 0.0;
-    for triangle in &cage.triangles {
+    for triangle in cage.triangles() {
         total += 2.0 * half_solid_angle_with(triangle, corners, &atan2);
     }
     total / (4.0 * std::f64::consts::PI)
@@ -149,7 +149,7 @@ unsafe fn fast_winding_number_avx2(cage: &Cage, corners: &[Corner]) -> f64 {
 #[inline(always)]
 fn fast_winding_number_any_cpu(cage: &Cage, corners: &[Corner]) -> f64 {
     let mut lanes = [0.0; 4];
-    let chunks = cage.triangles.chunks_exact(4);
+    let chunks = cage.triangles().chunks_exact(4);
     let rest = chunks.remainder();
     for chunk in chunks {
         for (lane, triangle) in lanes.iter_mut().zip(chunk) {

@@ -53,71 +53,43 @@ pub enum LoadError {
     },
 }
 
-/// A mesh was read but is not usable as a cage. Faces are numbered from 0 in file
-/// order (the n-th face line); vertices from 0 in `v` order.
+/// A mesh is not usable as a cage. Faces are numbered from 0 in file order (the
+/// n-th face line); vertices from 0 in `v` order. The loaders add the file
+/// ([`CageLoadError::Invalid`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CageError {
-    #[error("{path}: a cage needs at least 4 vertices, this one has {count}", path = path.display())]
-    TooFewVertices { path: PathBuf, count: usize },
-    #[error("{path}: the cage has no faces", path = path.display())]
-    NoFaces { path: PathBuf },
-    #[error("{path}: vertex {vertex} has a non-finite coordinate", path = path.display())]
-    NonFinite { path: PathBuf, vertex: usize },
-    #[error(
-        "{path}: face {face} refers to vertex {index}, but the cage has {count} vertices",
-        path = path.display()
-    )]
+    #[error("a cage needs at least 4 vertices, this one has {count}")]
+    TooFewVertices { count: usize },
+    #[error("the cage has no faces")]
+    NoFaces,
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFinite { vertex: usize },
+    #[error("face {face} refers to vertex {index}, but the cage has {count} vertices")]
     IndexOutOfRange {
-        path: PathBuf,
         face: usize,
         index: u32,
         count: usize,
     },
-    #[error(
-        "{path}: face {face} is degenerate (zero area) at vertices {a}, {b}, {c}",
-        path = path.display()
-    )]
-    DegenerateTriangle {
-        path: PathBuf,
-        face: usize,
-        a: u32,
-        b: u32,
-        c: u32,
-    },
-    #[error(
-        "{path}: the cage is not closed: edge {a}–{b} of face {face} has no neighbouring face",
-        path = path.display()
-    )]
-    OpenEdge {
-        path: PathBuf,
-        a: u32,
-        b: u32,
-        face: usize,
-    },
-    #[error(
-        "{path}: the cage is not edge-manifold: edge {a}–{b} is shared by {count} faces ({faces})",
-        path = path.display()
-    )]
+    #[error("face {face} is degenerate (zero area) at vertices {a}, {b}, {c}")]
+    DegenerateTriangle { face: usize, a: u32, b: u32, c: u32 },
+    #[error("the cage is not closed: edge {a}–{b} of face {face} has no neighbouring face")]
+    OpenEdge { a: u32, b: u32, face: usize },
+    #[error("the cage is not edge-manifold: edge {a}–{b} is shared by {count} faces ({faces})")]
     NonManifoldEdge {
-        path: PathBuf,
         a: u32,
         b: u32,
         count: usize,
         faces: String,
     },
-    #[error(
-        "{path}: faces {first} and {second} are oriented inconsistently: both run along edge {a}→{b}",
-        path = path.display()
-    )]
+    #[error("faces {first} and {second} are oriented inconsistently: both run along edge {a}→{b}")]
     InconsistentOrientation {
-        path: PathBuf,
         a: u32,
         b: u32,
         first: usize,
         second: usize,
     },
-    #[error("{path}: the cage encloses no volume", path = path.display())]
-    ZeroVolume { path: PathBuf },
+    #[error("the cage encloses no volume")]
+    ZeroVolume,
 }
 
 /// A cage file could not be read, or was read but is not a valid cage.
@@ -125,8 +97,8 @@ pub enum CageError {
 pub enum CageLoadError {
     #[error(transparent)]
     Load(#[from] LoadError),
-    #[error(transparent)]
-    Invalid(#[from] CageError),
+    #[error("{path}: {source}", path = path.display())]
+    Invalid { path: PathBuf, source: CageError },
 }
 
 /// An output file could not be written. Any existing file at `path` is untouched.

@@ -3,7 +3,7 @@
 //! which is renamed over it only once complete.
 
 use super::error::{CageLoadError, WriteError};
-use super::{obj, off, validate_cage, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
+use super::{obj, off, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
 use std::io::Write;
 use std::path::Path;
@@ -35,6 +35,13 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
             })
         }
     };
+    parse_mesh(path, text)
+}
+
+/// Parse the text of an OBJ or OFF file named `path` (the format chosen by its
+/// extension); `path` is only used for the format and for messages. The one entry
+/// for mesh text, used by [`load_mesh`] and by the editor's bundled scenes.
+pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -48,10 +55,17 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
     }
 }
 
-/// Read a cage file and validate it (see [`validate_cage`]).
+/// Read a cage file and validate it (see [`Cage::new`]).
 pub fn load_cage(path: &Path) -> Result<(Cage, CageReport), CageLoadError> {
-    let file = load_mesh(path)?;
-    Ok(validate_cage(path, file.mesh)?)
+    cage_from_file(path, load_mesh(path)?)
+}
+
+/// Validate a mesh read from `path` as a cage; errors name the file.
+pub fn cage_from_file(path: &Path, file: MeshFile) -> Result<(Cage, CageReport), CageLoadError> {
+    Cage::new(file.mesh).map_err(|source| CageLoadError::Invalid {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 /// Write a file through a temporary sibling that is renamed over `path` on success.
@@ -94,15 +108,24 @@ pub fn write_atomically(
 /// Write a triangle mesh as OBJ.
 pub fn write_obj(path: &Path, mesh: &TriMesh) -> Result<(), WriteError> {
     write_atomically(path, |out| {
-        writeln!(out, "# written by pmvc")?;
-        for p in &mesh.positions {
-            write_vertex(out, *p)?;
-        }
-        for [a, b, c] in &mesh.triangles {
-            writeln!(out, "f {} {} {}", a + 1, b + 1, c + 1)?;
-        }
-        Ok(())
+        write_obj_to(out, &mesh.positions, &mesh.triangles)
     })
+}
+
+/// The one OBJ writer: a comment, `v` lines, then 1-based triangular `f` lines.
+pub fn write_obj_to(
+    out: &mut dyn Write,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> std::io::Result<()> {
+    writeln!(out, "# written by pmvc")?;
+    for p in positions {
+        write_vertex(out, *p)?;
+    }
+    for [a, b, c] in triangles {
+        writeln!(out, "f {} {} {}", a + 1, b + 1, c + 1)?;
+    }
+    Ok(())
 }
 
 /// Write `file` with its vertices moved to `positions` (one per `v` line, in order).

@@ -12,13 +12,16 @@ mod off;
 pub mod procedural;
 pub mod subdivide;
 
-pub use cage::{validate_cage, Cage, CageReport};
+pub use cage::{Cage, CageReport};
 pub use classify::{
     classify_points, closest_point_on_triangle, generalized_winding_number, PointClass,
     PointClasses,
 };
 pub use error::{CageError, CageLoadError, LoadError, WriteError};
-pub use io::{load_cage, load_mesh, write_atomically, write_deformed_mesh, write_obj};
+pub use io::{
+    cage_from_file, load_cage, load_mesh, parse_mesh, write_atomically, write_deformed_mesh,
+    write_obj, write_obj_to,
+};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;

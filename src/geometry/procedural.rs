@@ -2,7 +2,7 @@
 //! prongs, an extruded star, subdivided spheres) and benchmark scenes of the sizes
 //! in the paper's tables. Deterministic: the same arguments give the same geometry.
 
-use super::Cage;
+use super::{Cage, TriMesh};
 use glam::{DVec2, DVec3};
 
 /// An axis-aligned cube cage of half-size `half`, centred at the origin, 8 vertices.
@@ -235,7 +235,7 @@ pub fn uv_sphere(radius: f64, rings: u32, segments: u32) -> Cage {
 /// `count` points strictly inside `cage`, uniformly distributed, from a fixed seed.
 /// Points closer than `margin` (relative to the cage diagonal) to the surface are rejected.
 pub fn points_inside(cage: &Cage, count: usize, seed: u64, margin: f64) -> Vec<DVec3> {
-    let (lo, hi) = super::bounds_of(&cage.positions);
+    let (lo, hi) = super::bounds_of(cage.positions());
     let min_distance = margin * cage.diagonal();
     let mut random = SplitMix64(seed);
     let mut points = Vec::with_capacity(count);
@@ -260,7 +260,7 @@ pub fn points_inside(cage: &Cage, count: usize, seed: u64, margin: f64) -> Vec<D
 
 /// Unsigned distance from `x` to the cage surface.
 pub fn distance_to_surface(cage: &Cage, x: DVec3) -> f64 {
-    (0..cage.triangles.len())
+    (0..cage.triangles().len())
         .map(|t| {
             let [a, b, c] = cage.triangle(t);
             super::closest_point_on_triangle(x, a, b, c).0.distance(x)
@@ -287,12 +287,83 @@ impl SplitMix64 {
     }
 }
 
+/// Every procedural cage goes through validation like a loaded one; the shapes
+/// here are closed and outward by construction (each has a test), so a failure is
+/// a bug in this file.
 fn cage_from(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Cage {
     let triangle_faces = (0..triangles.len() as u32).collect();
-    Cage {
+    let mesh = TriMesh {
         positions,
         triangles,
         triangle_faces,
+    };
+    match Cage::new(mesh) {
+        Ok((cage, _report)) => cage,
+        Err(error) => panic!("procedural cage is invalid: {error}"),
+    }
+}
+
+/// A coarse cage enclosing `points`: an icosphere stretched to their bounding box,
+/// with each vertex pulled in along its ray from the centre to just outside the
+/// farthest point in a cone around that ray. Moving vertices only along rays from
+/// one centre keeps the sphere star-shaped, so the cage never self-intersects; the
+/// margin grows until every point is inside.
+pub fn star_cage(points: &[DVec3], subdivisions: u32, cone_degrees: f64, margin: f64) -> Cage {
+    let (lo, hi) = super::bounds_of(points);
+    let centre = (lo + hi) / 2.0;
+    let half = ((hi - lo) / 2.0).max(DVec3::splat(1e-9));
+    let sphere = icosphere(1.0, subdivisions);
+    let cone_cos = cone_degrees.to_radians().cos();
+    // Work in the box-normalised space so that the cone is fair along every axis.
+    let normalised: Vec<DVec3> = points.iter().map(|p| (*p - centre) / half).collect();
+    let reach: Vec<f64> = sphere
+        .positions()
+        .iter()
+        .map(|direction| {
+            let direction = direction.normalize();
+            normalised
+                .iter()
+                .filter_map(|q| {
+                    let length = q.length();
+                    (length > 0.0 && q.dot(direction) >= cone_cos * length).then_some(length)
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    // Directions with no point in their cone would dent the cage down to the
+    // centre; lift every vertex at least to the mean of its neighbours.
+    let mut neighbours = vec![Vec::new(); sphere.vertex_count()];
+    for [a, b, c] in sphere.triangles() {
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            neighbours[*u as usize].push(*v as usize);
+        }
+    }
+    let mut reach = reach;
+    for _ in 0..3 {
+        reach = reach
+            .iter()
+            .zip(&neighbours)
+            .map(|(r, around)| {
+                let mean =
+                    around.iter().map(|&n| reach[n]).sum::<f64>() / around.len().max(1) as f64;
+                r.max(mean)
+            })
+            .collect();
+    }
+    let mut scale = 1.0 + margin;
+    loop {
+        let positions = sphere
+            .positions()
+            .iter()
+            .zip(&reach)
+            .map(|(direction, r)| centre + direction.normalize() * (r * scale) * half)
+            .collect();
+        let cage = sphere.with_positions(positions);
+        let classes = super::classify_points(&cage, points);
+        if classes.outside.is_empty() || scale > 4.0 {
+            return cage;
+        }
+        scale += margin;
     }
 }
 

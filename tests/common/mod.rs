@@ -15,11 +15,14 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 pub fn cage_obj(cage: &Cage) -> String {
-    let mut text = String::new();
-    for p in &cage.positions {
-        text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
-    }
-    for [a, b, c] in &cage.triangles {
+    triangles_obj(cage.positions(), cage.triangles())
+}
+
+/// OBJ text with every coordinate written to round-trip f64 exactly, so that a
+/// test reads back the geometry it made.
+pub fn triangles_obj(positions: &[glam::DVec3], triangles: &[[u32; 3]]) -> String {
+    let mut text = points_obj(positions);
+    for [a, b, c] in triangles {
         text.push_str(&format!("f {} {} {}\n", a + 1, b + 1, c + 1));
     }
     text
