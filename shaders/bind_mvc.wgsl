@@ -10,19 +10,9 @@
 // cage vertex, near a triangle, or near a triangle's plane): the per-triangle
 // weights become 0/0 forms. Such points are flagged FALLBACK and redone on the CPU.
 
-struct Params {
-    point_count: u32,
-    triangle_count: u32,
-    vertex_count: u32,
-    resolution: u32,
-    band_rows: u32,
-    max_missed: u32,
-    incidence_offsets: u32,
-    incidence_entries: u32,
-}
+#import bind_params
+#import bind_constants
 
-const WORKGROUP_SIZE: u32 = 64u;
-const FALLBACK: u32 = 1u;
 const PI: f32 = 3.14159265358979;
 // Below this |sin| of a spherical angle the 0/0 cancellation (error about 1e-8/|sin|
 // in a coordinate) could exceed the accuracy budget. Measured: 1e-3 sent 26% of the

@@ -14,22 +14,10 @@
 // Finally each cage vertex gathers its incident triangles' sums and the row is
 // normalised by its total (Σ_k E_k/det · Ω/|d| = w, so the row sum is Σ w).
 
-struct Params {
-    point_count: u32,
-    triangle_count: u32,
-    vertex_count: u32,
-    resolution: u32,
-    band_rows: u32,
-    max_missed: u32,
-    // Offsets into `topology`: vertex → incident corners (CSR).
-    incidence_offsets: u32,
-    incidence_entries: u32,
-}
+#import bind_params
+#import bind_constants
 
-const WORKGROUP_SIZE: u32 = 64u;
-const BAND_TEXELS: u32 = 1024u;
 const NO_TRIANGLE: u32 = 0xffffffffu;
-const FALLBACK: u32 = 1u;
 const FAR: f32 = 1e30;
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -86,17 +74,7 @@ fn triangle_at(t: u32, x: vec3<f32>) -> Triangle {
     return Triangle(a, b, c, e0, cross(c, a), cross(a, b), dot(a, e0));
 }
 
-// (right, up, normal) of cube face `face`, in the order of CUBE_FACES.
-fn face_axes(face: u32) -> mat3x3<f32> {
-    switch face {
-        case 0u: { return mat3x3<f32>(vec3(0.0, 1.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0)); }
-        case 1u: { return mat3x3<f32>(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(-1.0, 0.0, 0.0)); }
-        case 2u: { return mat3x3<f32>(vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)); }
-        case 3u: { return mat3x3<f32>(vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(0.0, -1.0, 0.0)); }
-        case 4u: { return mat3x3<f32>(vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), vec3(0.0, 0.0, 1.0)); }
-        default: { return mat3x3<f32>(vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, -1.0)); }
-    }
-}
+#import cube_faces
 
 // Conservative texel bounds of the triangle's projection on the face, widened by a
 // texel against rounding, as in the CPU's `texel_bounds`.

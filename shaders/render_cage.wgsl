@@ -2,14 +2,7 @@
 // drawn twice: dimmed where the mesh hides it (depth test "greater"), bright where
 // visible. Paired with src/render/cage.rs.
 
-struct Frame {
-    view_projection: mat4x4<f32>,
-    eye: vec4<f32>,
-    viewport: vec4<f32>,
-    counts: vec4<u32>,
-    colouring: vec4<u32>,
-    colour_scale: vec4<f32>,
-}
+#import frame
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(3) var<storage, read> cage: array<vec4<f32>>;
@@ -38,7 +31,7 @@ fn vs_handle(@builtin(vertex_index) corner: u32, @builtin(instance_index) handle
         vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0),
     );
     let state = handle_state[handle];
-    var radius = frame.viewport.z;
+    var radius = frame.handle_radius_px;
     var colour = vec3<f32>(0.92, 0.92, 0.95);
     if state == 1u {
         colour = vec3<f32>(1.0, 0.55, 0.05);
@@ -49,7 +42,7 @@ fn vs_handle(@builtin(vertex_index) corner: u32, @builtin(instance_index) handle
     }
     var clip = frame.view_projection * vec4<f32>(cage[handle].xyz, 1.0);
     clip.z -= 2e-4 * clip.w;
-    let offset = corners[corner] * radius * 2.0 / frame.viewport.xy;
+    let offset = corners[corner] * radius * 2.0 / frame.viewport_size_px;
     clip = vec4<f32>(clip.xy + offset * clip.w, clip.zw);
     var out: CageVarying;
     out.clip = clip;

@@ -158,6 +158,7 @@ fn heatmaps_colour_known_weights_blue_white_red() {
     for scale in [Scale::Linear, Scale::LogMagnitude] {
         let shading = Shading {
             method: Method::Mvc,
+            against: None,
             colouring: Colouring::CageVertexWeight(column as u32),
             scale,
             colour_limit: limit,

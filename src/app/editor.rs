@@ -260,23 +260,21 @@ impl EditorApp {
         let changes = self.document.take_changes();
         if changes.scene {
             let rest = to_f32(&self.document.mesh().positions);
-            let cage_rest = to_f32(self.document.cage().positions());
             let triangles = self.document.mesh().triangles.clone();
-            let cage_triangles = self.document.cage().triangles().to_vec();
+            let cage = self.document.cage().clone();
             self.with_renderer(|renderer, device, _| {
                 renderer.upload_scene(
                     device,
                     &SceneUpload {
                         rest_positions: &rest,
                         triangles: &triangles,
-                        cage_rest: &cage_rest,
-                        cage_triangles: &cage_triangles,
+                        cage: &cage,
                     },
                 )
             });
         }
         if changes.scene || changes.pose {
-            let pose = to_f32(self.document.pose());
+            let pose = self.document.pose().to_vec();
             self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
         }
         if changes.scene || changes.pose || !changes.weights.is_empty() {

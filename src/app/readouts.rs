@@ -150,6 +150,10 @@ impl EditorApp {
         let colouring = self.view.colouring(pane);
         Shading {
             method: pane.method(),
+            against: match pane {
+                Pane::Difference { against, .. } => Some(against),
+                Pane::Method(_) => None,
+            },
             colouring,
             scale: self.view.scale,
             colour_limit: self.colour_limit(colouring, pane),

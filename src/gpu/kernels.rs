@@ -2,20 +2,34 @@
 
 use super::GpuError;
 
-pub(super) const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
-pub(super) const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");
+use super::shader_source::compose;
 
-/// Invocations per workgroup in both kernels (`WORKGROUP_SIZE` in the WGSL).
+const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
+const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");
+
+/// The binding kernels' WGSL with imports resolved, by file name.
+pub fn kernel_sources() -> [(&'static str, String); 2] {
+    // The shared files are compiled in, so only a broken build can fail here.
+    let composed = |name, source| compose(name, source).unwrap_or_else(|error| panic!("{error}"));
+    [
+        ("bind_pmvc.wgsl", composed("bind_pmvc.wgsl", PMVC_SOURCE)),
+        ("bind_mvc.wgsl", composed("bind_mvc.wgsl", MVC_SOURCE)),
+    ]
+}
+
+// These three are written into the WGSL by `shader_source` (import `bind_constants`).
+/// Invocations per workgroup in both kernels.
 pub(super) const WORKGROUP_SIZE: u32 = 64;
-/// Texels of the PMVC kernel's shared depth buffer (`BAND_TEXELS` in the WGSL).
+/// Texels of the PMVC kernel's shared depth buffer.
 pub(super) const BAND_TEXELS: u32 = 1024;
 /// Status bit the kernels set for rows the CPU must redo.
 pub(super) const FALLBACK: u32 = 1;
 
-/// Uniform block of both kernels (`Params` in the WGSL).
+/// Uniform block of both kernels: `Params` in `shaders/shared/bind_params.wgsl`
+/// (layouts compared by `tests/shader_layouts.rs`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct Params {
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Params {
     pub point_count: u32,
     pub triangle_count: u32,
     pub vertex_count: u32,
@@ -76,7 +90,8 @@ impl Kernels {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = |label: &str, source: &str| {
+        let [(_, pmvc_source), (_, mvc_source)] = kernel_sources();
+        let pipeline = |label: &str, source: String| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(label),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -90,8 +105,8 @@ impl Kernels {
                 cache: None,
             })
         };
-        let pmvc = pipeline("bind_pmvc", PMVC_SOURCE);
-        let mvc = pipeline("bind_mvc", MVC_SOURCE);
+        let pmvc = pipeline("bind_pmvc", pmvc_source);
+        let mvc = pipeline("bind_mvc", mvc_source);
         if let Some(error) = pollster::block_on(memory.pop()) {
             return Err(error.into());
         }

@@ -9,7 +9,8 @@
 
 mod binder;
 mod context;
-mod kernels;
+pub mod kernels;
+pub mod shader_source;
 
 pub use binder::{
     Backend, BatchSize, BindConfig, BindError, BindHandle, BindInput, BindOutput, BindStats,

@@ -1,9 +1,16 @@
 //! The cage overlay: wire edges and vertex handles, each drawn dimmed where the
 //! mesh hides it and bright where visible. Paired with `shaders/render_cage.wgsl`.
 
-use super::viewport::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
+use super::scene_gpu::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
+use crate::gpu::shader_source::compose;
 
 const SHADER: &str = include_str!("../../shaders/render_cage.wgsl");
+
+/// `render_cage.wgsl` with its imports resolved.
+pub fn shader_source() -> String {
+    // The shared files are compiled in, so only a broken build can fail here.
+    compose("render_cage.wgsl", SHADER).unwrap_or_else(|error| panic!("{error}"))
+}
 
 pub struct CageRenderer {
     hidden_edges: wgpu::RenderPipeline,
@@ -20,7 +27,7 @@ impl CageRenderer {
     ) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render_cage.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("cage"),

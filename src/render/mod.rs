@@ -1,19 +1,29 @@
-//! Viewport drawing for the editor through egui_wgpu paint callbacks. Each
-//! renderer is paired with its WGSL file in `shaders/render_*.wgsl`:
-//! - [`mesh`]: the deformed mesh (deformation in the vertex shader) and readback;
+//! Viewport drawing for the editor through egui_wgpu paint callbacks. Imports
+//! run one way: the renderers depend on the leaf [`scene_gpu`], and only the
+//! orchestrator [`viewport`] depends on the renderers.
+//! - [`scene_gpu`]: formats, the frame uniform, the scene's buffers and layout;
+//! - [`mesh`]: the deformed mesh (deformation in the vertex shader);
 //! - [`cage`]: the cage's edges and handles;
-//! - [`viewport`]: buffers, the offscreen target and compositing into egui;
+//! - [`readback`]: the mesh shader's results read back, for tests and checks;
+//! - [`composite`]: offscreen targets and compositing into egui's pass;
+//! - [`viewport`]: the orchestrator and the paint callback;
 //! - [`camera`]: the orbit camera and screen projection (no GPU);
 //! - [`colormap`]: the heatmaps' colour maps, CPU twins of the shader's (no GPU).
+//!
+//! Each renderer is paired with its WGSL file in `shaders/render_*.wgsl`.
 
 pub mod cage;
 pub mod camera;
 pub mod colormap;
+pub mod composite;
 pub mod mesh;
+pub mod readback;
+pub mod scene_gpu;
 pub mod viewport;
 
 pub use camera::{OrbitCamera, ScreenProjection};
+pub use scene_gpu::{FrameUniform, ReadBack};
 pub use viewport::{
-    check_adapter, Colouring, FrameParams, ReadBack, RenderError, SceneUpload, Shading,
-    ViewportCallback, ViewportRenderer, MAX_VIEWS,
+    check_adapter, Colouring, FrameParams, RenderError, SceneUpload, Shading, ViewportCallback,
+    ViewportRenderer, MAX_VIEWS,
 };

@@ -1,31 +1,33 @@
-//! The 3D viewport inside egui: GPU buffers of the scene, an offscreen colour and
-//! depth target (egui's own pass has no depth buffer), and the paint callback that
-//! draws the mesh and cage there and composites the image into egui's pass.
-//! Paired with `shaders/render_composite.wgsl`.
+//! The 3D viewport inside egui: the orchestrator of the renderers. It owns the
+//! scene's GPU state ([`super::scene_gpu`]), one offscreen target per view
+//! ([`super::composite`]) and the paint callback that draws the mesh and cage
+//! there and composites the image into egui's pass.
 //!
-//! Up to [`MAX_VIEWS`] views are drawn in one frame (MVC and PMVC side by side, and
+//! Up to [`MAX_VIEWS`] views are drawn in one frame (families side by side, and
 //! their difference). Each has its own slot of the frame uniform (a dynamic
-//! offset) and its own offscreen target; the weights of both methods stay
-//! resident, so switching the method shown is only a different bind group.
+//! offset) and its own offscreen target. The weights of every family bound so far
+//! stay resident, so switching the family shown is only a different bind group.
 
 use super::cage::CageRenderer;
 use super::colormap::Scale;
+use super::composite::{Compositor, OffscreenTarget};
 use super::mesh::MeshRenderer;
+use super::readback::Readback;
+use super::scene_gpu::{
+    buffer_with, points_f32, scene_layout, FrameUniform, ReadBack, SceneGpu, WeightSlot,
+    FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
+};
 use crate::coords::{Method, Weights};
-use eframe::egui_wgpu::{self, wgpu::util::DeviceExt};
-use glam::{Mat4, Vec3};
+use crate::geometry::Cage;
+use eframe::egui_wgpu;
+use glam::{DVec3, Mat4, Vec3};
 
-pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Multisampling smooths the one-pixel cage lines and the mesh silhouette. It
 /// costs about 16 ms a frame on lavapipe, so software adapters default to 1.
 pub const MSAA_SAMPLES: u32 = 4;
-const COMPOSITE_SHADER: &str = include_str!("../../shaders/render_composite.wgsl");
 /// Views drawn in one frame.
 pub const MAX_VIEWS: usize = 3;
-/// Frame uniform slots: one per view and one for readbacks, each at an offset that
-/// every adapter accepts for dynamic uniform offsets.
-const FRAME_SLOT_BYTES: u64 = 256;
+/// The frame-uniform slot of readbacks, after the views'.
 const READBACK_SLOT: usize = MAX_VIEWS;
 const BACKGROUND: wgpu::Color = wgpu::Color {
     r: 0.13,
@@ -51,19 +53,13 @@ pub enum RenderError {
     UnsupportedAdapter { adapter: String, missing: String },
 }
 
-/// Storage buffers one shader stage needs: the scene group's five (read by every
-/// stage) and the two outputs of the readback's compute pass.
-pub const STORAGE_BUFFERS_PER_STAGE: u32 = 7;
-
-/// Whether the viewport's shaders can run on `adapter` with `device`: they read
-/// storage buffers in the vertex stage and deform in a compute pass, which
-/// WebGL-class adapters (wgpu's GL backend, for one) do not offer.
+/// Whether the viewport can draw on `adapter` with `device`: its vertex shader
+/// reads storage buffers, which WebGL-class adapters (wgpu's GL backend, for one)
+/// do not offer. Readback's compute pass is not required: only tests use it.
 pub fn check_adapter(adapter: &wgpu::Adapter, device: &wgpu::Device) -> Result<(), RenderError> {
     let flags = adapter.get_downlevel_capabilities().flags;
     let storage_buffers = device.limits().max_storage_buffers_per_shader_stage;
-    let missing = if !flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
-        "no compute shaders".to_owned()
-    } else if !flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE) {
+    let missing = if !flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE) {
         "no storage buffers in vertex shaders".to_owned()
     } else if storage_buffers < STORAGE_BUFFERS_PER_STAGE {
         format!(
@@ -85,15 +81,16 @@ pub enum Colouring {
     /// Plain shading.
     #[default]
     Shaded,
-    /// λᵢ of one cage vertex i.
+    /// The weight of one column: λᵢ of cage vertex i.
     CageVertexWeight(u32),
     /// minⱼ λⱼ per mesh vertex: where the coordinates go negative.
     MostNegativeWeight,
-    /// |p′ − p′_other| between the two methods' deformations, over the cage size.
+    /// |p′ − p′_against| between two families' deformations, over the cage size.
     MethodDistance,
 }
 
 impl Colouring {
+    /// The shader's `COLOURING_*` constant and the column it shows.
     fn code(self) -> [u32; 2] {
         match self {
             Colouring::Shaded => [0, 0],
@@ -109,6 +106,8 @@ impl Colouring {
 pub struct Shading {
     /// The weights the mesh is deformed (and coloured) with.
     pub method: Method,
+    /// The family compared with in the difference view ([`Colouring::MethodDistance`]).
+    pub against: Option<Method>,
     pub colouring: Colouring,
     pub scale: Scale,
     /// Magnitude at which the colour map saturates.
@@ -121,41 +120,13 @@ impl Default for Shading {
     fn default() -> Self {
         Self {
             method: Method::Pmvc,
+            against: None,
             colouring: Colouring::Shaded,
             scale: Scale::Linear,
             colour_limit: 1.0,
             cage_size: 1.0,
         }
     }
-}
-
-/// What a readback returns per mesh vertex, exactly as the shaders compute it.
-#[derive(Clone, Debug, Default)]
-pub struct ReadBack {
-    pub positions: Vec<Vec3>,
-    /// The colouring value (0 when shaded).
-    pub values: Vec<f32>,
-    /// The unshaded colour of each value.
-    pub colours: Vec<[f32; 3]>,
-}
-
-fn method_slot(method: Method) -> usize {
-    match method {
-        Method::Mvc => 0,
-        Method::Pmvc => 1,
-    }
-}
-
-/// The uniform shared by all viewport shaders (`struct Frame` in the WGSL).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct FrameUniform {
-    view_projection: [[f32; 4]; 4],
-    eye: [f32; 4],
-    viewport: [f32; 4],
-    counts: [u32; 4],
-    colouring: [u32; 4],
-    colour_scale: [f32; 4],
 }
 
 /// Per-frame camera settings, carried by the paint callback.
@@ -176,36 +147,8 @@ pub struct FrameParams {
 pub struct SceneUpload<'a> {
     pub rest_positions: &'a [Vec3],
     pub triangles: &'a [[u32; 3]],
-    pub cage_rest: &'a [Vec3],
-    pub cage_triangles: &'a [[u32; 3]],
-}
-
-/// The scene's GPU buffers and their bind group.
-pub struct SceneGpu {
-    /// Per method shown ([`method_slot`]): that method's weights at binding 1,
-    /// the other's at binding 5.
-    bind_groups: [wgpu::BindGroup; 2],
-    pub indices: wgpu::Buffer,
-    pub index_count: u32,
-    pub vertex_count: u32,
-    pub cage_edges: wgpu::Buffer,
-    pub cage_edge_index_count: u32,
-    pub cage_vertex_count: u32,
-    rest: wgpu::Buffer,
-    /// Per method ([`method_slot`]).
-    weights: [Option<wgpu::Buffer>; 2],
-    placeholder: wgpu::Buffer,
-    cage: wgpu::Buffer,
-    handle_state: wgpu::Buffer,
-}
-
-struct OffscreenTarget {
-    size: [u32; 2],
-    /// `None` without multisampling: then the pass draws straight into `resolved`.
-    multisampled: Option<wgpu::TextureView>,
-    depth: wgpu::TextureView,
-    resolved: wgpu::TextureView,
-    composite_group: wgpu::BindGroup,
+    /// The rest cage; weights columns follow its vertices (and faces).
+    pub cage: &'a Cage,
 }
 
 /// All GPU state of the viewport; lives in egui_wgpu's callback resources.
@@ -215,28 +158,13 @@ pub struct ViewportRenderer {
     frame: wgpu::Buffer,
     mesh: MeshRenderer,
     cage: CageRenderer,
-    composite: wgpu::RenderPipeline,
-    composite_layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
+    compositor: Compositor,
+    /// Made on the first readback.
+    readback: Option<Readback>,
     targets: [Option<OffscreenTarget>; MAX_VIEWS],
     scene: Option<SceneGpu>,
     max_storage_binding: u64,
     sample_count: u32,
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX
-            | wgpu::ShaderStages::FRAGMENT
-            | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 impl ViewportRenderer {
@@ -247,102 +175,22 @@ impl ViewportRenderer {
         target_format: wgpu::TextureFormat,
         sample_count: u32,
     ) -> Self {
-        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX
-                        | wgpu::ShaderStages::FRAGMENT
-                        | wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<FrameUniform>() as u64,
-                        ),
-                    },
-                    count: None,
-                },
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, true),
-                storage_entry(4, true),
-                storage_entry(5, true),
-            ],
-        });
+        let scene_layout = scene_layout(device);
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame"),
             size: FRAME_SLOT_BYTES * (MAX_VIEWS as u64 + 1),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("composite"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("render_composite.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(COMPOSITE_SHADER.into()),
-        });
-        let composite_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("composite"),
-                bind_group_layouts: &[Some(&composite_layout)],
-                immediate_size: 0,
-            });
-        let composite = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("composite"),
-            layout: Some(&composite_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_composite"),
-                compilation_options: Default::default(),
-                targets: &[Some(target_format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("composite"),
-            ..Default::default()
-        });
         let limits = device.limits();
         Self {
             mesh: MeshRenderer::new(device, &scene_layout, sample_count),
             cage: CageRenderer::new(device, &scene_layout, sample_count),
+            compositor: Compositor::new(device, target_format),
+            readback: None,
             sample_count,
             scene_layout,
             frame,
-            composite,
-            composite_layout,
-            sampler,
             targets: Default::default(),
             scene: None,
             max_storage_binding: limits
@@ -368,81 +216,19 @@ impl ViewportRenderer {
 
     /// Replace the scene. Weights start unbound: the mesh shows at rest.
     pub fn upload_scene(&mut self, device: &wgpu::Device, scene: &SceneUpload<'_>) {
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-        let rest: Vec<[f32; 4]> = scene
-            .rest_positions
-            .iter()
-            .map(|p| [p.x, p.y, p.z, 0.0])
-            .collect();
-        let rest = buffer_with(device, "rest positions", &rest, storage);
-        let indices: Vec<u32> = scene.triangles.iter().flatten().copied().collect();
-        let index_buffer = buffer_with(device, "mesh indices", &indices, wgpu::BufferUsages::INDEX);
-        let edges = feature_edges(scene.cage_rest, scene.cage_triangles);
-        let cage_positions: Vec<[f32; 4]> = scene
-            .cage_rest
-            .iter()
-            .map(|p| [p.x, p.y, p.z, 1.0])
-            .collect();
-        let cage = buffer_with(device, "cage pose", &cage_positions, storage);
-        let states = vec![0u32; scene.cage_rest.len().max(1)];
-        let handle_state = buffer_with(device, "handle states", &states, storage);
-        let placeholder = buffer_with(device, "no weights", &[0f32; 4], storage);
-        let cage_edges = buffer_with(device, "cage edges", &edges, wgpu::BufferUsages::INDEX);
-        let bind_group =
-            || self.scene_bind_group(device, [&placeholder; 2], &rest, &cage, &handle_state);
-        self.scene = Some(SceneGpu {
-            bind_groups: [bind_group(), bind_group()],
-            indices: index_buffer,
-            index_count: indices.len() as u32,
-            vertex_count: scene.rest_positions.len() as u32,
-            cage_edges,
-            cage_edge_index_count: edges.len() as u32 * 2,
-            cage_vertex_count: scene.cage_rest.len() as u32,
-            rest,
-            weights: [None, None],
-            placeholder,
-            cage,
-            handle_state,
-        });
+        let cage_rest: Vec<Vec3> = scene.cage.positions().iter().map(|p| p.as_vec3()).collect();
+        let edges = feature_edges(&cage_rest, scene.cage.triangles());
+        self.scene = Some(SceneGpu::new(
+            device,
+            scene.rest_positions,
+            scene.triangles,
+            scene.cage,
+            &edges,
+        ));
     }
 
-    fn scene_bind_group(
-        &self,
-        device: &wgpu::Device,
-        [shown_weights, other_weights]: [&wgpu::Buffer; 2],
-        rest: &wgpu::Buffer,
-        cage: &wgpu::Buffer,
-        handle_state: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &self.scene_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.frame,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
-                    }),
-                },
-                entry(1, shown_weights),
-                entry(2, rest),
-                entry(3, cage),
-                entry(4, handle_state),
-                entry(5, other_weights),
-            ],
-        })
-    }
-
-    /// Bind one method's weights (or unbind them with `None`, showing the mesh at
-    /// rest in views of that method). A `resident` buffer already holding them on
+    /// Bind one family's weights (or unbind them with `None`, showing the mesh at
+    /// rest in views of that family). A `resident` buffer already holding them on
     /// this device is used as it is; otherwise they are uploaded. Fails, leaving
     /// the weights unbound, when the matrix exceeds the GPU's limit.
     pub fn set_weights(
@@ -453,43 +239,47 @@ impl ViewportRenderer {
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
         let limit = self.max_storage_binding;
-        let Some(mut scene) = self.scene.take() else {
+        let Some(scene) = self.scene.as_mut() else {
             return Err(RenderError::NoScene);
         };
-        let mut result = Ok(());
-        scene.weights[method_slot(method)] = match weights {
+        let weights = match weights {
             Some(weights) if (weights.values.len() as u64) * 4 > limit => {
-                result = Err(RenderError::WeightsTooLarge {
+                scene.set_slot(method, None);
+                return Err(RenderError::WeightsTooLarge {
                     needed_mib: weights.values.len() as f64 * 4.0 / 1048576.0,
                     limit_mib: limit as f64 / 1048576.0,
                 });
-                None
             }
-            Some(weights) if !weights.values.is_empty() => Some(match resident {
-                Some(buffer) => buffer.clone(),
-                None => buffer_with(
-                    device,
-                    "weights",
-                    &weights.values,
-                    wgpu::BufferUsages::STORAGE,
-                ),
-            }),
-            _ => None,
+            Some(weights) if !weights.values.is_empty() => weights,
+            _ => {
+                scene.set_slot(method, None);
+                return Ok(());
+            }
         };
-        let buffer = |slot: usize| scene.weights[slot].as_ref().unwrap_or(&scene.placeholder);
-        let group = |shown: usize| {
-            self.scene_bind_group(
+        let weights_buffer = match resident {
+            Some(buffer) => buffer.clone(),
+            None => buffer_with(
                 device,
-                [buffer(shown), buffer(1 - shown)],
-                &scene.rest,
-                &scene.cage,
-                &scene.handle_state,
-            )
+                "weights",
+                &weights.values,
+                wgpu::BufferUsages::STORAGE,
+            ),
         };
-        let bind_groups = [group(0), group(1)];
-        scene.bind_groups = bind_groups;
-        self.scene = Some(scene);
-        result
+        let displacements = buffer_with(
+            device,
+            "column displacements",
+            &scene.displacements_of(method),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        scene.set_slot(
+            method,
+            Some(WeightSlot {
+                weights: weights_buffer,
+                displacements,
+                columns: weights.cols as u32,
+            }),
+        );
+        Ok(())
     }
 
     /// Mark the mesh vertices outside the cage (drawn red when highlighted).
@@ -509,14 +299,21 @@ impl ViewportRenderer {
         }
     }
 
-    /// Upload the deformed cage; called only when the pose changes.
-    pub fn set_cage_pose(&mut self, queue: &wgpu::Queue, pose: &[Vec3]) {
-        let Some(scene) = &self.scene else { return };
+    /// Upload the posed cage and every bound family's column displacements; called
+    /// only when the pose changes.
+    pub fn set_cage_pose(&mut self, queue: &wgpu::Queue, pose: &[DVec3]) {
+        let Some(scene) = self.scene.as_mut() else {
+            return;
+        };
         if pose.len() as u32 != scene.cage_vertex_count {
             return;
         }
-        let positions: Vec<[f32; 4]> = pose.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
-        queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&positions));
+        scene.pose = pose.to_vec();
+        queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&points_f32(pose, 1.0)));
+        for (&method, slot) in &scene.slots {
+            let displacements = scene.displacements_of(method);
+            queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
+        }
     }
 
     /// Per handle: 0 idle, 1 selected, 2 hovered.
@@ -531,44 +328,33 @@ impl ViewportRenderer {
     pub fn has_weights(&self, method: Method) -> bool {
         self.scene
             .as_ref()
-            .is_some_and(|scene| scene.weights[method_slot(method)].is_some())
+            .is_some_and(|scene| scene.slots.contains_key(&method))
     }
 
     fn frame_uniform(&self, params: &FrameParams) -> FrameUniform {
         let shading = &params.shading;
-        let slot = method_slot(shading.method);
-        let (columns, weights_bound, other_bound, vertices) = match &self.scene {
-            Some(scene) => (
-                scene.cage_vertex_count,
-                scene.weights[slot].is_some() as u32,
-                scene.weights[1 - slot].is_some() as u32,
-                scene.vertex_count,
-            ),
-            None => (0, 0, 0, 0),
+        let columns_of = |method: Option<Method>| {
+            let slot = self.scene.as_ref().zip(method);
+            slot.and_then(|(scene, method)| scene.slots.get(&method))
+                .map_or(0, |slot| slot.columns)
         };
-        let [colouring, cage_vertex] = shading.colouring.code();
+        let columns = columns_of(Some(shading.method));
+        let [colouring, colouring_column] = shading.colouring.code();
         FrameUniform {
             view_projection: params.view_projection.to_cols_array_2d(),
-            eye: params.eye.extend(1.0).to_array(),
-            viewport: [
-                params.size_px[0] as f32,
-                params.size_px[1] as f32,
-                params.handle_radius_px,
-                0.0,
-            ],
-            counts: [
-                columns,
-                weights_bound,
-                params.highlight_outside as u32,
-                vertices,
-            ],
-            colouring: [
-                colouring,
-                cage_vertex,
-                (shading.scale == Scale::LogMagnitude) as u32,
-                other_bound,
-            ],
-            colour_scale: [shading.colour_limit, shading.cage_size, 0.0, 0.0],
+            eye: params.eye.to_array(),
+            handle_radius_px: params.handle_radius_px,
+            viewport_size_px: params.size_px.map(|size| size as f32),
+            colour_limit: shading.colour_limit,
+            cage_size: shading.cage_size,
+            columns,
+            weights_bound: u32::from(columns > 0),
+            highlight_outside: u32::from(params.highlight_outside),
+            vertex_count: self.scene.as_ref().map_or(0, |scene| scene.vertex_count),
+            colouring,
+            colouring_column,
+            log_scale: u32::from(shading.scale == Scale::LogMagnitude),
+            other_columns: columns_of(shading.against),
         }
     }
 
@@ -599,139 +385,55 @@ impl ViewportRenderer {
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
-        let Some(scene) = &self.scene else {
+        let readback = self
+            .readback
+            .get_or_insert_with(|| Readback::new(device, &self.scene_layout));
+        let Some(scene) = self.scene.as_mut() else {
             return Err(RenderError::NoScene);
         };
-        let bind_group = &scene.bind_groups[method_slot(shading.method)];
+        let bind_group = scene
+            .bind_group(
+                device,
+                &self.scene_layout,
+                &self.frame,
+                shading.method,
+                shading.against,
+            )
+            .clone();
         let offset = (READBACK_SLOT as u64 * FRAME_SLOT_BYTES) as u32;
-        self.mesh
-            .read_back(device, queue, scene, bind_group, offset)
+        readback
+            .run(device, queue, scene, &bind_group, offset)
             .map_err(|_| RenderError::ReadBack)
     }
 
-    fn ensure_target(&mut self, device: &wgpu::Device, view: usize, size: [u32; 2]) {
-        let samples = self.sample_count;
-        if self.targets[view].as_ref().is_some_and(|t| t.size == size) {
-            return;
-        }
-        let extent = wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: 1,
-        };
-        let texture = |label, format, samples, usage| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: extent,
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let resolved = texture(
-            "viewport image",
-            OFFSCREEN_FORMAT,
-            1,
-            attachment | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("composite"),
-            layout: &self.composite_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&resolved),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-            ],
-        });
-        self.targets[view] = Some(OffscreenTarget {
-            size,
-            multisampled: (samples > 1)
-                .then(|| texture("viewport msaa", OFFSCREEN_FORMAT, samples, attachment)),
-            depth: texture("viewport depth", DEPTH_FORMAT, samples, attachment),
-            composite_group,
-            resolved,
-        });
-    }
-}
-
-/// Cage edges worth drawing: those between faces that are not coplanar. The
-/// diagonals that split flat quads and ear-clipped caps only clutter the view.
-fn feature_edges(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let normal = |[a, b, c]: [u32; 3]| {
-        let p = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-        (p(b) - p(a)).cross(p(c) - p(a)).normalize_or_zero()
-    };
-    let mut faces_of_edge: std::collections::BTreeMap<[u32; 2], Vec<Vec3>> = Default::default();
-    for &triangle in triangles {
-        let [a, b, c] = triangle;
-        for [u, v] in [[a, b], [b, c], [c, a]] {
-            faces_of_edge
-                .entry([u.min(v), u.max(v)])
-                .or_default()
-                .push(normal(triangle));
-        }
-    }
-    faces_of_edge
-        .into_iter()
-        .filter(|(_, normals)| match normals.as_slice() {
-            [n, m] => n.dot(*m) < 0.9995,
-            _ => true,
-        })
-        .map(|(edge, _)| edge)
-        .collect()
-}
-
-fn buffer_with<T: bytemuck::Pod>(
-    device: &wgpu::Device,
-    label: &str,
-    contents: &[T],
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    // wgpu rejects empty buffers; an empty slice gets one zeroed element's worth.
-    let bytes: &[u8] = bytemuck::cast_slice(contents);
-    let padding = [0u8; 16];
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: if bytes.is_empty() { &padding } else { bytes },
-        usage,
-    })
-}
-
-/// The paint callback for one frame of the viewport.
-pub struct ViewportCallback {
-    pub params: FrameParams,
-}
-
-impl egui_wgpu::CallbackTrait for ViewportCallback {
-    fn prepare(
-        &self,
+    /// Draw view `params.view` into its offscreen target.
+    fn draw_view(
+        &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        _screen_descriptor: &egui_wgpu::ScreenDescriptor,
         encoder: &mut wgpu::CommandEncoder,
-        resources: &mut egui_wgpu::CallbackResources,
-    ) -> Vec<wgpu::CommandBuffer> {
-        let Some(renderer) = resources.get_mut::<ViewportRenderer>() else {
-            return Vec::new();
-        };
-        let view = self.params.view.min(MAX_VIEWS - 1);
-        let size = [self.params.size_px[0].max(1), self.params.size_px[1].max(1)];
-        renderer.ensure_target(device, view, size);
-        let uniform = renderer.frame_uniform(&self.params);
-        renderer.write_frame_slot(queue, view, &uniform);
-        let Some(target) = &renderer.targets[view] else {
-            return Vec::new();
+        params: &FrameParams,
+    ) {
+        let view = params.view.min(MAX_VIEWS - 1);
+        let size = [params.size_px[0].max(1), params.size_px[1].max(1)];
+        if self.targets[view].as_ref().is_none_or(|t| t.size != size) {
+            self.targets[view] = Some(self.compositor.target(device, size, self.sample_count));
+        }
+        let uniform = self.frame_uniform(params);
+        self.write_frame_slot(queue, view, &uniform);
+        let bind_group = self.scene.as_mut().map(|scene| {
+            scene
+                .bind_group(
+                    device,
+                    &self.scene_layout,
+                    &self.frame,
+                    params.shading.method,
+                    params.shading.against,
+                )
+                .clone()
+        });
+        let Some(target) = &self.targets[view] else {
+            return;
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("viewport"),
@@ -762,11 +464,67 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some(scene) = &renderer.scene {
-            let bind_group = &scene.bind_groups[method_slot(self.params.shading.method)];
+        if let (Some(scene), Some(bind_group)) = (&self.scene, bind_group) {
             let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
-            renderer.mesh.draw(&mut pass, scene, bind_group, offset);
-            renderer.cage.draw(&mut pass, scene, bind_group, offset);
+            self.mesh.draw(&mut pass, scene, &bind_group, offset);
+            self.cage.draw(&mut pass, scene, &bind_group, offset);
+        }
+    }
+
+    /// Composite view `view`'s image into egui's pass.
+    fn composite(&self, pass: &mut wgpu::RenderPass<'static>, view: usize) {
+        let Some(target) = &self.targets[view.min(MAX_VIEWS - 1)] else {
+            return;
+        };
+        pass.set_pipeline(&self.compositor.pipeline);
+        pass.set_bind_group(0, &target.composite_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// Cage edges worth drawing: those between faces that are not coplanar. The
+/// diagonals that split flat quads and ear-clipped caps only clutter the view.
+fn feature_edges(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let normal = |[a, b, c]: [u32; 3]| {
+        let p = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+        (p(b) - p(a)).cross(p(c) - p(a)).normalize_or_zero()
+    };
+    let mut faces_of_edge: std::collections::BTreeMap<[u32; 2], Vec<Vec3>> = Default::default();
+    for &triangle in triangles {
+        let [a, b, c] = triangle;
+        for [u, v] in [[a, b], [b, c], [c, a]] {
+            faces_of_edge
+                .entry([u.min(v), u.max(v)])
+                .or_default()
+                .push(normal(triangle));
+        }
+    }
+    faces_of_edge
+        .into_iter()
+        .filter(|(_, normals)| match normals.as_slice() {
+            [n, m] => n.dot(*m) < 0.9995,
+            _ => true,
+        })
+        .map(|(edge, _)| edge)
+        .collect()
+}
+
+/// The paint callback for one frame of the viewport.
+pub struct ViewportCallback {
+    pub params: FrameParams,
+}
+
+impl egui_wgpu::CallbackTrait for ViewportCallback {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen_descriptor: &egui_wgpu::ScreenDescriptor,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = resources.get_mut::<ViewportRenderer>() {
+            renderer.draw_view(device, queue, encoder, &self.params);
         }
         Vec::new()
     }
@@ -777,14 +535,8 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
         pass: &mut wgpu::RenderPass<'static>,
         resources: &egui_wgpu::CallbackResources,
     ) {
-        let Some(renderer) = resources.get::<ViewportRenderer>() else {
-            return;
-        };
-        let Some(target) = &renderer.targets[self.params.view.min(MAX_VIEWS - 1)] else {
-            return;
-        };
-        pass.set_pipeline(&renderer.composite);
-        pass.set_bind_group(0, &target.composite_group, &[]);
-        pass.draw(0..3, 0..1);
+        if let Some(renderer) = resources.get::<ViewportRenderer>() {
+            renderer.composite(pass, self.params.view);
+        }
     }
 }

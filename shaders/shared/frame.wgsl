@@ -1,0 +1,30 @@
+// The uniform of every viewport shader, one slot per view; `render::FrameUniform`
+// in Rust (layouts compared by tests/shader_layouts.rs).
+struct Frame {
+    view_projection: mat4x4<f32>,
+    eye: vec3<f32>,
+    handle_radius_px: f32,
+    viewport_size_px: vec2<f32>,
+    // The magnitude at which heatmap colours saturate.
+    colour_limit: f32,
+    // Method distances are divided by this.
+    cage_size: f32,
+    // Weights columns per mesh vertex (cage vertices, plus faces for some families).
+    columns: u32,
+    weights_bound: u32,
+    highlight_outside: u32,
+    vertex_count: u32,
+    // One of the COLOURING_* constants.
+    colouring: u32,
+    // The column shown by COLOURING_COLUMN_WEIGHT.
+    colouring_column: u32,
+    log_scale: u32,
+    // Columns of the compared method's weights (the difference view); 0 when
+    // they are not bound.
+    other_columns: u32,
+}
+
+const COLOURING_SHADED: u32 = 0u;
+const COLOURING_COLUMN_WEIGHT: u32 = 1u;
+const COLOURING_MOST_NEGATIVE: u32 = 2u;
+const COLOURING_METHOD_DISTANCE: u32 = 3u;

@@ -1,0 +1,263 @@
+//! What every viewport renderer shares: target formats, the frame uniform, and the
+//! scene's GPU buffers with their bind-group layout. A leaf: it imports nothing else
+//! from `render`, and the renderers ([`super::mesh`], [`super::cage`]) depend on it,
+//! never on the orchestrator ([`super::viewport`]), as re_renderer's renderers
+//! depend on its global bindings.
+
+use crate::coords::Method;
+use crate::geometry::Cage;
+use eframe::egui_wgpu::wgpu::util::DeviceExt;
+use glam::{DVec3, Vec3};
+use std::collections::{BTreeMap, HashMap};
+
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Bytes per frame-uniform slot: an offset every adapter accepts for dynamic
+/// uniform offsets.
+pub const FRAME_SLOT_BYTES: u64 = 256;
+
+/// The uniform of every viewport shader: `struct Frame` in
+/// `shaders/shared/frame.wgsl` (layouts compared by `tests/shader_layouts.rs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniform {
+    pub view_projection: [[f32; 4]; 4],
+    pub eye: [f32; 3],
+    pub handle_radius_px: f32,
+    pub viewport_size_px: [f32; 2],
+    pub colour_limit: f32,
+    pub cage_size: f32,
+    pub columns: u32,
+    pub weights_bound: u32,
+    pub highlight_outside: u32,
+    pub vertex_count: u32,
+    pub colouring: u32,
+    pub colouring_column: u32,
+    pub log_scale: u32,
+    pub other_columns: u32,
+}
+
+/// Scene bindings: 0 frame, 1 weights shown, 2 rest positions, 3 cage pose, 4
+/// handle states, 5 compared weights, 6 and 7 the column displacements of each.
+const SCENE_STORAGE_BINDINGS: [u32; 7] = [1, 2, 3, 4, 5, 6, 7];
+
+/// Storage buffers the drawing shaders read in one stage.
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = SCENE_STORAGE_BINDINGS.len() as u32;
+
+/// The layout of the scene bind group (group 0 of every viewport shader).
+pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let mut entries = vec![wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::VERTEX
+            | wgpu::ShaderStages::FRAGMENT
+            | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+        },
+        count: None,
+    }];
+    entries.extend(SCENE_STORAGE_BINDINGS.map(|binding| storage_entry(binding, true)));
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("scene"),
+        entries: &entries,
+    })
+}
+
+/// A storage buffer binding visible to every stage.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX
+            | wgpu::ShaderStages::FRAGMENT
+            | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A buffer holding `contents`; wgpu rejects empty buffers, so an empty slice gets
+/// one zeroed element's worth.
+pub fn buffer_with<T: bytemuck::Pod>(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[T],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let bytes: &[u8] = bytemuck::cast_slice(contents);
+    let padding = [0u8; 16];
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: if bytes.is_empty() { &padding } else { bytes },
+        usage,
+    })
+}
+
+/// One family's weights on the GPU, and how far each of its columns' vectors moved
+/// in the current pose (`Method::column_displacements`).
+pub struct WeightSlot {
+    pub weights: wgpu::Buffer,
+    pub displacements: wgpu::Buffer,
+    pub columns: u32,
+}
+
+/// The scene's GPU buffers: one mesh and cage, and the weights of every family
+/// bound so far.
+pub struct SceneGpu {
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+    pub vertex_count: u32,
+    pub cage_edges: wgpu::Buffer,
+    pub cage_edge_index_count: u32,
+    pub cage_vertex_count: u32,
+    /// xyz: rest position; w: 1 for a vertex outside the cage.
+    pub rest: wgpu::Buffer,
+    /// The posed cage, for drawing its edges and handles.
+    pub cage: wgpu::Buffer,
+    pub handle_state: wgpu::Buffer,
+    /// Bound where a view's family has no weights yet.
+    pub placeholder: wgpu::Buffer,
+    pub slots: BTreeMap<Method, WeightSlot>,
+    /// The rest cage and the current pose, in f64: displacements are taken in f64
+    /// and only then rounded.
+    pub rest_cage: Cage,
+    pub pose: Vec<DVec3>,
+    /// Per (family shown, family compared): its bind group, made on first use.
+    bind_groups: HashMap<(Method, Option<Method>), wgpu::BindGroup>,
+}
+
+impl SceneGpu {
+    pub fn new(
+        device: &wgpu::Device,
+        rest_positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        rest_cage: &Cage,
+        cage_edges: &[[u32; 2]],
+    ) -> Self {
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let rest: Vec<[f32; 4]> = rest_positions
+            .iter()
+            .map(|p| [p.x, p.y, p.z, 0.0])
+            .collect();
+        let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
+        let pose = rest_cage.positions().to_vec();
+        let states = vec![0u32; pose.len().max(1)];
+        Self {
+            indices: buffer_with(device, "mesh indices", &indices, wgpu::BufferUsages::INDEX),
+            index_count: indices.len() as u32,
+            vertex_count: rest_positions.len() as u32,
+            cage_edges: buffer_with(device, "cage edges", cage_edges, wgpu::BufferUsages::INDEX),
+            cage_edge_index_count: cage_edges.len() as u32 * 2,
+            cage_vertex_count: pose.len() as u32,
+            rest: buffer_with(device, "rest positions", &rest, storage),
+            cage: buffer_with(device, "cage pose", &points_f32(&pose, 1.0), storage),
+            handle_state: buffer_with(device, "handle states", &states, storage),
+            placeholder: buffer_with(device, "no weights", &[0f32; 4], storage),
+            slots: BTreeMap::new(),
+            rest_cage: rest_cage.clone(),
+            pose,
+            bind_groups: HashMap::new(),
+        }
+    }
+
+    /// `method`'s column displacements for the current pose, as the shader reads them.
+    pub fn displacements_of(&self, method: Method) -> Vec<[f32; 4]> {
+        points_f32(
+            &method.column_displacements(&self.rest_cage, &self.pose),
+            0.0,
+        )
+    }
+
+    /// Install or remove `method`'s weights; bind groups that used the old ones go.
+    pub fn set_slot(&mut self, method: Method, slot: Option<WeightSlot>) {
+        match slot {
+            Some(slot) => self.slots.insert(method, slot),
+            None => self.slots.remove(&method),
+        };
+        self.bind_groups
+            .retain(|(shown, against), _| *shown != method && *against != Some(method));
+    }
+
+    /// The bind group showing `shown` (and `against` for the difference view).
+    pub fn bind_group(
+        &mut self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        frame: &wgpu::Buffer,
+        shown: Method,
+        against: Option<Method>,
+    ) -> &wgpu::BindGroup {
+        if !self.bind_groups.contains_key(&(shown, against)) {
+            let group = self.make_bind_group(device, layout, frame, shown, against);
+            self.bind_groups.insert((shown, against), group);
+        }
+        &self.bind_groups[&(shown, against)]
+    }
+
+    fn make_bind_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        frame: &wgpu::Buffer,
+        shown: Method,
+        against: Option<Method>,
+    ) -> wgpu::BindGroup {
+        let slot = |method: Option<Method>| method.and_then(|m| self.slots.get(&m));
+        let weights = |method| slot(method).map_or(&self.placeholder, |s| &s.weights);
+        let moves = |method| slot(method).map_or(&self.placeholder, |s| &s.displacements);
+        let buffers = [
+            weights(Some(shown)),
+            &self.rest,
+            &self.cage,
+            &self.handle_state,
+            weights(against),
+            moves(Some(shown)),
+            moves(against),
+        ];
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: frame,
+                offset: 0,
+                size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+            }),
+        }];
+        entries.extend(
+            SCENE_STORAGE_BINDINGS
+                .iter()
+                .zip(buffers)
+                .map(|(&binding, buffer)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: buffer.as_entire_binding(),
+                }),
+        );
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// Points as the shaders' `vec4<f32>`, with `w` as given.
+pub fn points_f32(points: &[DVec3], w: f32) -> Vec<[f32; 4]> {
+    points
+        .iter()
+        .map(|p| [p.x as f32, p.y as f32, p.z as f32, w])
+        .collect()
+}
+
+/// What a readback returns per mesh vertex, exactly as the shaders compute it.
+#[derive(Clone, Debug, Default)]
+pub struct ReadBack {
+    pub positions: Vec<Vec3>,
+    /// The colouring value (0 when shaded).
+    pub values: Vec<f32>,
+    /// The unshaded colour of each value.
+    pub colours: Vec<[f32; 3]>,
+}
