@@ -65,6 +65,7 @@ fn bind_writes_little_endian_f32_rows_in_file_order() {
             BindOptions {
                 method,
                 resolution: 32,
+                ..Default::default()
             },
             &BindProgress::default(),
         )
@@ -363,4 +364,76 @@ fn shared_data_binds_and_reproduces_the_rest_pose() {
         .filter(|(a, b)| a.distance(**b) > 1e-3 * diagonal)
         .count();
     assert!(moved > 0, "the pose moved nothing");
+}
+
+#[test]
+fn bind_harmonic_writes_the_library_weights_and_check_reports_the_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, cage, points) = comb_scene(dir.path(), 150);
+    let out = dir.path().join("hc.npy");
+    let output = pmvc(&[
+        "bind",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage_path),
+        "--method",
+        "harmonic",
+        "--grid",
+        "32",
+        "--out",
+        path_str(&out),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let (shape, values, _) = read_npy_f32(&out);
+    assert_eq!(shape, [points.len(), cage.vertex_count()]);
+    let classes = classify_points(&cage, &points);
+    let (expected, _) = pmvc::coords::harmonic::bind_harmonic(
+        &points,
+        &classes.classes,
+        &cage,
+        32,
+        &BindProgress::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        values, expected.values,
+        "the CLI writes what the library binds"
+    );
+    assert!(values.iter().all(|&w| w >= -1e-6));
+
+    let output = pmvc(&[
+        "check",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage_path),
+        "--grid",
+        "32",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = String::from_utf8_lossy(&output.stdout);
+    let plan = pmvc::coords::harmonic::plan(&cage, 32, points.len()).unwrap();
+    assert!(
+        text.contains(&format!("{} inside the cage", plan.inside_nodes)),
+        "{text}"
+    );
+
+    // A grid below the minimum is bad input: a message and exit status 1.
+    let output = pmvc(&[
+        "bind",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage_path),
+        "--method",
+        "harmonic",
+        "--grid",
+        "0",
+        "--out",
+        path_str(&dir.path().join("bad.npy")),
+    ]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    assert!(stderr(&output).contains("--grid"), "{}", stderr(&output));
+    assert!(!dir.path().join("bad.npy").exists());
 }

@@ -29,7 +29,11 @@ fn bind(cage: &Cage, points: &[DVec3], method: Method, resolution: u32) -> Weigh
         points,
         &classes.classes,
         cage,
-        BindOptions { method, resolution },
+        BindOptions {
+            method,
+            resolution,
+            ..Default::default()
+        },
         &BindProgress::default(),
     )
     .unwrap()
@@ -219,6 +223,7 @@ fn points_on_the_surface_get_barycentrics_and_never_nan() {
             BindOptions {
                 method,
                 resolution: 32,
+                ..Default::default()
             },
             &BindProgress::default(),
         )

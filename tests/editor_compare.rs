@@ -9,7 +9,7 @@ use common::editor::*;
 use egui::{Key, Modifiers};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotResults};
-use pmvc::app::compare::{Layout, Overlay, Pane, ViewSettings};
+use pmvc::app::compare::{Layout, MethodSet, Overlay, Pane, ViewSettings};
 use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
 use pmvc::render::colormap::{self, Scale};
@@ -56,6 +56,31 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
     assert_eq!(harness.state().active_method(), Method::Pmvc);
     let pmvc = harness.state().read_back_deformed().unwrap().unwrap();
 
+    // M cycles through every family: harmonic coordinates are bound on demand
+    // the first time they are shown, with the grid control's value.
+    press(&mut harness, Key::M);
+    assert_eq!(harness.state().active_method(), Method::Harmonic);
+    run_until_bound(&mut harness);
+    harness.run_steps(2);
+    let app = harness.state();
+    assert_eq!(
+        app.bind_count(),
+        binds + 1,
+        "harmonic bound once, on demand"
+    );
+    let harmonic = app.read_back_deformed().unwrap().unwrap();
+    assert!(max_distance(&harmonic, &cpu_deformed(app, Method::Harmonic)) < 1e-3);
+    assert!(
+        app.document()
+            .bound(Method::Harmonic)
+            .unwrap()
+            .quality
+            .most_negative
+            >= -1e-6
+    );
+
+    // Switching between bound families binds nothing.
+    let binds = app.bind_count();
     press(&mut harness, Key::M);
     let app = harness.state();
     assert_eq!(app.active_method(), Method::Mvc);
@@ -66,6 +91,8 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
     assert!(max_distance(&mvc, &pmvc) > 1e-2);
     assert!(max_distance(&mvc, &cpu_deformed(app, Method::Mvc)) < 1e-3);
     assert!(max_distance(&pmvc, &cpu_deformed(app, Method::Pmvc)) < 1e-3);
+    // The comb's fingers pull each other under MVC only.
+    assert!(max_distance(&mvc, &harmonic) > 1e-2);
 
     press(&mut harness, Key::M);
     assert_eq!(harness.state().active_method(), Method::Pmvc);
@@ -424,6 +451,15 @@ fn snapshots_of_each_view() {
             Method::Pmvc,
         ),
         (
+            "compare_three_families",
+            ViewSettings {
+                layout: Layout::SideBySide,
+                compared: MethodSet::of(&Method::ALL),
+                ..Default::default()
+            },
+            Method::Pmvc,
+        ),
+        (
             "compare_heatmap",
             ViewSettings {
                 layout: Layout::SideBySide,
@@ -458,4 +494,69 @@ fn snapshots_of_each_view() {
         results.extend_harness(&mut harness);
     }
     results.unwrap();
+}
+
+#[test]
+fn three_panes_show_every_family_each_as_its_weights_say() {
+    let Some(mut harness) = posed_editor(ViewSettings {
+        layout: Layout::SideBySide,
+        compared: MethodSet::of(&Method::ALL),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    harness.run_steps(2);
+    let app = harness.state();
+    let panes: Vec<Pane> = app.pane_rects().into_iter().map(|(pane, _)| pane).collect();
+    assert_eq!(
+        panes,
+        Method::ALL.map(Pane::Method).to_vec(),
+        "one pane per family, in menu order"
+    );
+    let mut deformed = Vec::new();
+    for method in Method::ALL {
+        assert!(
+            app.document().bound(method).is_some(),
+            "{method} bound on demand"
+        );
+        let shading = Shading {
+            method,
+            ..Default::default()
+        };
+        let gpu = app.read_back(&shading).unwrap().unwrap().positions;
+        assert!(
+            max_distance(&gpu, &cpu_deformed(app, method)) < 1e-3,
+            "{method}"
+        );
+        deformed.push(gpu);
+    }
+    // Under the pose MVC's fingers pull each other; PMVC's and HC's do not.
+    assert!(max_distance(&deformed[0], &deformed[2]) > 1e-2);
+    assert!(max_distance(&deformed[0], &deformed[1]) > 1e-2);
+}
+
+#[test]
+fn cancelling_a_harmonic_bind_keeps_the_bound_families() {
+    let Some(mut harness) = posed_editor(ViewSettings::default()) else {
+        return;
+    };
+    let pmvc = harness.state().document().weights(Method::Pmvc).cloned();
+    press(&mut harness, Key::M);
+    assert_eq!(harness.state().active_method(), Method::Harmonic);
+    assert!(
+        harness.state().is_binding(),
+        "harmonic coordinates bind on demand"
+    );
+    harness.state_mut().cancel_bind();
+    run_until_bound(&mut harness);
+    let app = harness.state();
+    assert!(app.document().weights(Method::Harmonic).is_none());
+    assert!(std::sync::Arc::ptr_eq(
+        app.document().weights(Method::Pmvc).unwrap(),
+        pmvc.as_ref().unwrap()
+    ));
+    // The view of the unbound family shows the mesh at rest, and nothing rebinds
+    // until asked.
+    harness.run_steps(3);
+    assert!(!harness.state().is_binding());
 }

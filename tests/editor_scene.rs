@@ -26,6 +26,7 @@ fn neighbour_drag(method: Method) -> f64 {
         BindOptions {
             method,
             resolution: 16,
+            ..Default::default()
         },
         &BindProgress::default(),
     )
@@ -74,6 +75,7 @@ fn on_the_default_scene_mvc_is_negative_and_pmvc_is_not() {
         let options = BindOptions {
             method,
             resolution: pmvc::coords::DEFAULT_RESOLUTION,
+            ..Default::default()
         };
         let weights = bind_cpu(
             &mesh.positions,

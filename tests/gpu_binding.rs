@@ -57,6 +57,7 @@ fn input(cage: &Cage, points: Vec<DVec3>, method: Method) -> BindInput {
         options: BindOptions {
             method,
             resolution: 32,
+            ..Default::default()
         },
     }
 }

@@ -105,6 +105,7 @@ fn an_inward_facing_cage_is_flipped_and_binds_exactly_like_its_outward_twin() {
                 BindOptions {
                     method,
                     resolution: 16,
+                    ..Default::default()
                 },
                 &BindProgress::default(),
             )

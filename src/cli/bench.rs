@@ -44,6 +44,45 @@ pub struct BenchRow {
     pub backend: String,
     pub median_seconds: f64,
     pub runs: Vec<f64>,
+    /// The paper's time for this scene size and method (its 2007 GPU for MVC and
+    /// PMVC, its CPU solver for HC), for scale.
+    pub paper_seconds: Option<f64>,
+}
+
+/// The paper's Table 1: (scene, method, parameter, seconds).
+const PAPER_TABLE1: [(&str, Method, u32, f64); 21] = [
+    ("armadillo-size", Method::Mvc, 0, 3.70),
+    ("armadillo-size", Method::Pmvc, 32, 3.03),
+    ("armadillo-size", Method::Pmvc, 64, 9.82),
+    ("armadillo-size", Method::Harmonic, 64, 66.48),
+    ("armadillo-size", Method::Harmonic, 128, 770.00),
+    ("horse-size", Method::Mvc, 0, 5.92),
+    ("horse-size", Method::Pmvc, 32, 8.75),
+    ("horse-size", Method::Pmvc, 64, 30.64),
+    ("horse-size", Method::Harmonic, 64, 28.61),
+    ("horse-size", Method::Harmonic, 128, 305.93),
+    ("hand-size", Method::Mvc, 0, 13.50),
+    ("hand-size", Method::Pmvc, 32, 6.64),
+    ("hand-size", Method::Pmvc, 64, 18.50),
+    ("hand-size", Method::Harmonic, 64, 333.61),
+    ("hand-size", Method::Harmonic, 128, 4413.66),
+    // Table 2 (PMVC 32², by cage vertices) is matched by its own rows' label.
+    ("sphere 51 (Table 2)", Method::Pmvc, 32, 16.07),
+    ("sphere 102 (Table 2)", Method::Pmvc, 32, 16.32),
+    ("sphere 198 (Table 2)", Method::Pmvc, 32, 16.73),
+    ("sphere 402 (Table 2)", Method::Pmvc, 32, 17.44),
+    ("sphere 843 (Table 2)", Method::Pmvc, 32, 18.70),
+    ("sphere 1523 (Table 2)", Method::Pmvc, 32, 20.41),
+];
+
+fn paper_seconds(scene: &str, method: Method, parameter: u32) -> Option<f64> {
+    let scene = scene.strip_suffix(" (Table 1)").unwrap_or(scene);
+    PAPER_TABLE1
+        .iter()
+        .find(|(name, m, p, _)| {
+            *name == scene && *m == method && (method.spec().parameter.is_none() || *p == parameter)
+        })
+        .map(|entry| entry.3)
 }
 
 /// A backend to time, with the name its rows carry.
@@ -80,7 +119,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let wanted = |name: &str| args.scenes.is_empty() || args.scenes.iter().any(|s| s == name);
 
     let mut rows = Vec::new();
-    let table1 = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Pmvc, 64)];
+    let table1 = [
+        (Method::Mvc, 0),
+        (Method::Pmvc, 32),
+        (Method::Pmvc, 64),
+        (Method::Harmonic, 64),
+        (Method::Harmonic, 128),
+    ];
     for name in procedural::table1_scene_names() {
         if let Some(scene) = procedural::table1_scene(name).filter(|_| wanted(name)) {
             let label = format!("{name} (Table 1)");
@@ -134,6 +179,12 @@ fn bench_scene(
     let mut rows = Vec::new();
     for timed in backends {
         for &(method, resolution) in configurations {
+            // A family without a GPU kernel binds on the CPU on every backend: its
+            // CPU row says all there is.
+            let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
+            if gpu_backend && crate::gpu::kernels::Kernel::of(method).is_none() {
+                continue;
+            }
             let mut options = BindOptions::for_method(method);
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
@@ -164,6 +215,7 @@ fn bench_scene(
                 backend: timed.name.clone(),
                 median_seconds: median(&times),
                 runs: times,
+                paper_seconds: paper_seconds(name, method, resolution),
             };
             eprintln!(
                 "  {} | {} | {}: {:.3} s",
@@ -197,7 +249,7 @@ fn bench_shared_data(
     for name in names {
         let mesh = geometry::load_mesh(&args.data.join(format!("{name}.obj")))?;
         let (cage, _) = geometry::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
-        let configurations = [(Method::Mvc, 0), (Method::Pmvc, 32)];
+        let configurations = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)];
         rows.extend(bench_scene(
             &name,
             &cage,
@@ -225,10 +277,13 @@ fn median(times: &[f64]) -> f64 {
 }
 
 pub fn markdown(rows: &[BenchRow]) -> String {
-    let mut text = String::from("| scene | mesh vertices | cage vertices | method | backend | median (s) |\n|---|---:|---:|---|---|---:|\n");
+    let mut text = String::from("| scene | mesh vertices | cage vertices | method | backend | median (s) | paper (s) |\n|---|---:|---:|---|---|---:|---:|\n");
     for row in rows {
+        let paper = row
+            .paper_seconds
+            .map_or(String::new(), |seconds| format!("{seconds:.2}"));
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.3} |\n",
+            "| {} | {} | {} | {} | {} | {:.3} | {paper} |\n",
             row.scene,
             row.mesh_vertices,
             row.cage_vertices,

@@ -228,6 +228,19 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         );
     }
 
+    let plan = crate::coords::harmonic::plan(&cage, args.grid, mesh.mesh.positions.len())?;
+    println!(
+        "harmonic at --grid {}: {} × {} × {} nodes of {:.6}, {} inside the cage, {} multigrid levels, about {} MiB",
+        plan.grid,
+        plan.dims[0],
+        plan.dims[1],
+        plan.dims[2],
+        plan.cell,
+        plan.inside_nodes,
+        plan.levels,
+        plan.predicted_bytes >> 20
+    );
+
     // MVC negativity on an evenly spaced sample of inside vertices.
     let inside: Vec<usize> = (0..mesh.mesh.positions.len())
         .filter(|&i| matches!(classes.classes[i], geometry::PointClass::Inside))
@@ -241,10 +254,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         .collect();
     let points: Vec<DVec3> = sample.iter().map(|&i| mesh.mesh.positions[i]).collect();
     let sample_classes: Vec<_> = sample.iter().map(|&i| classes.classes[i]).collect();
-    let options = BindOptions {
-        method: Method::Mvc,
-        resolution: 1,
-    };
+    let options = BindOptions::for_method(Method::Mvc);
     let weights = bind_cpu(
         &points,
         &sample_classes,

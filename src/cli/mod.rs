@@ -80,7 +80,10 @@ pub struct MethodChoice {
     /// PMVC cube-map resolution: texels along one face edge (1–1024).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub resolution: u32,
-    /// Where binding runs.
+    /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
+    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    pub grid: u32,
+    /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
     /// Treat mesh vertices outside the cage as an error instead of giving them MVC weights.
@@ -94,6 +97,7 @@ impl MethodChoice {
         crate::coords::BindOptions {
             method: self.method,
             resolution: self.resolution,
+            grid: self.grid,
         }
     }
 }
@@ -118,7 +122,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method and --resolution are then ignored).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored).
     #[arg(long, value_name = "W.npy")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are dropped.
@@ -133,6 +137,9 @@ pub struct CheckArgs {
     /// Mesh vertices sampled for the MVC negativity statistic.
     #[arg(long, default_value_t = 2000)]
     pub sample: usize,
+    /// The harmonic grid to report on: cells along the cage's longest side.
+    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    pub grid: u32,
 }
 
 #[derive(Debug, clap::Args)]
@@ -256,7 +263,19 @@ pub struct GenerateArgs {
 
 /// Entry point of the binary: parse, run, report.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and version go to stdout and succeed; a bad argument is bad input
+        // like any other: its message, then exit status 1 (clap's own is 2).
+        Err(error) => {
+            let _ = error.print();
+            return if error.use_stderr() {
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     let result = match cli.command {
         None => crate::app::run_editor(crate::app::EditorOptions::default())
             .map_err(anyhow::Error::from),

@@ -4,9 +4,9 @@
 //! [`Method::spec`]; none of them names a family.
 //!
 //! Adding a family: write its module in `coords`, add a variant here with its
-//! [`FamilySpec`], and dispatch to it in [`super::weights_at`] (and, if it has more
-//! columns than cage vertices, in [`Method::columns`] and
-//! [`Method::column_displacements`]).
+//! [`FamilySpec`], and dispatch to it in [`super::bind_cpu`] (a whole-scene solve)
+//! or [`super::weights_at`] (one row at a time); if it has more columns than cage
+//! vertices, also in [`Method::columns`] and [`Method::column_displacements`].
 
 use crate::geometry::Cage;
 use glam::DVec3;
@@ -18,6 +18,8 @@ pub enum Method {
     Mvc,
     /// Positive mean value coordinates (Lipman et al. 2007), by cube-map integration.
     Pmvc,
+    /// Harmonic coordinates (Joshi et al. 2007), by a grid solve of Laplace's equation.
+    Harmonic,
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -41,6 +43,8 @@ pub struct ParameterSpec {
 pub enum Parameter {
     /// Cube-map texels along one face edge (PMVC).
     Resolution,
+    /// Grid cells along the cage's longest side (harmonic coordinates).
+    Grid,
 }
 
 /// What a family's weights matrix holds per mesh vertex.
@@ -101,14 +105,32 @@ const PMVC: FamilySpec = FamilySpec {
     outside_policy: OUTSIDE_BY_MVC,
 };
 
+const HARMONIC: FamilySpec = FamilySpec {
+    id: "harmonic",
+    name: "HC",
+    summary: "harmonic coordinates: a grid solve of Laplace's equation inside the cage",
+    parameter: Some(ParameterSpec {
+        key: Parameter::Grid,
+        label: "harmonic grid",
+        flag: "--grid",
+        choices: &[32, 64, 128],
+        default: super::harmonic::DEFAULT_GRID,
+        format: |value| format!("grid {value}"),
+    }),
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 2] = [Method::Mvc, Method::Pmvc];
+    pub const ALL: [Method; 3] = [Method::Mvc, Method::Pmvc, Method::Harmonic];
 
     pub fn spec(self) -> &'static FamilySpec {
         match self {
             Method::Mvc => &MVC,
             Method::Pmvc => &PMVC,
+            Method::Harmonic => &HARMONIC,
         }
     }
 

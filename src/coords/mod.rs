@@ -14,6 +14,7 @@
 
 pub mod cubemap;
 pub mod family;
+pub mod harmonic;
 pub mod mvc;
 pub mod npy;
 pub mod pmvc;
@@ -30,8 +31,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BindOptions {
     pub method: Method,
-    /// Cube-map resolution for PMVC; ignored by MVC.
+    /// Cube-map resolution for PMVC; ignored by the others.
     pub resolution: u32,
+    /// Grid cells along the cage's longest side for harmonic coordinates; ignored
+    /// by the others.
+    pub grid: u32,
 }
 
 impl BindOptions {
@@ -47,12 +51,14 @@ impl BindOptions {
     pub fn get(&self, parameter: Parameter) -> u32 {
         match parameter {
             Parameter::Resolution => self.resolution,
+            Parameter::Grid => self.grid,
         }
     }
 
     pub fn set(&mut self, parameter: Parameter, value: u32) {
         match parameter {
             Parameter::Resolution => self.resolution = value,
+            Parameter::Grid => self.grid = value,
         }
     }
 
@@ -76,6 +82,7 @@ impl Default for BindOptions {
         Self {
             method: Method::Pmvc,
             resolution: DEFAULT_RESOLUTION,
+            grid: harmonic::DEFAULT_GRID,
         }
     }
 }
@@ -210,21 +217,46 @@ impl BindProgress {
 #[error("binding was cancelled")]
 pub struct Cancelled;
 
+/// Why a CPU bind produced no weights.
+#[derive(Debug, thiserror::Error)]
+pub enum BindFailure {
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
+    #[error(transparent)]
+    Harmonic(harmonic::HarmonicError),
+}
+
+impl From<harmonic::HarmonicError> for BindFailure {
+    fn from(error: harmonic::HarmonicError) -> Self {
+        match error {
+            harmonic::HarmonicError::Cancelled(cancelled) => BindFailure::Cancelled(cancelled),
+            other => BindFailure::Harmonic(other),
+        }
+    }
+}
+
 /// Rows bound per parallel task: small enough to balance and to notice a cancel
 /// quickly, large enough to amortise the scratch set-up.
 const ROWS_PER_TASK: usize = 32;
 
-/// Bind `points` to `cage` on the CPU, in parallel over points.
+/// Bind `points` to `cage` on the CPU, in parallel.
 ///
 /// `classes` comes from [`crate::geometry::classify_points`] for the same points and
 /// cage; it decides the inside/outside/surface policy described in the module doc.
+/// Families with a closed form or per-point integral go row by row
+/// ([`bind_rows`]); harmonic coordinates solve over the whole cage first.
 pub fn bind_cpu(
     points: &[DVec3],
     classes: &[PointClass],
     cage: &Cage,
     options: BindOptions,
     progress: &BindProgress,
-) -> Result<Weights, Cancelled> {
+) -> Result<Weights, BindFailure> {
+    if options.method == Method::Harmonic {
+        let (weights, _stats) =
+            harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
+        return Ok(weights);
+    }
     let mut weights = Weights::zeros(points.len(), cage.vertex_count());
     let rows: Vec<usize> = (0..points.len()).collect();
     bind_rows(
@@ -322,7 +354,9 @@ pub fn weights_at(
         }
         PointClass::Outside => mvc::mvc_weights(x, cage, out, mvc_scratch),
         PointClass::Inside => match method {
-            Method::Mvc => mvc::mvc_weights(x, cage, out, mvc_scratch),
+            // Harmonic coordinates have no per-point form; bind_cpu solves them
+            // whole. Asked for one row, MVC is the outside policy's answer.
+            Method::Mvc | Method::Harmonic => mvc::mvc_weights(x, cage, out, mvc_scratch),
             Method::Pmvc => {
                 if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the

@@ -3,6 +3,25 @@
 use super::GpuError;
 
 use super::shader_source::compose;
+use crate::coords::Method;
+
+/// The families that have a GPU kernel. The rest bind on the CPU whatever the
+/// backend, so a new family needs no change here until it gets a kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    Mvc,
+    Pmvc,
+}
+
+impl Kernel {
+    pub fn of(method: Method) -> Option<Kernel> {
+        match method {
+            Method::Mvc => Some(Kernel::Mvc),
+            Method::Pmvc => Some(Kernel::Pmvc),
+            _ => None,
+        }
+    }
+}
 
 const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
 const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");

@@ -2,6 +2,7 @@
 
 use crate::app::document::WeightSet;
 use crate::app::editor::EditorApp;
+use crate::coords::quality::NEGATIVE_TOLERANCE;
 
 /// A row of the table: its name and how a method's weights show in it.
 type QualityRow = (&'static str, fn(&WeightSet) -> String);
@@ -11,7 +12,15 @@ const ROWS: [QualityRow; 5] = [
         format!("{:.1} %", 100.0 * set.quality.negative_share)
     }),
     ("most negative λ", |set| {
-        format!("{:.4}", set.quality.most_negative)
+        // Above −NEGATIVE_TOLERANCE a weight is solver rounding, not a negative
+        // weight: show it as the 0 the first row counts it as, not as "-0.0000".
+        let most_negative = set.quality.most_negative;
+        let shown = if most_negative < -NEGATIVE_TOLERANCE {
+            most_negative
+        } else {
+            0.0
+        };
+        format!("{shown:.4}")
     }),
     ("max |Σλ - 1|", |set| {
         format!("{:.1e}", set.quality.max_partition_error)

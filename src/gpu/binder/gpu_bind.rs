@@ -2,10 +2,10 @@
 //! CPU, and typed readback.
 
 use super::{BatchSize, BindConfig, BindError, BindInput, BindOutput, BindStats, GpuWeights};
-use crate::coords::{self, cubemap::TexelTable, BindProgress, Method, Weights};
+use crate::coords::{self, cubemap::TexelTable, BindProgress, Weights};
 use crate::geometry::{bounds_of, Cage, PointClass};
 use crate::gpu::context::GpuContext;
-use crate::gpu::kernels::{Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
+use crate::gpu::kernels::{Kernel, Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
 use crate::gpu::GpuError;
 use glam::DVec3;
 use std::time::Instant;
@@ -40,6 +40,7 @@ pub(super) struct GpuBind<'a> {
     context: &'a GpuContext,
     input: &'a BindInput,
     config: BindConfig,
+    kernel: Kernel,
     centre: DVec3,
     rows: usize,
     cols: usize,
@@ -97,8 +98,9 @@ impl<'a> GpuBind<'a> {
         let cols = input.cage.vertex_count();
         let triangles = input.cage.triangle_count();
         let method = input.options.method;
+        let kernel = Kernel::of(method).ok_or(BindError::NoGpuKernel { method })?;
         let resolution = input.options.resolution.max(1);
-        if method == Method::Pmvc && resolution > BAND_TEXELS {
+        if kernel == Kernel::Pmvc && resolution > BAND_TEXELS {
             return Err(BindError::ResolutionTooHigh {
                 asked: resolution,
                 max: BAND_TEXELS,
@@ -109,7 +111,7 @@ impl<'a> GpuBind<'a> {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
         // Corner sums per triangle, for the whole sphere and for the current band.
-        let sums_per_row = if method == Method::Pmvc {
+        let sums_per_row = if kernel == Kernel::Pmvc {
             6 * triangles
         } else {
             0
@@ -141,7 +143,7 @@ impl<'a> GpuBind<'a> {
             }
         }
         let max_groups = limits.max_compute_workgroups_per_dimension as usize;
-        let dispatch_cap = if method == Method::Pmvc {
+        let dispatch_cap = if kernel == Kernel::Pmvc {
             max_groups
         } else {
             max_groups * WORKGROUP_SIZE as usize
@@ -178,9 +180,9 @@ impl<'a> GpuBind<'a> {
                 })
                 .collect();
             let positions = storage("cage positions", bytemuck::cast_slice(&padded(positions)));
-            let (topology, params) = topology(&input.cage, method, resolution, rows);
+            let (topology, params) = topology(&input.cage, kernel, resolution, rows);
             let topology = storage("cage topology", bytemuck::cast_slice(&padded(topology)));
-            let texels: Vec<f32> = if method == Method::Pmvc {
+            let texels: Vec<f32> = if kernel == Kernel::Pmvc {
                 table
                     .solid_angle_over_length
                     .iter()
@@ -265,6 +267,7 @@ impl<'a> GpuBind<'a> {
                 context,
                 input,
                 config,
+                kernel,
                 centre,
                 rows,
                 cols,
@@ -299,9 +302,9 @@ impl<'a> GpuBind<'a> {
             // triangle (PMVC: bounds walks over the cube map).
             BatchSize::Adaptive { .. } => {
                 let triangles = self.input.cage.triangle_count().max(1);
-                match self.input.options.method {
-                    Method::Pmvc => 2048 / triangles,
-                    Method::Mvc => 65536 / triangles,
+                match self.kernel {
+                    Kernel::Pmvc => 2048 / triangles,
+                    Kernel::Mvc => 65536 / triangles,
                 }
             }
         }
@@ -421,12 +424,12 @@ impl<'a> GpuBind<'a> {
                         timestamp_writes: None,
                     });
                     pass.set_bind_group(0, &self.bind_group, &[]);
-                    let groups = match input.options.method {
-                        Method::Pmvc => {
+                    let groups = match self.kernel {
+                        Kernel::Pmvc => {
                             pass.set_pipeline(&kernels.pmvc);
                             inside.len() as u32
                         }
-                        Method::Mvc => {
+                        Kernel::Mvc => {
                             pass.set_pipeline(&kernels.mvc);
                             (inside.len() as u32).div_ceil(WORKGROUP_SIZE)
                         }
@@ -523,7 +526,7 @@ fn padded<T: Default + Clone>(mut values: Vec<T>) -> Vec<T> {
 
 /// Triangle corners, then the vertex → incident-corner CSR, and the kernel params
 /// that locate them.
-fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u32>, Params) {
+fn topology(cage: &Cage, kernel: Kernel, resolution: u32, rows: usize) -> (Vec<u32>, Params) {
     let triangles = cage.triangle_count();
     let vertices = cage.vertex_count();
     let mut topology: Vec<u32> = cage.triangles().iter().flatten().copied().collect();
@@ -553,7 +556,7 @@ fn topology(cage: &Cage, method: Method, resolution: u32, rows: usize) -> (Vec<u
         vertex_count: vertices as u32,
         resolution,
         band_rows: (BAND_TEXELS / resolution).max(1),
-        max_missed: if method == Method::Pmvc {
+        max_missed: if kernel == Kernel::Pmvc {
             (0.01 * 6.0 * texels).floor() as u32
         } else {
             0

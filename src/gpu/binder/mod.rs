@@ -152,11 +152,22 @@ pub enum BindError {
     ThreadSpawn(String),
     #[error("the binding thread panicked")]
     Panicked,
+    #[error(transparent)]
+    Harmonic(coords::harmonic::HarmonicError),
 }
 
 impl From<coords::Cancelled> for BindError {
     fn from(_: coords::Cancelled) -> Self {
         BindError::Cancelled
+    }
+}
+
+impl From<coords::BindFailure> for BindError {
+    fn from(failure: coords::BindFailure) -> Self {
+        match failure {
+            coords::BindFailure::Cancelled(_) => BindError::Cancelled,
+            coords::BindFailure::Harmonic(error) => BindError::Harmonic(error),
+        }
     }
 }
 
@@ -298,8 +309,18 @@ fn run(
 ) -> Result<BindOutput, BindError> {
     validate(input)?;
     let started = Instant::now();
+    let has_kernel = crate::gpu::kernels::Kernel::of(input.options.method).is_some();
     match backend {
-        Backend::Cpu => {
+        Backend::Gpu(_) if has_kernel && !config.cpu_weights && !config.gpu_buffer => {
+            Err(BindError::NothingKept)
+        }
+        Backend::Gpu(context) if has_kernel => {
+            let mut output = GpuBind::new(context, input, config)?.run(progress)?;
+            output.stats.elapsed = started.elapsed();
+            Ok(output)
+        }
+        // The CPU backend, and families without a GPU kernel on any backend.
+        _ => {
             let weights = coords::bind_cpu(
                 &input.points,
                 &input.classes,
@@ -318,12 +339,6 @@ fn run(
                     device: "CPU".into(),
                 },
             })
-        }
-        Backend::Gpu(_) if !config.cpu_weights && !config.gpu_buffer => Err(BindError::NothingKept),
-        Backend::Gpu(context) => {
-            let mut output = GpuBind::new(context, input, config)?.run(progress)?;
-            output.stats.elapsed = started.elapsed();
-            Ok(output)
         }
     }
 }
