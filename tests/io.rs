@@ -207,3 +207,13 @@ fn a_bad_number_names_the_file_and_line() {
     let message = error.to_string();
     assert!(message.starts_with("assets/example.obj:3:"), "{message}");
 }
+
+/// Every benchmark scene's cage passes validation (they are built through it).
+#[test]
+fn every_table1_scene_builds_a_valid_cage() {
+    for &name in procedural::table1_scene_names() {
+        let scene = procedural::table1_scene(name).expect("a known scene");
+        assert!(scene.cage.vertex_count() > 0, "{name}");
+        assert!(!scene.points.is_empty(), "{name}");
+    }
+}

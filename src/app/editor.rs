@@ -102,6 +102,9 @@ impl EditorApp {
         if let Some(resolution) = options.resolution {
             bind_options.resolution = resolution.max(1);
         }
+        if let Some(grid) = options.grid {
+            bind_options.grid = grid.max(crate::coords::harmonic::MIN_GRID);
+        }
         let mut app = Self {
             gpu,
             document: Document::new(BundledScene::Comb.title(), mesh, cage),

@@ -40,6 +40,8 @@ pub struct EditorOptions {
     pub pose: Option<PathBuf>,
     /// PMVC cube-map resolution; `None` for the default.
     pub resolution: Option<u32>,
+    /// Harmonic grid (cells along the cage's longest side); `None` for the default.
+    pub grid: Option<u32>,
     /// Coordinates to bind with; `None` for PMVC.
     pub method: Option<crate::coords::Method>,
     /// Save a PNG of the window once the first bind finishes, then quit.

@@ -155,6 +155,9 @@ pub struct EditArgs {
     /// PMVC cube-map resolution (1–1024).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub resolution: Option<u32>,
+    /// Harmonic grid: cells along the cage's longest side (4–2048).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    pub grid: Option<u32>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
     pub method: Option<crate::coords::Method>,
@@ -235,6 +238,7 @@ impl EditArgs {
             cage: self.cage,
             pose: self.pose,
             resolution: self.resolution,
+            grid: self.grid,
             method,
             screenshot: self.screenshot,
             bind_on: match self.backend {

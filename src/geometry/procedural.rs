@@ -88,11 +88,19 @@ pub fn extrude(outline: &[DVec2], z0: f64, z1: f64) -> Cage {
 /// Triangulate a simple counter-clockwise polygon by ear clipping (O(n²), for cages).
 pub fn ear_clip(outline: &[DVec2]) -> Vec<[u32; 3]> {
     let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let (lo, hi) = outline
+        .iter()
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    // An ear flatter than this would be a degenerate triangle to cage validation
+    // (refined outlines have runs of collinear vertices).
+    let flat = 1e-9 * (hi - lo).length_squared();
     let mut remaining: Vec<u32> = (0..outline.len() as u32).collect();
     let mut triangles = Vec::new();
     while remaining.len() > 3 {
         let m = remaining.len();
-        let ear = (0..m).find(|&k| {
+        let is_ear = |k: usize, min_area: f64| {
             let (ia, ib, ic) = (
                 remaining[(k + m - 1) % m],
                 remaining[k],
@@ -103,7 +111,7 @@ pub fn ear_clip(outline: &[DVec2]) -> Vec<[u32; 3]> {
                 outline[ib as usize],
                 outline[ic as usize],
             );
-            if cross(a, b, c) <= 0.0 {
+            if cross(a, b, c) <= min_area {
                 return false;
             }
             remaining.iter().all(|&other| {
@@ -113,7 +121,10 @@ pub fn ear_clip(outline: &[DVec2]) -> Vec<[u32; 3]> {
                 let p = outline[other as usize];
                 !(cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0)
             })
-        });
+        };
+        let ear = (0..m)
+            .find(|&k| is_ear(k, flat))
+            .or_else(|| (0..m).find(|&k| is_ear(k, 0.0)));
         let k = ear.expect("a simple polygon always has an ear");
         triangles.push([
             remaining[(k + m - 1) % m],

@@ -216,9 +216,11 @@ impl Multigrid {
     }
 }
 
-/// Column-wise dot products of two blocks, in f64.
+/// Column-wise dot products of two blocks, in f64. Partial sums are added in a
+/// fixed order, so a bind gives the same weights on every run.
 fn dots(a: &[f32], b: &[f32], width: usize) -> Vec<f64> {
-    a.par_chunks(width * ROWS_PER_TASK)
+    let partials: Vec<Vec<f64>> = a
+        .par_chunks(width * ROWS_PER_TASK)
         .zip(b.par_chunks(width * ROWS_PER_TASK))
         .map(|(a, b)| {
             let mut sums = vec![0.0f64; width];
@@ -229,13 +231,12 @@ fn dots(a: &[f32], b: &[f32], width: usize) -> Vec<f64> {
             }
             sums
         })
-        .reduce(
-            || vec![0.0f64; width],
-            |mut x, y| {
-                x.iter_mut().zip(y).for_each(|(x, y)| *x += y);
-                x
-            },
-        )
+        .collect();
+    let mut total = vec![0.0f64; width];
+    for partial in partials {
+        total.iter_mut().zip(partial).for_each(|(t, p)| *t += p);
+    }
+    total
 }
 
 /// How a block solve went.
