@@ -25,6 +25,8 @@ shoot compare-heatmap --pose "$finger" --view side-by-side --heatmap 7
 shoot compare-heatmap-log --pose "$finger" --view side-by-side --heatmap 7 --log-scale
 shoot compare-negativity --pose "$finger" --view side-by-side --negativity
 shoot compare-difference --pose "$finger" --view difference
+shoot compare-three-families --pose "$finger" --compare mvc,pmvc,harmonic
+shoot compare-three-heatmap --pose "$finger" --compare mvc,pmvc,harmonic --heatmap 7 --log-scale
 elephant=(assets/scan_mesh.obj assets/scan_cage.obj --pose docs/poses/elephant-head-sideways.obj)
 shoot compare-elephant-side-by-side "${elephant[@]}" --view side-by-side
 shoot compare-elephant-heatmap "${elephant[@]}" --view side-by-side --heatmap 56 --log-scale

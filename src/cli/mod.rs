@@ -172,6 +172,10 @@ pub struct EditArgs {
     /// deformations (`difference`).
     #[arg(long, value_parser = parse_view)]
     pub view: Option<ViewArg>,
+    /// The families the side-by-side view shows, e.g. `mvc,pmvc,harmonic` (default
+    /// mvc,pmvc); implies `--view side-by-side` when no view is given.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "METHODS")]
+    pub compare: Vec<crate::coords::Method>,
     /// Colour the mesh by the coordinate function of this cage vertex (0-based).
     #[arg(long, value_name = "CAGE_VERTEX", conflicts_with = "negativity")]
     pub heatmap: Option<usize>,
@@ -214,14 +218,18 @@ fn parse_view(value: &str) -> Result<ViewArg, String> {
 
 impl EditArgs {
     fn editor_options(self) -> crate::app::EditorOptions {
-        use crate::app::compare::{Layout, Overlay, ViewSettings};
+        use crate::app::compare::{Layout, MethodSet, Overlay, ViewSettings};
         let mut view = ViewSettings::default();
         let mut method = self.method;
         match self.view {
             Some(ViewArg::Single(shown)) => method = Some(shown),
             Some(ViewArg::SideBySide) => view.layout = Layout::SideBySide,
             Some(ViewArg::Difference) => view.layout = Layout::Difference,
+            None if !self.compare.is_empty() => view.layout = Layout::SideBySide,
             None => {}
+        }
+        if !self.compare.is_empty() {
+            view.compared = MethodSet::of(&self.compare);
         }
         if let Some(vertex) = self.heatmap {
             view.overlay = Overlay::Heatmap;
@@ -325,6 +333,12 @@ mod tests {
         assert_eq!(
             options.view.scale,
             crate::render::colormap::Scale::LogMagnitude
+        );
+        let options = edit_options(&["--compare", "mvc,pmvc,harmonic"]);
+        assert_eq!(options.view.layout, Layout::SideBySide);
+        assert_eq!(
+            options.view.compared.iter().collect::<Vec<_>>(),
+            Method::ALL.to_vec()
         );
         let options = edit_options(&["--view", "mvc", "--negativity"]);
         assert_eq!(options.view.layout, Layout::Single);

@@ -10,6 +10,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
+/// Negative values above this are the solver's tolerance (2·10⁻⁷ relative).
+const SOLVER_ROUNDING: f32 = 1e-6;
+
 /// Where a cell corner's values come from.
 #[derive(Clone, Copy, Debug)]
 enum Corner {
@@ -146,6 +149,13 @@ impl Sampler {
                                 }
                             }
                         }
+                    }
+                }
+                // The exact solution is non-negative (maximum principle); what the
+                // iteration leaves below zero is its tolerance, not a weight to show.
+                for value in out.iter_mut() {
+                    if (-SOLVER_ROUNDING..0.0).contains(value) {
+                        *value = 0.0;
                     }
                 }
             });
