@@ -35,7 +35,7 @@ pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> 
             );
         }
         eprintln!(
-            "pmvc: {}: warning: {summary} of {}; they get MVC weights, which are finite, reproduce the rest pose and meet PMVC continuously on the cage",
+            "pmvc: {}: warning: {summary} of {}; they get MVC weights, which are finite, reproduce the rest pose and meet the inside coordinates continuously on the cage",
             input.mesh.display(),
             input.cage.display()
         );

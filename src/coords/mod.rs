@@ -1,16 +1,17 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
-//! coordinates ([`pmvc`]), and the dense weights matrix they fill. Nothing here
-//! touches the GPU or the UI.
+//! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), and the dense
+//! weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
-//!   cage diagonal), both methods give the barycentric coordinates of the touching
-//!   triangle, which is the limit of both MVC and PMVC there;
-//! - outside, both methods use MVC. MVC is finite off the surface (its total weight
+//!   cage diagonal), every family gives the barycentric coordinates of the
+//!   touching triangle, which is the limit of each of them there;
+//! - outside, every family uses MVC. MVC is finite off the surface (its total weight
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
-//!   reproduces the rest pose by linear precision, and meets PMVC continuously on
-//!   the surface because both reduce to the triangle's barycentrics there.
+//!   reproduces the rest pose by linear precision, and meets every family
+//!   continuously on the surface because all reduce to the triangle's barycentrics
+//!   there.
 
 pub mod cubemap;
 pub mod family;
