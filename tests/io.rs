@@ -217,3 +217,70 @@ fn every_table1_scene_builds_a_valid_cage() {
         assert!(!scene.points.is_empty(), "{name}");
     }
 }
+
+/// `text` with `suffix` after the numbers of every `v` line.
+fn with_vertex_suffix(text: &str, suffix: &str) -> String {
+    text.lines()
+        .map(|line| {
+            if line.starts_with("v ") {
+                format!("{line}{suffix}\n")
+            } else {
+                format!("{line}\n")
+            }
+        })
+        .collect()
+}
+
+/// Inputs are never silently changed: a byte-order mark, CR-only line endings and
+/// the common `v` forms read as what the file says; other forms are errors that
+/// name the line.
+#[test]
+fn byte_order_marks_line_endings_and_vertex_forms() {
+    use pmvc::geometry::parse_mesh;
+    let path = std::path::Path::new("cube.obj");
+    let cube = procedural::cube_cage(1.0);
+    let plain = cage_obj(&cube);
+    let expected = parse_mesh(path, plain.clone()).unwrap().mesh;
+    assert_eq!(expected.positions.len(), 8);
+    let variants = [
+        ("byte-order mark", format!("\u{feff}{plain}")),
+        ("CR line endings", plain.replace('\n', "\r")),
+        ("CRLF line endings", plain.replace('\n', "\r\n")),
+        ("x y z w", with_vertex_suffix(&plain, " 1")),
+        ("x y z r g b", with_vertex_suffix(&plain, " 0.5 0.5 0.5")),
+    ];
+    for (name, text) in variants {
+        let mesh = parse_mesh(path, text)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .mesh;
+        assert_eq!(mesh.positions, expected.positions, "{name}");
+        assert_eq!(mesh.triangles, expected.triangles, "{name}");
+    }
+    let bad = [
+        ("v 0 0 0 1 2\n", ":1:", "has 5 numbers"),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1 a b c\nf 1 2 3\n",
+            ":4:",
+            "'a' is not a number",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 x 1\nf 1 2 3\n",
+            ":4:",
+            "normal: 'x'",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 nope\nf 1 2 3\n",
+            ":4:",
+            "texture coordinate",
+        ),
+    ];
+    for (text, line, what) in bad {
+        let message = parse_mesh(path, text.to_owned()).unwrap_err().to_string();
+        assert!(message.starts_with(&format!("cube.obj{line}")), "{message}");
+        assert!(message.contains(what), "{message}");
+    }
+    // A runaway token is quoted short.
+    let long = format!("v 0 0 {}\n", "9".repeat(100_000) + "x");
+    let message = parse_mesh(path, long).unwrap_err().to_string();
+    assert!(message.len() < 200, "{} bytes of message", message.len());
+}

@@ -42,6 +42,17 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
 /// extension); `path` is only used for the format and for messages. The one entry
 /// for mesh text, used by [`load_mesh`] and by the editor's bundled scenes.
 pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
+    // A byte-order mark would hide the first line's keyword; old-Mac files end
+    // lines with CR alone, which `str::lines` does not split on.
+    let text = match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_owned(),
+        None => text,
+    };
+    let text = if text.contains('\r') {
+        text.replace("\r\n", "\n").replace('\r', "\n")
+    } else {
+        text
+    };
     let extension = path
         .extension()
         .and_then(|e| e.to_str())

@@ -42,9 +42,35 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                     *value = token.parse().map_err(|_| {
                         parse_error(
                             line_number,
-                            format!("vertex {}: '{token}' is not a number", positions.len()),
+                            format!(
+                                "vertex {}: '{}' is not a number",
+                                positions.len(),
+                                quoted(token)
+                            ),
                         )
                     })?;
+                }
+                // Accepted: x y z, x y z w, and x y z r g b (vertex colours).
+                let extra: Vec<&str> = tokens.collect();
+                if !matches!(extra.len(), 0 | 1 | 3) {
+                    return Err(parse_error(
+                        line_number,
+                        format!(
+                            "vertex {} has {} numbers; expected x y z, x y z w or x y z r g b",
+                            positions.len(),
+                            3 + extra.len()
+                        ),
+                    ));
+                }
+                if let Some(token) = extra.iter().find(|token| token.parse::<f64>().is_err()) {
+                    return Err(parse_error(
+                        line_number,
+                        format!(
+                            "vertex {}: '{}' is not a number",
+                            positions.len(),
+                            quoted(token)
+                        ),
+                    ));
                 }
                 if !coordinate.iter().all(|c| c.is_finite()) {
                     return Err(LoadError::NonFinite {
@@ -57,6 +83,28 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                 positions.push(DVec3::from_array(coordinate));
                 continue;
             }
+            Some(keyword @ ("vn" | "vt")) => {
+                // Checked here so that a bad number names its line; the OBJ
+                // library's own message would not.
+                let (element, counts) = if keyword == "vn" {
+                    ("normal", 3..=3)
+                } else {
+                    ("texture coordinate", 1..=3)
+                };
+                let values: Vec<&str> = tokens.collect();
+                if !counts.contains(&values.len()) {
+                    return Err(parse_error(
+                        line_number,
+                        format!("{element} has {} numbers", values.len()),
+                    ));
+                }
+                if let Some(token) = values.iter().find(|token| token.parse::<f64>().is_err()) {
+                    return Err(parse_error(
+                        line_number,
+                        format!("{element}: '{}' is not a number", quoted(token)),
+                    ));
+                }
+            }
             Some("f") => {
                 // Checked here so that the error can name the line and the face.
                 for token in tokens {
@@ -64,7 +112,10 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                     let index: i64 = index_text.parse().map_err(|_| {
                         parse_error(
                             line_number,
-                            format!("face {face_count}: '{token}' is not a vertex index"),
+                            format!(
+                                "face {face_count}: '{}' is not a vertex index",
+                                quoted(token)
+                            ),
                         )
                     })?;
                     let resolved = if index < 0 {
@@ -160,4 +211,14 @@ fn count_vertices(text: &str) -> usize {
     text.lines()
         .filter(|line| line.split_whitespace().next() == Some("v"))
         .count()
+}
+
+/// A token as messages quote it: at most 40 characters, so that a runaway token
+/// (a 2 MB line of digits) does not flood the terminal.
+fn quoted(token: &str) -> String {
+    const SHOWN: usize = 40;
+    match token.char_indices().nth(SHOWN) {
+        Some((end, _)) => format!("{}… ({} bytes)", &token[..end], token.len()),
+        None => token.to_owned(),
+    }
 }
