@@ -437,3 +437,52 @@ fn bind_harmonic_writes_the_library_weights_and_check_reports_the_grid() {
     assert!(stderr(&output).contains("--grid"), "{}", stderr(&output));
     assert!(!dir.path().join("bad.npy").exists());
 }
+
+/// A reader that goes away (`pmvc check … | head -1`) and a stderr that cannot be
+/// written (`2>/dev/full`) end the command cleanly, never with a panic.
+#[test]
+fn closed_stdout_and_full_stderr_end_cleanly() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, _, _) = comb_scene(dir.path(), 50);
+    let args = [
+        "check",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage_path),
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pmvc"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close the pipe before the command writes (it reads its files first), as a
+    // reader that has already gone would.
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_ne!(output.status.code(), Some(101), "{stderr}");
+
+    if std::path::Path::new("/dev/full").exists() {
+        // A bind of points partly outside the cage warns on stderr.
+        let outside = write(dir.path(), "outside.obj", "v 0.5 0.5 0\nv 40 40 40\n");
+        let output = Command::new(env!("CARGO_BIN_EXE_pmvc"))
+            .args([
+                "bind",
+                "--mesh",
+                path_str(&outside),
+                "--cage",
+                path_str(&cage_path),
+                "--out",
+                path_str(&dir.path().join("w.npy")),
+            ])
+            .stderr(std::fs::File::create("/dev/full").unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(0), "the bind itself succeeds");
+        assert!(dir.path().join("w.npy").exists());
+    }
+}

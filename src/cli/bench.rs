@@ -112,7 +112,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ),
         Err(error) => format!("none ({error})"),
     };
-    eprintln!(
+    warn_line!(
         "pmvc bench: {threads} CPU threads, GPU adapter: {adapter}, {} runs per row",
         args.runs
     );
@@ -159,7 +159,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if !args.no_data {
         rows.extend(bench_shared_data(args, &wanted, &backends)?);
     }
-    println!("{}", markdown(&rows));
+    say!("{}", markdown(&rows));
     if let Some(path) = &args.json {
         let json = to_json(&rows, threads, &adapter);
         geometry::write_atomically(path, |out| out.write_all(json.as_bytes()))?;
@@ -217,9 +217,12 @@ fn bench_scene(
                 runs: times,
                 paper_seconds: paper_seconds(name, method, resolution),
             };
-            eprintln!(
+            warn_line!(
                 "  {} | {} | {}: {:.3} s",
-                row.scene, row.method, row.backend, row.median_seconds
+                row.scene,
+                row.method,
+                row.backend,
+                row.median_seconds
             );
             rows.push(row);
         }
@@ -233,7 +236,7 @@ fn bench_shared_data(
     backends: &[Timed],
 ) -> Result<Vec<BenchRow>> {
     let Ok(entries) = std::fs::read_dir(&args.data) else {
-        eprintln!(
+        warn_line!(
             "pmvc bench: {} not found; shared-data rows not run",
             args.data.display()
         );

@@ -22,7 +22,7 @@ pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> 
     let mesh = geometry::load_mesh(&input.mesh)?;
     let (cage, report) = geometry::load_cage(&input.cage)?;
     for message in report.messages() {
-        eprintln!("pmvc: {}: {message}", input.cage.display());
+        warn_line!("pmvc: {}: {message}", input.cage.display());
     }
     let classes = classify_points(&cage, &mesh.mesh.positions);
     if !classes.outside.is_empty() {
@@ -34,7 +34,7 @@ pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> 
                 input.cage.display()
             );
         }
-        eprintln!(
+        warn_line!(
             "pmvc: {}: warning: {summary} of {}; they get MVC weights, which are finite, reproduce the rest pose and meet the inside coordinates continuously on the cage",
             input.mesh.display(),
             input.cage.display()
@@ -178,7 +178,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
 
 pub(super) fn check(args: &CheckArgs) -> Result<()> {
     let mesh = geometry::load_mesh(&args.input.mesh)?;
-    println!(
+    say!(
         "mesh  {}: {} vertices, {} triangles{}",
         args.input.mesh.display(),
         mesh.mesh.positions.len(),
@@ -190,13 +190,13 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         }
     );
     let (cage, report) = geometry::load_cage(&args.input.cage)?;
-    println!(
+    say!(
         "cage  {}: {} vertices, {} triangles, closed, edge-manifold, consistently oriented",
         args.input.cage.display(),
         cage.vertex_count(),
         cage.triangles().len()
     );
-    println!(
+    say!(
         "      volume {:.6}, faces point {}, diagonal {:.6}",
         report.volume,
         if report.flipped {
@@ -207,7 +207,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         cage.diagonal()
     );
     for message in report.messages() {
-        println!("      {message}");
+        say!("      {message}");
     }
     let classes = classify_points(&cage, &mesh.mesh.positions);
     let on_surface = classes
@@ -216,20 +216,20 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         .filter(|c| matches!(c, geometry::PointClass::OnSurface { .. }))
         .count();
     if classes.outside.is_empty() {
-        println!(
+        say!(
             "inside: all {} mesh vertices ({} on the cage surface)",
             mesh.mesh.positions.len(),
             on_surface
         );
     } else {
-        println!(
+        say!(
             "outside: {}",
             outside_summary(&classes, mesh.mesh.positions.len())
         );
     }
 
     let plan = crate::coords::harmonic::plan(&cage, args.grid, mesh.mesh.positions.len())?;
-    println!(
+    say!(
         "harmonic at --grid {}: {} × {} × {} nodes of {:.6}, {} inside the cage, {} multigrid levels, about {} MiB",
         plan.grid,
         plan.dims[0],
@@ -265,7 +265,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
     let negative_rows = (0..weights.rows)
         .filter(|&r| weights.row(r).iter().any(|&w| w < 0.0))
         .count();
-    println!(
+    say!(
         "MVC on {} sampled inside vertices: {:.1}% have a negative weight, most negative {:.4}",
         weights.rows,
         100.0 * negative_rows as f64 / weights.rows.max(1) as f64,
@@ -287,7 +287,7 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
     };
     geometry::write_obj(&args.mesh, &points)?;
     geometry::write_obj(&args.cage, &cage)?;
-    println!(
+    say!(
         "{}: {} mesh vertices in a {}-vertex cage",
         scene.name,
         points.positions.len(),
@@ -297,6 +297,6 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
 }
 
 pub(super) fn info() -> Result<()> {
-    print!("{}", crate::gpu::adapters_report());
+    say!("{}", crate::gpu::adapters_report().trim_end());
     Ok(())
 }

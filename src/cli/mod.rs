@@ -5,8 +5,30 @@
 //! Outputs are written through a temporary file, so an existing output survives a
 //! failure.
 
+/// `println!` that returns a closed or failing stdout as an error (`pmvc check |
+/// head -1`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::OutputError)?
+    }};
+}
+
+/// `eprintln!` that never panics: with stderr closed there is nowhere to report.
+macro_rules! warn_line {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod commands;
+
+/// Standard output could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write to standard output: {0}")]
+pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -303,8 +325,16 @@ pub fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader went away (`| head`): what it wanted it has, so end quietly.
+        Err(error)
+            if error
+                .downcast_ref::<OutputError>()
+                .is_some_and(|e| e.0.kind() == std::io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(error) => {
-            eprintln!("pmvc: error: {error:#}");
+            warn_line!("pmvc: error: {error:#}");
             ExitCode::FAILURE
         }
     }
