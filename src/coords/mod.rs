@@ -14,6 +14,7 @@
 
 pub mod cubemap;
 pub mod family;
+pub mod green;
 pub mod mvc;
 pub mod pmvc;
 pub mod quality;
