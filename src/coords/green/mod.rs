@@ -98,18 +98,22 @@ impl GreenCage {
         if !x.is_finite() {
             return Err(GreenError::NonFinitePoint { index: 0 });
         }
-        if let Some((direction, weight_per_face, only)) = self.surface_push_at(x) {
-            self.closed_form(x + self.surface_push * direction, phi_out, psi_out);
-            // x = pushed − push·direction, and −direction is Σ nⱼ / |Σ nⱼ| over the
-            // touching triangles: add the push back along their normals.
-            for t in self.touching(x, only) {
-                psi_out[t] += self.surface_push * weight_per_face;
+        let mut shares = Vec::new();
+        let Some(direction) = self.surface_push_at(x, &mut shares) else {
+            let winding = self.closed_form(x, phi_out, psi_out);
+            if winding < 0.5 {
+                self.continue_outside(x, phi_out, psi_out);
             }
             return Ok(());
+        };
+        let pushed = x + self.surface_push * direction;
+        if self.closed_form(pushed, phi_out, psi_out) < 0.5 {
+            // A sliver of the cage thinner than the push: still exact at rest.
+            self.continue_outside(pushed, phi_out, psi_out);
         }
-        let winding = self.closed_form(x, phi_out, psi_out);
-        if winding < 0.5 {
-            self.continue_outside(x, phi_out, psi_out);
+        // x = pushed − push · direction = pushed + push · Σ shareⱼ nⱼ.
+        for (t, share) in shares {
+            psi_out[t] += self.surface_push * share;
         }
         Ok(())
     }
@@ -146,60 +150,75 @@ impl GreenCage {
         solid_angle / (4.0 * PI)
     }
 
-    fn is_touching(&self, t: usize, x: DVec3) -> bool {
-        let frame = &self.frames[t];
-        if frame.height_of(x).abs() > self.surface_tolerance {
-            return false;
+    /// For a point on the surface: the inward direction to evaluate along, and each
+    /// touching triangle's share of the push, `(triangle, share)` with
+    /// `Σ share · nⱼ = −direction`. The direction is the angle-weighted normal
+    /// (Bærentzen and Aanæs), which points into the cage at faces, edges and
+    /// vertices alike. `None` off the surface.
+    fn surface_push_at(&self, x: DVec3, shares: &mut Vec<(usize, f64)>) -> Option<DVec3> {
+        shares.clear();
+        let mut weighted_normal = DVec3::ZERO;
+        for (t, frame) in self.frames.iter().enumerate() {
+            if let Some(angle) = frame.angle_at(x, self.surface_tolerance) {
+                shares.push((t, angle));
+                weighted_normal += angle * frame.normal;
+            }
         }
-        let [a, b, c] = frame.corners;
-        closest_point_on_triangle(x, a, b, c).0.distance(x) <= self.surface_tolerance
-    }
-
-    /// The triangles `x` lies on: all of them, or only `only` when their normals
-    /// cancel (two sheets of the cage meeting at x).
-    fn touching(&self, x: DVec3, only: Option<usize>) -> impl Iterator<Item = usize> + '_ {
-        (0..self.frames.len())
-            .filter(move |&t| only.is_none_or(|only| only == t) && self.is_touching(t, x))
-    }
-
-    /// For a point on the surface: the inward direction to evaluate along (minus
-    /// the normalised sum of the touching triangles' normals), the ψ each touching
-    /// triangle gets per unit of push, and the one triangle to use when the normals
-    /// cancel. `None` off the surface.
-    fn surface_push_at(&self, x: DVec3) -> Option<(DVec3, f64, Option<usize>)> {
-        let mut first = None;
-        let mut normal_sum = DVec3::ZERO;
-        for t in self.touching(x, None) {
-            first.get_or_insert(t);
-            normal_sum += self.frames[t].normal;
+        let length = weighted_normal.length();
+        if shares.is_empty() {
+            return None;
         }
-        let first = first?;
-        let length = normal_sum.length();
-        if length > 1e-3 {
-            Some((-normal_sum / length, 1.0 / length, None))
-        } else {
-            Some((-self.frames[first].normal, 1.0, Some(first)))
+        if length <= 1e-3 {
+            // Two sheets of the cage meet at x with opposite normals: push off one.
+            shares.truncate(1);
+            shares[0].1 = 1.0;
+            return Some(-self.frames[shares[0].0].normal);
         }
+        for (_, share) in shares.iter_mut() {
+            *share /= length;
+        }
+        Some(-weighted_normal / length)
     }
 
     /// The paper's exterior extension: crossing triangle j outward, φ of its corners
     /// jumps by the hat functions at x and ψⱼ's normal derivative by one; adding
-    /// both back continues the inside coordinates analytically through j. Here j is
-    /// the triangle nearest to x.
+    /// both back continues the inside coordinates analytically through j.
+    ///
+    /// j is the nearest triangle whose outer prism holds x (so the added hat values
+    /// lie in [0, 1]). Where no prism does (beyond an edge or a corner), j is the
+    /// nearest triangle, and of the triangles sharing that nearest edge or corner
+    /// the one with the smallest hat values at x (a sliver's would be large and lose
+    /// precision in f32 weights).
     fn continue_outside(&self, x: DVec3, phi_out: &mut [f64], psi_out: &mut [f64]) {
-        let nearest = self
-            .frames
-            .iter()
-            .enumerate()
-            .map(|(t, frame)| {
-                let [a, b, c] = frame.corners;
-                (
-                    t,
-                    closest_point_on_triangle(x, a, b, c).0.distance_squared(x),
-                )
+        let frames = || self.frames.iter().enumerate();
+        let in_prism = frames()
+            .filter_map(|(t, frame)| {
+                let (barycentric, height) = frame.affine_frame(x);
+                (height >= 0.0 && barycentric.iter().all(|&b| b >= 0.0)).then_some((t, height))
             })
-            .min_by(|(_, d0), (_, d1)| d0.total_cmp(d1));
-        let Some((t, _)) = nearest else {
+            .min_by(|(_, h0), (_, h1)| h0.total_cmp(h1));
+        let chosen = in_prism.map(|(t, _)| t).or_else(|| {
+            let distances: Vec<f64> = self
+                .frames
+                .iter()
+                .map(|frame| {
+                    let [a, b, c] = frame.corners;
+                    closest_point_on_triangle(x, a, b, c).0.distance(x)
+                })
+                .collect();
+            let nearest = distances.iter().copied().fold(f64::INFINITY, f64::min);
+            let tie = nearest + self.surface_tolerance;
+            let largest_hat = |t: usize| {
+                let (barycentric, _) = self.frames[t].affine_frame(x);
+                barycentric.iter().fold(0.0f64, |m, b| m.max(b.abs()))
+            };
+            (0..self.frames.len())
+                .filter(|&t| distances[t] <= tie)
+                .map(|t| (t, largest_hat(t)))
+                .min_by(|(_, m0), (_, m1)| m0.total_cmp(m1))
+                .map(|(t, _)| t)
+        });
+        let Some(t) = chosen else {
             return;
         };
         let (barycentric, height) = self.frames[t].affine_frame(x);

@@ -13,6 +13,7 @@
 //! Unlike the paper's per-corner division by `N·v`, nothing here divides by h, so
 //! points on or near the triangle's plane lose no accuracy.
 
+use crate::geometry::closest_point_on_triangle;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -74,6 +75,39 @@ impl TriangleFrame {
                 / self.doubled_area
         });
         (barycentric, height)
+    }
+
+    /// If `x` is within `tolerance` of the triangle, the angle the triangle spans
+    /// around the closest point: 2π inside it, π on an edge, the corner's angle at a
+    /// corner (the weights of the angle-weighted normal).
+    pub fn angle_at(&self, x: DVec3, tolerance: f64) -> Option<f64> {
+        if self.height_of(x).abs() > tolerance {
+            return None;
+        }
+        let [a, b, c] = self.corners;
+        let (closest, barycentric) = closest_point_on_triangle(x, a, b, c);
+        if closest.distance(x) > tolerance {
+            return None;
+        }
+        // Distance from the closest point to the edge opposite each corner.
+        let near_edge: [bool; 3] = std::array::from_fn(|k| {
+            let opposite = (k + 1) % 3;
+            barycentric[k] * self.doubled_area / self.lengths[opposite] <= tolerance
+        });
+        Some(match near_edge.iter().filter(|&&near| near).count() {
+            0 => 2.0 * PI,
+            1 => PI,
+            _ => {
+                // At the corner both of whose edges are near: the one whose
+                // opposite edge is not.
+                let corner = (0..3).find(|&k| !near_edge[k]).unwrap_or(0);
+                let (to_next, to_previous) = (
+                    self.corners[(corner + 1) % 3] - self.corners[corner],
+                    self.corners[(corner + 2) % 3] - self.corners[corner],
+                );
+                to_next.angle_between(to_previous)
+            }
+        })
     }
 
     /// The triangle's integrals seen from `x`.
@@ -180,10 +214,10 @@ mod tests {
             assert!((on.phi[k] - below.phi[k]).abs() < 1e-7, "{on:?} {below:?}");
         }
         assert!((on.psi - below.psi).abs() < 1e-7);
-        // Half the hat function: the jump of the double layer is split evenly.
+        // The inner limit of the double layer on the triangle: half the hat function.
         let (barycentric, _) = frame.affine_frame(x);
-        for k in 0..3 {
-            assert!((on.phi[k] - 0.5 * barycentric[k]).abs() < 1e-12);
+        for (phi, hat) in on.phi.iter().zip(barycentric) {
+            assert!((phi - 0.5 * hat).abs() < 1e-12);
         }
     }
 
