@@ -138,7 +138,10 @@ mod tests {
     fn published_gc_tri_int_does_not_reproduce_the_rest_pose() {
         let cage = procedural::cube_cage(1.0);
         let x = DVec3::new(0.2, -0.3, 0.1);
-        assert!(reproduction_error(&cage, x, Version::Corrected) < 1e-9);
-        assert!(reproduction_error(&cage, x, Version::Published) > 1e-2);
+        let corrected = reproduction_error(&cage, x, Version::Corrected);
+        let published = reproduction_error(&cage, x, Version::Published);
+        eprintln!("rest error in the cube: corrected {corrected:.1e}, published {published:.1e}");
+        assert!(corrected < 1e-9);
+        assert!(published > 1e-2);
     }
 }
