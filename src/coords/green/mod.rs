@@ -190,8 +190,7 @@ impl GreenCage {
     /// the one with the smallest hat values at x (a sliver's would be large and lose
     /// precision in f32 weights).
     fn continue_outside(&self, x: DVec3, phi_out: &mut [f64], psi_out: &mut [f64]) {
-        let frames = || self.frames.iter().enumerate();
-        let in_prism = frames()
+        let in_prism = (self.frames.iter().enumerate())
             .filter_map(|(t, frame)| {
                 let (barycentric, height) = frame.affine_frame(x);
                 (height >= 0.0 && barycentric.iter().all(|&b| b >= 0.0)).then_some((t, height))
