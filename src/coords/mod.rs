@@ -15,6 +15,7 @@
 
 pub mod cubemap;
 pub mod family;
+pub mod green;
 pub mod harmonic;
 pub mod mvc;
 pub mod npy;
