@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Smoke test of the real editor binary under Xvfb on a software Vulkan driver:
 #  1. `--screenshot` run: the default scene binds and a PNG of the window is saved;
+#     a scripted run with a missing --pose must exit with status 1;
 #  2. an interactive run: xdotool drags across the viewport (orbiting the view, or
 #     moving a handle if one is under the cursor), presses M to switch between MVC
 #     and PMVC, and the screen is captured after each.
@@ -30,6 +31,15 @@ timeout 300 "$PMVC_EDITOR" edit --screenshot "$out/default-scene.png" 2>"$out/sc
 echo "   saved $out/default-scene.png in $(( $(date +%s) - start )) s"
 grep "frame time" "$out/screenshot-run.log" || true
 test -s "$out/default-scene.png"
+
+echo "== a scripted run that fails must say so"
+if timeout 300 "$PMVC_EDITOR" edit --pose "$out/no-such-pose.obj" --screenshot "$out/failed-run.png" \
+    2>"$out/failed-run.log"; then
+  echo "a --screenshot run with a missing --pose exited with status 0" >&2
+  cat "$out/failed-run.log"; exit 1
+fi
+grep -q "no-such-pose.obj" "$out/failed-run.log" || { cat "$out/failed-run.log"; exit 1; }
+echo "   exited non-zero, naming the pose file"
 
 echo "== interactive run with an xdotool drag"
 "$PMVC_EDITOR" edit >"$out/interactive-run.log" 2>&1 &

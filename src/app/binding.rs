@@ -166,13 +166,14 @@ impl EditorApp {
                 return;
             }
             Err(error) => {
-                self.error(error.to_string());
                 if matches!(self.queue.backend(), Backend::Gpu(_)) {
-                    // The CPU path always works; use it from now on.
+                    // The CPU path always works; use it from now on. Not an error of
+                    // the run: the weights still come, from the CPU.
                     self.queue.fall_back_to_cpu();
-                    self.info("retrying the bind on the CPU");
+                    self.info(format!("{error}; retrying the bind on the CPU"));
                     self.queue.request_first(options);
                 } else {
+                    self.error(error.to_string());
                     // Views must not ask again for a bind that fails on the CPU.
                     self.binding_paused = true;
                     self.queue.launch_next();

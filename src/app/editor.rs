@@ -222,6 +222,9 @@ impl EditorApp {
     pub(super) fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
         log::warn!("{text}");
+        if let Some(screenshot) = &self.screenshot {
+            screenshot.record_failure(&text);
+        }
         self.notices.error(text);
     }
 

@@ -66,10 +66,14 @@ pub enum BindOn {
     Gpu,
 }
 
-/// The editor window could not run.
+/// The editor could not run, or a scripted run (`--screenshot`) reported errors.
 #[derive(Debug, thiserror::Error)]
-#[error("the editor window failed: {0}")]
-pub struct EditorError(String);
+pub enum EditorError {
+    #[error("the editor window failed: {0}")]
+    Window(String),
+    #[error("--screenshot: {} error(s) in the run: {}", .0.len(), .0.join("; "))]
+    ScriptedRun(Vec<String>),
+}
 
 /// Open the editor window and run until it is closed.
 pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
@@ -93,10 +97,24 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
             ..Default::default()
         });
     }
+    let failures: std::sync::Arc<std::sync::Mutex<Vec<String>>> = Default::default();
+    let failures_of_run = std::sync::Arc::clone(&failures);
     eframe::run_native(
         "pmvc editor",
         native_options,
-        Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, options)))),
+        Box::new(move |cc| {
+            let mut app = EditorApp::new(cc, options);
+            if let Some(screenshot) = app.screenshot.as_mut() {
+                screenshot.share_failures(failures_of_run);
+            }
+            Ok(Box::new(app))
+        }),
     )
-    .map_err(|error| EditorError(error.to_string()))
+    .map_err(|error| EditorError::Window(error.to_string()))?;
+    let failures = failures.lock().map(|list| list.clone()).unwrap_or_default();
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(EditorError::ScriptedRun(failures))
+    }
 }

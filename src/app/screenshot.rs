@@ -1,10 +1,11 @@
 //! `--screenshot`: wait for the binds, let a few frames settle, capture the
-//! window as PNG, quit.
+//! window as PNG, quit. Every error the run reports is also kept here, so that a
+//! script learns of it: the command then exits with status 1.
 
 use super::editor::EditorApp;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// Frames drawn after the bind before `--screenshot` captures.
@@ -15,6 +16,8 @@ pub struct ScreenshotState {
     frames_after_bind: u32,
     requested: bool,
     saved: Arc<AtomicBool>,
+    /// What failed during the run, in order; read by `run_editor` after it ends.
+    failures: Arc<Mutex<Vec<String>>>,
 }
 
 impl ScreenshotState {
@@ -24,6 +27,26 @@ impl ScreenshotState {
             frames_after_bind: 0,
             requested: false,
             saved: Arc::new(AtomicBool::new(false)),
+            failures: Arc::default(),
+        }
+    }
+
+    /// The failures of this run, shared with whoever waits for it to end.
+    pub fn failures(&self) -> Arc<Mutex<Vec<String>>> {
+        Arc::clone(&self.failures)
+    }
+
+    /// Record into `shared` from now on, with what was recorded so far.
+    pub fn share_failures(&mut self, shared: Arc<Mutex<Vec<String>>>) {
+        if let (Ok(recorded), Ok(mut list)) = (self.failures.lock(), shared.lock()) {
+            list.extend(recorded.iter().cloned());
+        }
+        self.failures = shared;
+    }
+
+    pub fn record_failure(&self, text: &str) {
+        if let Ok(mut failures) = self.failures.lock() {
+            failures.push(text.to_owned());
         }
     }
 }
@@ -58,10 +81,15 @@ impl EditorApp {
             state.requested = true;
             let path = state.path.clone();
             let saved = Arc::clone(&state.saved);
+            let failures = state.failures();
             let repaint = ctx.clone();
             ctx.request_screenshot(move |image| {
                 if let Err(error) = save_png(&path, &image) {
-                    eprintln!("pmvc editor: cannot save {}: {error}", path.display());
+                    let text = format!("cannot save {}: {error}", path.display());
+                    eprintln!("pmvc editor: {text}");
+                    if let Ok(mut failures) = failures.lock() {
+                        failures.push(text);
+                    }
                 }
                 saved.store(true, Ordering::Relaxed);
                 repaint.request_repaint();
