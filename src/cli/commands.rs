@@ -35,9 +35,10 @@ pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> 
             );
         }
         warn_line!(
-            "pmvc: {}: warning: {summary} of {}; they get MVC weights, which are finite, reproduce the rest pose and meet the inside coordinates continuously on the cage",
+            "pmvc: {}: warning: {summary} of {}; they get MVC weights (beyond {} cage diagonals, MVC's affine extension), which sum to one, reproduce their points at any distance and meet the inside coordinates continuously on the cage",
             input.mesh.display(),
-            input.cage.display()
+            input.cage.display(),
+            crate::coords::mvc::FAR_FIELD_DIAGONALS
         );
     }
     Ok(BoundInput {
@@ -171,7 +172,13 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         }
         None => compute_weights(&input, &args.method)?,
     };
-    let deformed: Vec<DVec3> = weights.apply(&pose.mesh.positions);
+    // Displacement form: exact at rest for any weights, and no cancellation of
+    // large absolute positions far from the origin.
+    let moves = args
+        .method
+        .method
+        .column_displacements(&input.cage, &pose.mesh.positions);
+    let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
     geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     Ok(())
 }

@@ -75,8 +75,8 @@ pub struct FamilySpec {
 /// PMVC's default cube-map resolution (texels along one face edge).
 pub const DEFAULT_RESOLUTION: u32 = 32;
 
-const OUTSIDE_BY_MVC: &str =
-    "vertices outside the cage get MVC weights, which reproduce the rest pose exactly";
+const OUTSIDE_BY_MVC: &str = "vertices outside the cage get MVC weights (their affine \
+     extension beyond 10 cage diagonals), which sum to one and reproduce their points";
 
 const MVC: FamilySpec = FamilySpec {
     id: "mvc",

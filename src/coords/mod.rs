@@ -11,7 +11,9 @@
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
 //!   reproduces the rest pose by linear precision, and meets every family
 //!   continuously on the surface because all reduce to the triangle's barycentrics
-//!   there.
+//!   there. Beyond [`mvc::FAR_FIELD_DIAGONALS`] cage diagonals, where the closed
+//!   form loses digits, MVC are extended affinely (see [`mvc`]), which keeps
+//!   those properties exactly at every distance.
 
 pub mod cubemap;
 pub mod family;

@@ -196,6 +196,27 @@ pub fn write_deformed_mesh(
 }
 
 fn write_vertex(out: &mut dyn Write, p: DVec3) -> std::io::Result<()> {
-    // f32 precision matches the f32 weights and keeps files compact.
-    writeln!(out, "v {} {} {}", p.x as f32, p.y as f32, p.z as f32)
+    writeln!(
+        out,
+        "v {} {} {}",
+        RoundTrip(p.x),
+        RoundTrip(p.y),
+        RoundTrip(p.z)
+    )
+}
+
+/// The shortest decimal that reads back as the same f64 (0.1 stays "0.1"), with
+/// an exponent for very large or small magnitudes so that no value takes
+/// hundreds of digits.
+struct RoundTrip(f64);
+
+impl std::fmt::Display for RoundTrip {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let magnitude = self.0.abs();
+        if magnitude != 0.0 && !(1e-5..1e16).contains(&magnitude) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
 }
