@@ -24,6 +24,7 @@ macro_rules! warn_line {
 
 mod bench;
 mod commands;
+mod environment;
 
 /// Standard output could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -297,6 +298,7 @@ pub struct GenerateArgs {
 
 /// Entry point of the binary: parse, run, report.
 pub fn main() -> ExitCode {
+    environment::ensure_runtime_dir();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         // Help and version go to stdout and succeed; a bad argument is bad input
