@@ -127,7 +127,7 @@ impl EditorApp {
     }
 
     /// Make the parameter controls show what the weights in use were bound with.
-    fn sync_parameters_with_weights(&mut self) {
+    pub(super) fn sync_parameters_with_weights(&mut self) {
         if let Some(set) = self.document.bound(self.active_method()) {
             if let Some((spec, value)) = set.options.parameter() {
                 self.bind_options.set(spec.key, value);
@@ -224,7 +224,7 @@ impl EditorApp {
             subdivided.pose,
         );
         let camera = self.viewport.cameras();
-        self.install_document(document);
+        self.replace_document(document, "subdivide the cage");
         self.viewport.set_cameras(camera);
         self.info(format!(
             "subdivided the cage: {before} -> {after} vertices; rebinding"

@@ -57,6 +57,8 @@ pub struct Document {
     changes: Changes,
     /// Bumped by every pose change, so caches of deformed positions can tell.
     pose_revision: u64,
+    /// Pose edits recorded for undo (not undo or redo themselves).
+    edits: u64,
 }
 
 impl Document {
@@ -79,6 +81,7 @@ impl Document {
                 weights: BTreeSet::new(),
             },
             pose_revision: 0,
+            edits: 0,
         }
     }
 
@@ -182,6 +185,28 @@ impl Document {
         ((lo + hi) / 2.0, ((hi - lo).length() / 2.0).max(1e-6))
     }
 
+    /// Pose edits recorded so far; undo and redo do not count.
+    pub fn edits(&self) -> u64 {
+        self.edits
+    }
+
+    /// Drop the poses undo has put aside: a document being replaced keeps only
+    /// what can be undone.
+    pub fn forget_redo(&mut self) {
+        self.history.clear_redo();
+    }
+
+    /// Everything is new to the GPU copy: the document is coming back from the
+    /// scene history.
+    pub fn mark_all_changed(&mut self) {
+        self.changes = Changes {
+            scene: true,
+            pose: true,
+            selection: true,
+            weights: self.weight_sets.keys().copied().collect(),
+        };
+    }
+
     /// What changed since the last call; the editor applies it to the GPU.
     pub fn take_changes(&mut self) -> Changes {
         std::mem::take(&mut self.changes)
@@ -202,6 +227,7 @@ impl Document {
     pub fn edit_pose(&mut self, pose: Vec<DVec3>) {
         if pose.len() == self.pose.len() && pose != self.pose {
             self.history.record(self.pose.clone());
+            self.edits += 1;
             self.pose = pose;
             self.pose_changed();
         }
@@ -212,6 +238,7 @@ impl Document {
     pub fn record_undo_point(&mut self, before: Vec<DVec3>) {
         if before != self.pose {
             self.history.record(before);
+            self.edits += 1;
         }
     }
 

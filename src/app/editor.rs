@@ -8,6 +8,7 @@ use super::bind_queue::BindQueue;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::readouts::ReadoutCache;
+use super::scene_history::SceneHistory;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::notices::Notices;
@@ -15,6 +16,7 @@ use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method};
+use crate::geometry::TriMesh;
 use crate::gpu::{Backend, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
 use crate::render::{OrbitCamera, ReadBack, RenderError, SceneUpload, Shading, ViewportRenderer};
@@ -60,6 +62,8 @@ pub struct EditorApp {
     pub(super) hide_timings: bool,
     /// The pose when a drag on a numeric position field began.
     pub(super) numeric_drag_start: Option<Vec<DVec3>>,
+    /// Documents replaced by opening files, switching scenes and cage edits.
+    pub(super) scene_history: SceneHistory,
 }
 
 impl EditorApp {
@@ -123,6 +127,7 @@ impl EditorApp {
             binding_paused: false,
             hide_timings: options.hide_timings,
             numeric_drag_start: None,
+            scene_history: SceneHistory::default(),
         };
         if let Some(error) = unsupported {
             app.error(error.to_string());
@@ -150,6 +155,8 @@ impl EditorApp {
                 app.view.heat_vertex
             ));
         }
+        // Opening the files asked for is where editing starts, not an undo step.
+        app.scene_history.clear();
         app.start_bind();
         app
     }
@@ -245,9 +252,22 @@ impl EditorApp {
     // ---- the document and its GPU copy ----------------------------------------
 
     /// Make `document` current: the bind queue and the views start afresh on it,
-    /// and the camera frames it.
+    /// and the camera frames it. Not undoable: for the start-up scene.
     pub(super) fn install_document(&mut self, document: Document) {
         self.document = document;
+        self.document_swapped(true);
+    }
+
+    /// Replace the document by `action` ("open cage.obj"), which undo reverses.
+    pub(super) fn replace_document(&mut self, document: Document, action: impl Into<String>) {
+        let before = std::mem::replace(&mut self.document, document);
+        self.scene_history.record(before, action.into());
+        self.document_swapped(true);
+    }
+
+    /// After the document was swapped: the bind queue and the views start afresh
+    /// on it, and the camera frames it if asked.
+    fn document_swapped(&mut self, frame: bool) {
         self.queue.set_scene(
             self.document.mesh().positions.as_slice().into(),
             Arc::clone(self.document.cage()),
@@ -257,8 +277,38 @@ impl EditorApp {
         let cage_vertices = self.document.pose().len();
         self.view.heat_vertex = self.view.heat_vertex.min(cage_vertices.saturating_sub(1));
         self.binding_paused = false;
-        self.frame_scene();
+        if frame {
+            self.frame_scene();
+        }
         self.sync_gpu();
+    }
+
+    /// Show a document back from the scene history with the weights it had,
+    /// without binding again.
+    fn reinstate_document(&mut self, mesh_before: &Arc<TriMesh>) {
+        self.document.mark_all_changed();
+        let same_mesh = Arc::ptr_eq(mesh_before, self.document.mesh());
+        self.document_swapped(!same_mesh);
+        let rest = to_f32(&self.document.mesh().positions);
+        let outside = self.document.outside().to_vec();
+        let sets: Vec<_> = Method::ALL
+            .iter()
+            .filter_map(|&m| {
+                self.document
+                    .bound(m)
+                    .map(|set| (m, Arc::clone(&set.weights)))
+            })
+            .collect();
+        let uploaded = self.with_renderer(|renderer, device, queue| {
+            renderer.set_outside(queue, &rest, &outside);
+            sets.iter().try_for_each(|(method, weights)| {
+                renderer.set_weights(device, *method, Some(weights), None)
+            })
+        });
+        if let Some(Err(error)) = uploaded {
+            self.error(error.to_string());
+        }
+        self.sync_parameters_with_weights();
     }
 
     /// Apply what changed in the document to the GPU copy and the caches.
@@ -306,12 +356,50 @@ impl EditorApp {
 
     // ---- pose editing -----------------------------------------------------------
 
+    /// Undo the last pose edit, or else the last action that replaced the
+    /// document (opening a file, switching scenes, subdividing, resting the cage).
     pub fn undo(&mut self) {
-        self.document.undo();
+        if self.document.history().can_undo() {
+            self.document.undo();
+            return;
+        }
+        let mesh_before = Arc::clone(self.document.mesh());
+        if let Some(action) = self.scene_history.undo(&mut self.document) {
+            self.reinstate_document(&mesh_before);
+            self.info(format!("undid: {action}"));
+        }
     }
 
+    /// Redo what undo reversed: the replacement of the document first if that
+    /// was undone last, else a pose edit.
     pub fn redo(&mut self) {
-        self.document.redo();
+        if self.document.history().can_redo() {
+            self.document.redo();
+            return;
+        }
+        let mesh_before = Arc::clone(self.document.mesh());
+        if let Some(action) = self.scene_history.redo(&mut self.document) {
+            self.reinstate_document(&mesh_before);
+            self.info(format!("redid: {action}"));
+        }
+    }
+
+    /// What Undo would reverse, for its menu entry ("move handles", "open cage.obj").
+    pub fn undo_label(&self) -> Option<String> {
+        if self.document.history().can_undo() {
+            return Some("pose edit".into());
+        }
+        self.scene_history.undo_action().map(Into::into)
+    }
+
+    /// What Redo would repeat, for its menu entry.
+    pub fn redo_label(&self) -> Option<String> {
+        if self.document.history().can_redo() {
+            return Some("pose edit".into());
+        }
+        self.scene_history
+            .redo_action(&self.document)
+            .map(Into::into)
     }
 
     pub fn reset_pose(&mut self) {

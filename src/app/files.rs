@@ -44,7 +44,12 @@ impl EditorApp {
         }
         let document = Document::new(file_title(mesh_path), mesh.mesh.clone(), cage)
             .with_files(Some(mesh), Some(cage_path.to_owned()));
-        self.install_document(document);
+        let action = format!(
+            "open {} and {}",
+            file_title(mesh_path),
+            file_title(cage_path)
+        );
+        self.replace_document(document, action);
         self.remember(FileRole::Mesh, mesh_path);
         self.remember(FileRole::Cage, cage_path);
         true
@@ -80,7 +85,11 @@ impl EditorApp {
                 }
             },
         };
-        self.install_document(document);
+        let role_name = match role {
+            FileRole::Mesh => "mesh",
+            FileRole::Cage => "cage",
+        };
+        self.replace_document(document, format!("open {role_name} {}", file_title(path)));
         self.remember(role, path);
         self.info(format!("opened {}", path.display()));
         self.start_bind();
@@ -91,7 +100,8 @@ impl EditorApp {
     pub fn open_bundled(&mut self, bundled: BundledScene) {
         match bundled.build() {
             Ok((mesh, cage)) => {
-                self.install_document(Document::new(bundled.title(), mesh, cage));
+                let action = format!("open the {} scene", bundled.title());
+                self.replace_document(Document::new(bundled.title(), mesh, cage), action);
                 self.start_bind();
             }
             Err(error) => self.error(error.to_string()),
@@ -154,17 +164,35 @@ impl EditorApp {
         }
     }
 
-    /// Rest the cage in its current pose and rebind.
-    pub(super) fn pose_as_rest(&mut self) {
+    /// Make the current pose the rest shape: the mesh takes the shape the active
+    /// method gives it, the cage rests in its pose, and both are bound afresh.
+    /// Undo returns to the previous rest shape and its weights.
+    pub fn pose_as_rest(&mut self) {
+        let method = self.active_method();
+        if self.document.bound(method).is_none() {
+            self.error(format!(
+                "cannot use the pose as rest shape before {method} is bound: the mesh would not follow the cage"
+            ));
+            return;
+        }
+        let mesh = TriMesh {
+            positions: self.document.deformed_positions(method),
+            ..(**self.document.mesh()).clone()
+        };
         let cage = self
             .document
             .cage()
             .with_positions(self.document.pose().to_vec());
-        let rest = cage.positions().to_vec();
-        let document =
-            self.document
-                .with_cage(cage, self.document.cage_path().map(Into::into), rest);
-        self.install_document(document);
+        let document = Document::new(self.document.title(), mesh, cage).with_files(
+            self.document.mesh_file().cloned(),
+            self.document.cage_path().map(Into::into),
+        );
+        let camera = self.viewport.cameras();
+        self.replace_document(document, "use pose as rest shape");
+        self.viewport.set_cameras(camera);
+        self.info(format!(
+            "the mesh now rests as {method} deformed it, in the posed cage; rebinding"
+        ));
         self.start_bind();
     }
 

@@ -51,6 +51,11 @@ impl PoseHistory {
         self.undo.clear();
         self.redo.clear();
     }
+
+    /// Forget the poses undo has put aside, as a new edit would.
+    pub fn clear_redo(&mut self) {
+        self.redo.clear();
+    }
 }
 
 #[cfg(test)]

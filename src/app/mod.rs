@@ -20,6 +20,7 @@ pub mod editor;
 mod files;
 pub mod history;
 mod readouts;
+pub mod scene_history;
 pub mod scenes;
 mod screenshot;
 pub mod ui;

@@ -84,16 +84,23 @@ impl EditorApp {
     }
 
     fn edit_menu(&mut self, ui: &mut egui::Ui) {
-        let history = self.document.history();
-        let (can_undo, can_redo) = (history.can_undo(), history.can_redo());
+        let (undo, redo) = (self.undo_label(), self.redo_label());
+        let undo_text = match &undo {
+            Some(action) => format!("Undo {action} (Ctrl+Z)"),
+            None => "Undo (Ctrl+Z)".into(),
+        };
         if ui
-            .add_enabled(can_undo, egui::Button::new("Undo (Ctrl+Z)"))
+            .add_enabled(undo.is_some(), egui::Button::new(undo_text))
             .clicked()
         {
             self.undo();
         }
+        let redo_text = match &redo {
+            Some(action) => format!("Redo {action} (Ctrl+Shift+Z)"),
+            None => "Redo (Ctrl+Shift+Z)".into(),
+        };
         if ui
-            .add_enabled(can_redo, egui::Button::new("Redo (Ctrl+Shift+Z)"))
+            .add_enabled(redo.is_some(), egui::Button::new(redo_text))
             .clicked()
         {
             self.redo();

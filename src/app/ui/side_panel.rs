@@ -146,8 +146,7 @@ impl EditorApp {
                 }
             }
         }
-        let history = self.document.history();
-        let (can_undo, can_redo) = (history.can_undo(), history.can_redo());
+        let (can_undo, can_redo) = (self.undo_label().is_some(), self.redo_label().is_some());
         ui.horizontal(|ui| {
             if ui.button("Reset pose").clicked() {
                 self.reset_pose();
