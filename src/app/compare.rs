@@ -102,8 +102,14 @@ impl MethodSet {
     }
 }
 
+/// The smallest distance, as a fraction of the cage diagonal, the difference
+/// view's automatic scale reaches: a difference of 0.1% is barely a pixel at usual
+/// zooms, and f32 rounding (about 1e-7 of the diagonal) stays white under it,
+/// also on the log scale's three decades.
+pub const DIFFERENCE_FLOOR: f32 = 1e-3;
+
 /// The comparison settings, as the toolbar and `pmvc edit --view …` set them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
     pub layout: Layout,
     pub overlay: Overlay,
@@ -118,6 +124,10 @@ pub struct ViewSettings {
     pub difference: [Method; 2],
     /// In the side-by-side layout, one more view of the difference.
     pub difference_pane: bool,
+    /// The difference view's colour scale ends here (a fraction of the cage
+    /// diagonal) when set; otherwise at the largest distance, but never below
+    /// [`DIFFERENCE_FLOOR`].
+    pub difference_limit: Option<f32>,
     /// All views share one camera.
     pub cameras_locked: bool,
     /// Show the weights under the cursor even on a plainly shaded mesh.
@@ -134,6 +144,7 @@ impl Default for ViewSettings {
             compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
             difference: [Method::Mvc, Method::Pmvc],
             difference_pane: false,
+            difference_limit: None,
             cameras_locked: true,
             hover_in_shaded: false,
         }

@@ -124,7 +124,16 @@ impl EditorApp {
     /// The magnitude at which `colouring`'s colours saturate: the same for every
     /// method in view, so methods are compared on one scale, side by side or when
     /// switching.
-    fn colour_limit(&mut self, colouring: Colouring, pane: Pane) -> f32 {
+    pub(super) fn colour_limit(&mut self, colouring: Colouring, pane: Pane) -> f32 {
+        if colouring == Colouring::MethodDistance {
+            if let Some(fixed) = self.view.difference_limit {
+                return fixed.max(f32::MIN_POSITIVE);
+            }
+        }
+        let floor = match colouring {
+            Colouring::MethodDistance => compare::DIFFERENCE_FLOOR,
+            _ => 0.0,
+        };
         let panes: Vec<Pane> = match colouring {
             Colouring::MethodDistance => vec![pane],
             _ => self
@@ -137,7 +146,7 @@ impl EditorApp {
             .into_iter()
             .filter_map(|pane| self.value_range(colouring, pane))
             .map(|range| range.magnitude())
-            .fold(0.0f32, f32::max);
+            .fold(floor, f32::max);
         if limit > 0.0 {
             limit
         } else {

@@ -76,27 +76,49 @@ pub fn draw_colour_bar(
         font.clone(),
         text,
     );
+    // Distances read as a share of the cage diagonal; the log scale's left end
+    // is where it stops resolving, not zero.
+    let number = |value: f32| if signed { short(value) } else { percent(value) };
+    let left = match (signed, shading.scale) {
+        (_, Scale::Linear) => number(low),
+        (true, Scale::LogMagnitude) => format!("−{}", short(limit)),
+        (false, Scale::LogMagnitude) => {
+            format!("≤ {}", number(limit * 10f32.powf(-colormap::LOG_DECADES)))
+        }
+    };
     painter.text(
         bar.center_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::CENTER_TOP,
-        format!("min {} · max {}", short(range.min), short(range.max)),
+        format!("min {} · max {}", number(range.min), number(range.max)),
         font.clone(),
         text,
     );
     painter.text(
         bar.left_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::LEFT_TOP,
-        short(low),
+        left,
         font.clone(),
         text,
     );
     painter.text(
         bar.right_bottom() + egui::vec2(0.0, 2.0),
         egui::Align2::RIGHT_TOP,
-        short(limit),
+        number(limit),
         font,
         text,
     );
+}
+
+/// A fraction as a percentage with three significant digits ("0.100%").
+pub fn percent(fraction: f32) -> String {
+    let value = fraction * 100.0;
+    if value == 0.0 {
+        "0%".into()
+    } else if value.abs() >= 0.01 {
+        format!("{value:.3}%")
+    } else {
+        format!("{value:.2e}%")
+    }
 }
 
 /// A colour-bar number: three decimals, or three significant digits when small.

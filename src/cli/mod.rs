@@ -208,6 +208,11 @@ pub struct EditArgs {
     /// Show heatmap magnitudes on a log scale (three decades).
     #[arg(long)]
     pub log_scale: bool,
+    /// End the difference view's colour scale at this distance, in % of the cage
+    /// diagonal, instead of at the largest distance (at least 0.1%): pictures of
+    /// several runs then share one scale.
+    #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
+    pub difference_limit: Option<f32>,
 }
 
 /// What the editor's viewport shows.
@@ -220,6 +225,17 @@ pub enum ViewArg {
     /// The distance between two methods' deformations per mesh vertex, relative
     /// to the cage size.
     Difference,
+}
+
+/// A percentage in (0, 100], with or without the % sign.
+fn parse_percent(text: &str) -> Result<f32, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f32>() {
+        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value),
+        _ => Err(format!(
+            "'{text}' is not a percentage between 0 and 100 (e.g. 0.5 or 0.5%)"
+        )),
+    }
 }
 
 fn parse_view(value: &str) -> Result<ViewArg, String> {
@@ -264,6 +280,7 @@ impl EditArgs {
         if self.log_scale {
             view.scale = crate::render::colormap::Scale::LogMagnitude;
         }
+        view.difference_limit = self.difference_limit.map(|percent| percent / 100.0);
         crate::app::EditorOptions {
             mesh: self.mesh,
             cage: self.cage,
@@ -380,6 +397,13 @@ mod tests {
             edit_options(&["--view", "difference"]).view.layout,
             Layout::Difference
         );
+        let fixed = edit_options(&["--view", "difference", "--difference-limit", "0.5%"]);
+        assert_eq!(fixed.view.difference_limit, Some(0.005));
+        assert_eq!(edit_options(&[]).view.difference_limit, None);
+        for bad in ["0", "-1", "101", "lots"] {
+            let parsed = Cli::try_parse_from(["pmvc", "edit", "--difference-limit", bad]);
+            assert!(parsed.is_err(), "--difference-limit {bad} was accepted");
+        }
     }
 
     #[test]

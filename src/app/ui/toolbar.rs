@@ -1,10 +1,11 @@
 //! The comparison controls above the viewport: the method shown, the layout,
 //! which methods are compared, and the colouring.
 
-use crate::app::compare::{Layout, Overlay};
+use crate::app::compare::{Layout, Overlay, Pane};
 use crate::app::editor::EditorApp;
 use crate::coords::Method;
 use crate::render::colormap::Scale;
+use crate::render::Colouring;
 
 impl EditorApp {
     pub(in crate::app) fn toolbar(&mut self, ui: &mut egui::Ui) {
@@ -60,6 +61,9 @@ impl EditorApp {
             });
         }
         ui.checkbox(&mut self.view.difference_pane, "+ difference");
+        if self.view.difference_pane {
+            self.difference_scale_controls(ui);
+        }
         let mut locked = self.view.cameras_locked;
         if ui.checkbox(&mut locked, "Lock cameras").changed() {
             self.set_cameras_locked(locked);
@@ -78,6 +82,38 @@ impl EditorApp {
                     }
                 });
             self.view.difference[index] = chosen;
+        }
+        self.difference_scale_controls(ui);
+    }
+
+    /// Auto (the largest distance, at least `compare::DIFFERENCE_FLOOR`) or a fixed end
+    /// of the difference's colour scale, shared by every difference view.
+    fn difference_scale_controls(&mut self, ui: &mut egui::Ui) {
+        let mut fixed = self.view.difference_limit.is_some();
+        let toggle = ui.checkbox(&mut fixed, "fixed scale").on_hover_text(
+            "Keep the difference's colour scale at one distance (in % of the cage diagonal) \
+             across poses and views; pmvc edit --difference-limit sets it for a run",
+        );
+        if toggle.changed() {
+            self.view.difference_limit = if fixed {
+                let [against, shown] = self.view.difference;
+                Some(self.colour_limit(
+                    Colouring::MethodDistance,
+                    Pane::Difference { against, shown },
+                ))
+            } else {
+                None
+            };
+        }
+        if let Some(limit) = self.view.difference_limit {
+            let mut percent = limit * 100.0;
+            ui.add(
+                egui::DragValue::new(&mut percent)
+                    .speed(0.01)
+                    .range(1e-4..=100.0)
+                    .suffix("%"),
+            );
+            self.view.difference_limit = Some(percent / 100.0);
         }
     }
 }

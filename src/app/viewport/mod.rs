@@ -287,7 +287,7 @@ impl EditorApp {
                 None => format!("{} · not bound", method.name()),
             },
             Pane::Difference { against, shown } => {
-                format!("{against} vs {shown}: distance / cage size")
+                format!("{against} vs {shown}: distance / cage diagonal")
             }
         }
     }
@@ -297,8 +297,15 @@ impl EditorApp {
         match (self.view.colouring(kind), kind) {
             (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
             (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
-            (Colouring::MethodDistance, Pane::Difference { against, shown }) => {
-                format!("|p'({against}) - p'({shown})| / cage size")
+            (Colouring::MethodDistance, Pane::Difference { .. }) => {
+                // The pane's title names the methods; the bar says how it scales.
+                match self.view.difference_limit {
+                    Some(_) => "distance / cage diagonal · fixed scale".to_owned(),
+                    None => format!(
+                        "distance / cage diagonal · auto, ≥ {}",
+                        super::widgets::percent(super::compare::DIFFERENCE_FLOOR)
+                    ),
+                }
             }
             _ => String::new(),
         }

@@ -1,0 +1,97 @@
+//! Views that must not mislead: the difference view's colour scale has a floor,
+//! so rounding noise at rest is not painted as signal, and it can be fixed.
+
+mod common;
+
+use common::editor::*;
+use egui_kittest::Harness;
+use pmvc::app::compare::{Layout, Pane, ViewSettings, DIFFERENCE_FLOOR};
+use pmvc::app::{EditorApp, EditorOptions};
+use pmvc::coords::Method;
+use std::path::PathBuf;
+
+const DIFFERENCE: Pane = Pane::Difference {
+    against: Method::Mvc,
+    shown: Method::Pmvc,
+};
+
+fn difference_editor(
+    pose: bool,
+    difference_limit: Option<f32>,
+) -> Option<Harness<'static, EditorApp>> {
+    let pose = pose.then(|| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj")
+    });
+    let mut harness = editor_with(EditorOptions {
+        pose,
+        view: ViewSettings {
+            layout: Layout::Difference,
+            difference_limit,
+            ..Default::default()
+        },
+        ..Default::default()
+    })?;
+    run_until_bound(&mut harness);
+    harness.run_steps(3);
+    Some(harness)
+}
+
+/// Viewport samples (above the colour bar) whose colour is clearly red.
+fn red_samples(harness: &mut Harness<'static, EditorApp>) -> usize {
+    let rect = harness.state().pane_rects()[0].1;
+    let image = harness.render().expect("the harness renders");
+    let mut red = 0;
+    let bottom = (rect.top() + rect.height() * 0.75) as u32;
+    for y in (rect.top() as u32..bottom).step_by(3) {
+        for x in (rect.left() as u32..rect.right() as u32).step_by(3) {
+            let [r, g, b, _] = image.get_pixel(x, y).0.map(i32::from);
+            if r > g + 60 && r > b + 60 {
+                red += 1;
+            }
+        }
+    }
+    red
+}
+
+#[test]
+fn the_difference_view_at_rest_is_white_and_its_scale_stops_at_the_floor() {
+    let Some(mut harness) = difference_editor(false, None) else {
+        return;
+    };
+    let app = harness.state_mut();
+    let shading = app.shading_of(DIFFERENCE);
+    let values = app.read_back(&shading).unwrap().unwrap().values;
+    let largest = values.iter().copied().fold(0.0, f32::max);
+    // At rest MVC and PMVC differ only by rounding.
+    assert!(largest < 1e-5, "largest distance at rest {largest}");
+    assert_eq!(shading.colour_limit, DIFFERENCE_FLOOR);
+    assert_eq!(
+        red_samples(&mut harness),
+        0,
+        "rounding noise drawn as signal"
+    );
+
+    // Posed, the fingers differ by more than the floor and the view shows it.
+    let Some(mut posed) = difference_editor(true, None) else {
+        return;
+    };
+    let shading = posed.state_mut().shading_of(DIFFERENCE);
+    assert!(shading.colour_limit > DIFFERENCE_FLOOR);
+    assert!(red_samples(&mut posed) > 20);
+}
+
+#[test]
+fn a_fixed_difference_scale_holds_across_poses() {
+    let Some(mut harness) = difference_editor(true, Some(0.25)) else {
+        return;
+    };
+    let shading = harness.state_mut().shading_of(DIFFERENCE);
+    assert_eq!(shading.colour_limit, 0.25);
+    harness.state_mut().reset_pose();
+    harness.run_steps(2);
+    let shading = harness.state_mut().shading_of(DIFFERENCE);
+    assert_eq!(
+        shading.colour_limit, 0.25,
+        "the scale does not follow the pose"
+    );
+}
