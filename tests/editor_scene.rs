@@ -85,7 +85,12 @@ fn on_the_default_scene_mvc_is_negative_and_pmvc_is_not() {
             &BindProgress::default(),
         )
         .expect("not cancelled");
-        WeightQuality::measure(&weights, &mesh.positions, cage.positions())
+        WeightQuality::measure(
+            &weights,
+            &mesh.positions,
+            cage.positions(),
+            &classes.outside,
+        )
     };
     let mvc = quality(Method::Mvc);
     let pmvc = quality(Method::Pmvc);

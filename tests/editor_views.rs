@@ -95,3 +95,64 @@ fn a_fixed_difference_scale_holds_across_poses() {
         "the scale does not follow the pose"
     );
 }
+
+/// A vertex outside the cage (in a gap between two fingers) gets MVC weights
+/// with a negative one under every family; the quality table counts it apart, so
+/// PMVC's "inside: vertices with λ < 0" stays 0.
+#[test]
+fn outside_vertices_are_reported_apart_from_the_inside_ones() {
+    use pmvc::app::editor::FileRole;
+    use pmvc::coords::mvc::{mvc_weights, MvcScratch};
+    use pmvc::geometry::{classify_points, PointClass};
+    let Some(mut harness) = editor_with(EditorOptions::default()) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    let cage = harness.state().document().cage().clone();
+    let (lo, hi) = pmvc::geometry::bounds_of(cage.positions());
+    let candidates: Vec<glam::DVec3> = (1..40)
+        .flat_map(|i| (1..10).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            glam::DVec3::new(
+                lo.x + (hi.x - lo.x) * i as f64 / 40.0,
+                lo.y + (hi.y - lo.y) * j as f64 / 10.0,
+                (lo.z + hi.z) / 2.0,
+            )
+        })
+        .collect();
+    let classes = classify_points(&cage, &candidates);
+    let mut row = vec![0.0; cage.vertex_count()];
+    let gap = candidates
+        .iter()
+        .zip(&classes.classes)
+        .filter(|(_, class)| matches!(class, PointClass::Outside))
+        .map(|(p, _)| *p)
+        .find(|&p| {
+            mvc_weights(p, &cage, &mut row, &mut MvcScratch::default());
+            row.iter().any(|&w| w < -1e-3)
+        })
+        .expect("a point between the fingers with a negative MVC weight");
+    let inside = classes
+        .classes
+        .iter()
+        .position(|class| matches!(class, PointClass::Inside))
+        .map(|i| candidates[i])
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = common::write(dir.path(), "two.obj", &common::points_obj(&[inside, gap]));
+    assert!(harness.state_mut().open_file(FileRole::Mesh, &mesh));
+    run_until_bound(&mut harness);
+    let quality = harness
+        .state()
+        .document()
+        .bound(Method::Pmvc)
+        .unwrap()
+        .quality;
+    assert_eq!(quality.outside_vertices, 1, "{quality:?}");
+    assert_eq!(quality.outside_negative_vertices, 1, "{quality:?}");
+    assert_eq!(quality.negative_vertices, 0, "{quality:?}");
+    assert_eq!(quality.negative_share, 0.0);
+    use egui_kittest::kittest::Queryable;
+    harness.get_by_label("outside: with λ < 0 (MVC)");
+    harness.get_by_label("inside: vertices with λ < 0");
+}

@@ -350,8 +350,12 @@ fn run(
                 method: options.method,
                 source: BindError::NothingKept,
             })?;
-            let quality =
-                WeightQuality::measure(&weights, &prepared.points, prepared.cage.positions());
+            let quality = WeightQuality::measure(
+                &weights,
+                &prepared.points,
+                prepared.cage.positions(),
+                &outside,
+            );
             Ok(BindOutcome {
                 quality,
                 weights: Arc::new(weights),

@@ -13,15 +13,27 @@ use rayon::prelude::*;
 pub const NEGATIVE_TOLERANCE: f64 = 1e-7;
 
 /// Quality of one set of weights against the points and cage they were bound for.
+///
+/// Negativity is measured over the vertices inside the cage (and on it), where a
+/// family's promise holds; vertices outside get MVC weights under every family's
+/// outside policy, so their negative weights are reported apart and say nothing
+/// about the family.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WeightQuality {
-    /// Mesh vertices with any weight < -NEGATIVE_TOLERANCE, as a share in [0, 1].
+    /// Inside vertices with any weight < -NEGATIVE_TOLERANCE, as a share of the
+    /// inside vertices, in [0, 1].
     pub negative_share: f64,
-    /// Vertices counted in negative_share.
+    /// Inside vertices counted in negative_share.
     pub negative_vertices: usize,
-    /// The most negative weight of all (0 if none is negative) and where: (row, col).
+    /// The most negative weight of an inside vertex (0 if none is negative) and
+    /// where: (row, col).
     pub most_negative: f64,
     pub most_negative_at: Option<(usize, usize)>,
+    /// Vertices outside the cage, and how many of them have a negative weight.
+    pub outside_vertices: usize,
+    pub outside_negative_vertices: usize,
+    /// The most negative weight of an outside vertex (0 if none is negative).
+    pub outside_most_negative: f64,
     /// max over rows of |Σ_j λ_ij − 1|.
     pub max_partition_error: f64,
     /// max over rows of |Σ_j λ_ij c_j − x_i| divided by the cage's bounding-box diagonal.
@@ -29,11 +41,12 @@ pub struct WeightQuality {
 }
 
 impl WeightQuality {
-    /// `points`: the rows' rest positions; `cage`: the rest cage positions (the columns).
-    /// Every row is measured. `most_negative` is the true minimum even when it is
-    /// within the tolerance, which only decides what is counted. A degenerate cage
-    /// (zero diagonal) gives the linear precision error unscaled.
-    pub fn measure(weights: &Weights, points: &[DVec3], cage: &[DVec3]) -> Self {
+    /// `points`: the rows' rest positions; `cage`: the rest cage positions (the
+    /// columns); `outside`: the rows outside the cage, ascending. Every row is
+    /// measured. `most_negative` is the true minimum even when it is within the
+    /// tolerance, which only decides what is counted. A degenerate cage (zero
+    /// diagonal) gives the linear precision error unscaled.
+    pub fn measure(weights: &Weights, points: &[DVec3], cage: &[DVec3], outside: &[u32]) -> Self {
         assert_eq!(points.len(), weights.rows, "one point per weights row");
         assert_eq!(
             cage.len(),
@@ -45,26 +58,42 @@ impl WeightQuality {
             (hi - lo).length()
         };
         let scale = if diagonal > 0.0 { 1.0 / diagonal } else { 1.0 };
-        let total = (0..weights.rows)
+        let is_outside = |i: usize| outside.binary_search(&(i as u32)).is_ok();
+        let (inside, beyond) = (0..weights.rows)
             .into_par_iter()
-            .map(|i| RowQuality::of(i, weights.row(i), points[i], cage))
-            .reduce(RowQuality::default, RowQuality::merge);
-        let most_negative_at = total.min_at.filter(|_| total.min < 0.0);
+            .map(|i| {
+                let row = RowQuality::of(i, weights.row(i), points[i], cage);
+                if is_outside(i) {
+                    (RowQuality::default(), row)
+                } else {
+                    (row, RowQuality::default())
+                }
+            })
+            .reduce(
+                || (RowQuality::default(), RowQuality::default()),
+                |a, b| (RowQuality::merge(a.0, b.0), RowQuality::merge(a.1, b.1)),
+            );
+        let inside_rows = weights.rows - outside.len().min(weights.rows);
+        let most_negative_at = inside.min_at.filter(|_| inside.min < 0.0);
         Self {
-            negative_share: if weights.rows == 0 {
+            negative_share: if inside_rows == 0 {
                 0.0
             } else {
-                total.negative_rows as f64 / weights.rows as f64
+                inside.negative_rows as f64 / inside_rows as f64
             },
-            negative_vertices: total.negative_rows,
+            negative_vertices: inside.negative_rows,
             most_negative: if most_negative_at.is_some() {
-                total.min
+                inside.min
             } else {
                 0.0
             },
             most_negative_at,
-            max_partition_error: total.partition_error,
-            max_linear_precision_error: total.linear_error * scale,
+            outside_vertices: weights.rows - inside_rows,
+            outside_negative_vertices: beyond.negative_rows,
+            outside_most_negative: beyond.min.min(0.0),
+            max_partition_error: max_keeping_nan(inside.partition_error, beyond.partition_error),
+            max_linear_precision_error: max_keeping_nan(inside.linear_error, beyond.linear_error)
+                * scale,
         }
     }
 }
@@ -223,13 +252,26 @@ mod tests {
             cols: 4,
             values: rows.concat(),
         };
-        let quality = WeightQuality::measure(&weights, &points, &cage);
+        let quality = WeightQuality::measure(&weights, &points, &cage, &[]);
         assert_eq!(quality.negative_vertices, 2);
         assert!(close(quality.negative_share, 0.4));
         assert_eq!(quality.most_negative, -0.5);
         assert_eq!(quality.most_negative_at, Some((1, 1)));
         assert!(close(quality.max_partition_error, 0.25));
         assert!(close(quality.max_linear_precision_error, 0.6 / 3.0));
+
+        // Row 1 outside the cage: its negative weight is reported apart, and the
+        // inside share is of the four inside rows.
+        let split = WeightQuality::measure(&weights, &points, &cage, &[1]);
+        assert_eq!(split.negative_vertices, 1);
+        assert!(close(split.negative_share, 0.25));
+        assert_eq!(split.most_negative, -0.5);
+        assert_eq!(split.most_negative_at, Some((4, 2)));
+        assert_eq!(split.outside_vertices, 1);
+        assert_eq!(split.outside_negative_vertices, 1);
+        assert_eq!(split.outside_most_negative, -0.5);
+        // Partition of unity and linear precision still cover every row.
+        assert!(close(split.max_linear_precision_error, 0.6 / 3.0));
     }
 
     #[test]
@@ -240,9 +282,9 @@ mod tests {
             values: vec![0.5, 0.5],
         };
         let cage = [DVec3::ZERO, DVec3::X];
-        let quality = WeightQuality::measure(&weights, &[DVec3::X * 0.5], &cage);
+        let quality = WeightQuality::measure(&weights, &[DVec3::X * 0.5], &cage, &[]);
         assert_eq!(quality, WeightQuality::default());
-        let empty = WeightQuality::measure(&Weights::zeros(0, 2), &[], &cage);
+        let empty = WeightQuality::measure(&Weights::zeros(0, 2), &[], &cage, &[]);
         assert_eq!(empty, WeightQuality::default());
     }
 
@@ -251,7 +293,7 @@ mod tests {
         let cage = procedural::cube_cage(1.0);
         let points = procedural::points_inside(&cage, 300, 7, 1e-3);
         let quality =
-            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions());
+            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions(), &[]);
         assert_eq!(quality.negative_vertices, 0, "{quality:?}");
         assert_eq!(quality.negative_share, 0.0);
         assert!(quality.max_partition_error < 1e-5, "{quality:?}");
@@ -263,7 +305,7 @@ mod tests {
         let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
         let points = procedural::points_inside(&cage, 300, 5, 1e-3);
         let quality =
-            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions());
+            WeightQuality::measure(&mvc_matrix(&cage, &points), &points, cage.positions(), &[]);
         assert!(quality.negative_share > 0.0, "{quality:?}");
         assert!(quality.most_negative < -NEGATIVE_TOLERANCE);
         let (row, col) = quality.most_negative_at.unwrap();

@@ -8,10 +8,10 @@ use crate::coords::quality::NEGATIVE_TOLERANCE;
 type QualityRow = (&'static str, fn(&WeightSet) -> String);
 
 const ROWS: [QualityRow; 5] = [
-    ("vertices with λ < 0", |set| {
+    ("inside: vertices with λ < 0", |set| {
         format!("{:.1} %", 100.0 * set.quality.negative_share)
     }),
-    ("most negative λ", |set| {
+    ("inside: most negative λ", |set| {
         // Above −NEGATIVE_TOLERANCE a weight is solver rounding, not a negative
         // weight: show it as the 0 the first row counts it as, not as "-0.0000".
         let most_negative = set.quality.most_negative;
@@ -62,11 +62,24 @@ impl EditorApp {
                     }
                     ui.end_row();
                 }
-                ui.label("outside vertices");
+                ui.label("outside vertices").on_hover_text(
+                    "Vertices outside the cage get MVC weights under every method \
+                     (the outside policy), so their negative weights are counted here, \
+                     not above.",
+                );
                 for _ in &methods {
                     ui.label(outside.to_string());
                 }
                 ui.end_row();
+                if outside > 0 {
+                    ui.label("outside: with λ < 0 (MVC)");
+                    for &method in &methods {
+                        ui.label(self.document.bound(method).map_or("—".into(), |set| {
+                            set.quality.outside_negative_vertices.to_string()
+                        }));
+                    }
+                    ui.end_row();
+                }
             });
     }
 }
