@@ -101,7 +101,7 @@ fn nan_coordinate() {
 fn face_index_out_of_range() {
     let text = TETRA.replace("f 2 3 4\n", "f 2 3 9\n");
     let (output, cage) = bind_with_cage(&text, "cage.obj");
-    assert_clean_failure(&output, &cage, "face 3 refers to vertex 9");
+    assert_clean_failure(&output, &cage, "face 4 refers to vertex 9");
 }
 
 #[test]

@@ -1,6 +1,9 @@
 //! Cage validation: a cage must be a closed, edge-manifold, consistently oriented
-//! triangle mesh with no degenerate triangle. Inward-facing cages are flipped.
+//! triangle mesh with no degenerate triangle, that does not cross itself, whose
+//! parts (shells) are solids side by side or cavities inside them. Inward-facing
+//! cages are flipped.
 
+use super::intersect::ShellProblem;
 use super::{CageError, TriMesh};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -211,7 +214,7 @@ fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
                     count: uses.len(),
                     faces: faces
                         .iter()
-                        .map(usize::to_string)
+                        .map(|face| (face + 1).to_string())
                         .collect::<Vec<_>>()
                         .join(", "),
                 });
@@ -231,6 +234,27 @@ fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
             triangle.reverse();
         }
         volume = -volume;
+    }
+
+    if let Some(crossing) = super::intersect::find_crossing(&mesh.positions, &triangles, diagonal) {
+        return Err(CageError::SelfIntersecting {
+            first: face_of(crossing.first),
+            second: face_of(crossing.second),
+        });
+    }
+    match super::intersect::check_shells(&mesh.positions, &triangles) {
+        None => {}
+        Some(ShellProblem::Nested { inner, outer }) => {
+            return Err(CageError::NestedShells {
+                inner: face_of(inner),
+                outer: face_of(outer),
+            })
+        }
+        Some(ShellProblem::InwardAlone { shell }) => {
+            return Err(CageError::InwardShell {
+                shell: face_of(shell),
+            })
+        }
     }
 
     let mut referenced = vec![false; count];

@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-/// A mesh file could not be read.
+/// A mesh file could not be read. Lines, faces and vertices in the messages and
+/// fields count from 1 in file order, as OBJ and the user do; indices are as written.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
     #[error("{path}: cannot read: {source}", path = path.display())]
@@ -53,8 +54,9 @@ pub enum LoadError {
     },
 }
 
-/// A mesh is not usable as a cage. Faces are numbered from 0 in file order (the
-/// n-th face line); vertices from 0 in `v` order. The loaders add the file
+/// A mesh is not usable as a cage. The fields number faces from 0 in file order
+/// (the n-th face line) and vertices from 0 in `v` order; the messages count both
+/// from 1, as OBJ and the user do. The loaders add the file
 /// ([`CageLoadError::Invalid`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CageError {
@@ -62,26 +64,26 @@ pub enum CageError {
     TooFewVertices { count: usize },
     #[error("the cage has no faces")]
     NoFaces,
-    #[error("vertex {vertex} has a non-finite coordinate")]
+    #[error("vertex {} has a non-finite coordinate", .vertex + 1)]
     NonFinite { vertex: usize },
-    #[error("face {face} refers to vertex {index}, but the cage has {count} vertices")]
+    #[error("face {} refers to vertex {}, but the cage has {count} vertices", .face + 1, *.index as u64 + 1)]
     IndexOutOfRange {
         face: usize,
         index: u32,
         count: usize,
     },
-    #[error("face {face} is degenerate (zero area) at vertices {a}, {b}, {c}")]
+    #[error("face {} is degenerate (zero area) at vertices {}, {}, {}", .face + 1, .a + 1, .b + 1, .c + 1)]
     DegenerateTriangle { face: usize, a: u32, b: u32, c: u32 },
-    #[error("the cage is not closed: edge {a}–{b} of face {face} has no neighbouring face")]
+    #[error("the cage is not closed: edge {}–{} of face {} has no neighbouring face", .a + 1, .b + 1, .face + 1)]
     OpenEdge { a: u32, b: u32, face: usize },
-    #[error("the cage is not edge-manifold: edge {a}–{b} is shared by {count} faces ({faces})")]
+    #[error("the cage is not edge-manifold: edge {}–{} is shared by {count} faces ({faces})", .a + 1, .b + 1)]
     NonManifoldEdge {
         a: u32,
         b: u32,
         count: usize,
         faces: String,
     },
-    #[error("faces {first} and {second} are oriented inconsistently: both run along edge {a}→{b}")]
+    #[error("faces {} and {} are oriented inconsistently: both run along edge {}→{}", .first + 1, .second + 1, .a + 1, .b + 1)]
     InconsistentOrientation {
         a: u32,
         b: u32,
@@ -90,6 +92,12 @@ pub enum CageError {
     },
     #[error("the cage encloses no volume")]
     ZeroVolume,
+    #[error("the cage crosses itself: faces {} and {} intersect (a vertex pushed through a face, or a fold)", .first + 1, .second + 1)]
+    SelfIntersecting { first: usize, second: usize },
+    #[error("the cage's part with face {} lies inside its part with face {}, and both face outward: the space inside both would count twice", .inner + 1, .outer + 1)]
+    NestedShells { inner: usize, outer: usize },
+    #[error("the cage's part with face {} faces inward but is inside no other part, so it is not a cavity", .shell + 1)]
+    InwardShell { shell: usize },
 }
 
 /// A cage file could not be read, or was read but is not a valid cage.

@@ -6,6 +6,7 @@
 mod cage;
 mod classify;
 mod error;
+mod intersect;
 mod io;
 mod obj;
 mod off;

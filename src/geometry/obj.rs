@@ -76,7 +76,7 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                     return Err(LoadError::NonFinite {
                         path: path.to_owned(),
                         line: line_number,
-                        vertex: positions.len(),
+                        vertex: positions.len() + 1,
                     });
                 }
                 ordinal_text.push_str(&format!("v {} 0 0\n", positions.len()));
@@ -130,7 +130,7 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                         return Err(LoadError::IndexOutOfRange {
                             path: path.to_owned(),
                             line: line_number,
-                            face: face_count,
+                            face: face_count + 1,
                             index,
                             count: total_vertices,
                         });

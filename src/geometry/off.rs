@@ -68,7 +68,7 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
             *value = token.parse().map_err(|_| {
                 error(
                     number,
-                    format!("vertex {vertex}: '{token}' is not a number"),
+                    format!("vertex {}: '{token}' is not a number", vertex + 1),
                 )
             })?;
         }
@@ -76,7 +76,7 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
             return Err(LoadError::NonFinite {
                 path: path.to_owned(),
                 line: number,
-                vertex,
+                vertex: vertex + 1,
             });
         }
         mesh.positions.push(DVec3::from_array(coordinate));
@@ -99,26 +99,26 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
         let arity: usize = tokens
             .next()
             .and_then(|token| token.parse().ok())
-            .ok_or_else(|| error(number, format!("face {face}: missing corner count")))?;
+            .ok_or_else(|| error(number, format!("face {}: missing corner count", face + 1)))?;
         corners.clear();
         for _ in 0..arity {
             let token = tokens.next().ok_or_else(|| {
                 error(
                     number,
-                    format!("face {face} lists fewer than {arity} corners"),
+                    format!("face {} lists fewer than {arity} corners", face + 1),
                 )
             })?;
             let index: i64 = token.parse().map_err(|_| {
                 error(
                     number,
-                    format!("face {face}: '{token}' is not a vertex index"),
+                    format!("face {}: '{token}' is not a vertex index", face + 1),
                 )
             })?;
             if index < 0 || index as usize >= mesh.positions.len() {
                 return Err(LoadError::IndexOutOfRange {
                     path: path.to_owned(),
                     line: number,
-                    face,
+                    face: face + 1,
                     index,
                     count: mesh.positions.len(),
                 });
