@@ -413,41 +413,6 @@ fn holding_x_constrains_a_drag_to_the_x_axis() {
     );
 }
 
-/// A file dropped on the window, as the window system hands it to egui.
-#[derive(Debug)]
-struct DroppedPath(std::path::PathBuf);
-
-impl egui::DroppedFile for DroppedPath {
-    fn path(&self) -> &std::path::Path {
-        &self.0
-    }
-
-    fn bytes(&self) -> Result<Vec<u8>, String> {
-        std::fs::read(&self.0).map_err(|e| e.to_string())
-    }
-}
-
-#[test]
-fn dropped_mesh_rebinds_and_reports_outside_vertices() {
-    let Some(mut harness) = editor() else { return };
-    run_until_bound(&mut harness);
-    let directory = tempfile::tempdir().unwrap();
-    // Two vertices inside the comb cage's palm, one far outside it.
-    let mesh = directory.path().join("dropped.obj");
-    std::fs::write(&mesh, "v 1 0.5 0\nv 2 0.5 0\nv 1 0.5 9\nf 1 2 3\n").unwrap();
-    harness
-        .input_mut()
-        .dropped_files
-        .push(std::sync::Arc::new(DroppedPath(mesh)));
-    harness.step();
-    assert!(harness.state().is_binding(), "a dropped mesh rebinds");
-    run_until_bound(&mut harness);
-    let app = harness.state();
-    assert_eq!(app.document().mesh().positions.len(), 3);
-    assert_eq!(app.document().outside(), vec![2]);
-    assert_eq!(app.document().weights(Method::Pmvc).unwrap().rows, 3);
-}
-
 #[test]
 fn shift_click_toggles_and_the_scenes_menu_switches_scenes() {
     let Some(mut harness) = editor() else { return };

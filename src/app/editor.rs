@@ -11,6 +11,7 @@ use super::readouts::ReadoutCache;
 use super::scene_history::SceneHistory;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
+use super::ui::drop_dialog::DroppedFile;
 use super::ui::notices::Notices;
 use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
@@ -64,6 +65,8 @@ pub struct EditorApp {
     pub(super) numeric_drag_start: Option<Vec<DVec3>>,
     /// Documents replaced by opening files, switching scenes and cage edits.
     pub(super) scene_history: SceneHistory,
+    /// A file dropped on the window, waiting for the user to say what it is.
+    pub(super) dropped: Option<DroppedFile>,
 }
 
 impl EditorApp {
@@ -128,6 +131,7 @@ impl EditorApp {
             hide_timings: options.hide_timings,
             numeric_drag_start: None,
             scene_history: SceneHistory::default(),
+            dropped: None,
         };
         if let Some(error) = unsupported {
             app.error(error.to_string());
@@ -467,6 +471,7 @@ impl eframe::App for EditorApp {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui))
             });
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        self.drop_dialog(&ctx);
         self.request_wanted_binds();
         if self.show_statistics {
             // Keep frames coming so the readout measures rendering, not idling.

@@ -195,29 +195,6 @@ impl EditorApp {
         ));
         self.start_bind();
     }
-
-    pub(super) fn handle_dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped: Vec<PathBuf> = ctx.input(|i| {
-            i.raw
-                .dropped_files
-                .iter()
-                .map(|f| f.path().to_owned())
-                .filter(|p| !p.as_os_str().is_empty())
-                .collect()
-        });
-        for path in dropped {
-            // A file whose name mentions "cage" replaces the cage; anything else the mesh.
-            let is_cage = path
-                .file_name()
-                .is_some_and(|n| n.to_string_lossy().to_lowercase().contains("cage"));
-            let role = if is_cage {
-                FileRole::Cage
-            } else {
-                FileRole::Mesh
-            };
-            self.open_file(role, &path);
-        }
-    }
 }
 
 /// The system's file dialog for opening a mesh-like file.

@@ -1,6 +1,7 @@
 //! The editor's panels, one file each, as in egui's demo app: each adds an
 //! `impl EditorApp` method that draws its panel and calls the editor's actions.
 
+pub mod drop_dialog;
 pub mod menu;
 pub mod notices;
 pub mod quality_table;
