@@ -284,3 +284,27 @@ fn byte_order_marks_line_endings_and_vertex_forms() {
     let message = parse_mesh(path, long).unwrap_err().to_string();
     assert!(message.len() < 200, "{} bytes of message", message.len());
 }
+
+/// A polyline (`l`) is not a face, and a face needs three corners: the OBJ library
+/// would read the first as a face and drop the second, and either would shift the
+/// face numbers that cage errors name.
+#[test]
+fn polylines_are_skipped_and_short_faces_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let with_line = tetra.replace("f 1 2 4\n", "l 1 2 3\nf 1 2 4\n");
+    let file = load_mesh(&write(dir.path(), "line.obj", &with_line)).unwrap();
+    assert_eq!(file.mesh.triangles.len(), 4);
+    assert_eq!(file.mesh.triangle_faces, vec![0, 1, 2, 3]);
+
+    let short = tetra.replace("f 1 2 4\n", "f 1 2\nf 1 2 4\n");
+    let path = write(dir.path(), "short.obj", &short);
+    let message = load_mesh(&path).unwrap_err().to_string();
+    assert_eq!(
+        message,
+        format!(
+            "{}:6: face 2 has 2 corners; a face needs at least 3",
+            path.display()
+        )
+    );
+}

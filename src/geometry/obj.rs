@@ -105,8 +105,25 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
                     ));
                 }
             }
+            Some("l") => {
+                // A polyline, not a face; the OBJ library would read it as one.
+                ordinal_text.push('\n');
+                continue;
+            }
             Some("f") => {
                 // Checked here so that the error can name the line and the face.
+                // The OBJ library drops faces of fewer than three corners, which
+                // would shift the numbers of all later faces in messages.
+                let corners = tokens.clone().count();
+                if corners < 3 {
+                    return Err(parse_error(
+                        line_number,
+                        format!(
+                            "face {} has {corners} corners; a face needs at least 3",
+                            face_count + 1
+                        ),
+                    ));
+                }
                 for token in tokens {
                     let index_text = token.split('/').next().unwrap_or("");
                     let index: i64 = index_text.parse().map_err(|_| {
