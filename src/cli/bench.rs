@@ -161,6 +161,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     say!("{}", markdown(&rows));
     if let Some(path) = &args.json {
+        if let Some(warning) = geometry::extension_warning(path, &["json"], "JSON") {
+            warn_line!("pmvc: {warning}");
+        }
         let json = to_json(&rows, threads, &adapter);
         geometry::write_atomically(path, |out| out.write_all(json.as_bytes()))?;
     }

@@ -1,9 +1,12 @@
 //! The work behind each subcommand.
 
 use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
-use crate::coords::npy::{read_npy, write_npy};
+use crate::coords::npy::{npy_file_bytes, read_npy, write_npy_to};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
-use crate::geometry::{self, classify_points, Cage, MeshFile, PointClasses};
+use crate::geometry::{
+    self, classify_points, extension_warning, human_bytes, refuse_same_file, Cage, MeshFile,
+    PendingOutput, PointClasses,
+};
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
@@ -18,9 +21,14 @@ pub(super) struct BoundInput {
 }
 
 /// Load and validate the inputs, printing the cage's notices and the outside count.
-pub(super) fn load_input(input: &CageInput, strict: bool) -> Result<BoundInput> {
+/// With `will_bind`, a weights matrix that cannot fit in memory is an error before
+/// any work on the points.
+pub(super) fn load_input(input: &CageInput, strict: bool, will_bind: bool) -> Result<BoundInput> {
     let mesh = geometry::load_mesh(&input.mesh)?;
     let (cage, report) = geometry::load_cage(&input.cage)?;
+    if will_bind {
+        check_weights_fit(mesh.mesh.positions.len(), cage.vertex_count(), &input.mesh)?;
+    }
     for message in report.messages() {
         warn_line!("pmvc: {}: {message}", input.cage.display());
     }
@@ -131,22 +139,75 @@ pub(super) fn progress_bar(total: u64, method: Method) -> indicatif::ProgressBar
     bar
 }
 
+/// Refuse an output that is one of the inputs, and warn when its name says it
+/// holds something else.
+fn check_output(
+    out: &std::path::Path,
+    inputs: &[&std::path::Path],
+    extensions: &[&str],
+    what: &str,
+) -> Result<()> {
+    refuse_same_file(out, inputs)?;
+    if let Some(warning) = extension_warning(out, extensions, what) {
+        warn_line!("pmvc: {warning}");
+    }
+    Ok(())
+}
+
+/// An error before the work starts when a dense `rows` × `cols` weights matrix
+/// cannot fit in the memory left, instead of an abort once it is allocated.
+fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
+    let bytes = 4 * rows as u64 * cols as u64;
+    if let Some(available) = super::environment::available_memory() {
+        if bytes > available {
+            bail!(
+                "{}: its weights would take {} ({rows} vertices × {cols} cage vertices × 4 bytes), but only {} of memory is available; bind the mesh in parts, or use a coarser cage",
+                mesh.display(),
+                human_bytes(bytes),
+                human_bytes(available)
+            );
+        }
+    }
+    Ok(())
+}
+
 pub(super) fn bind(args: &BindArgs) -> Result<()> {
+    let inputs = [args.input.mesh.as_path(), args.input.cage.as_path()];
+    check_output(
+        &args.out,
+        &inputs,
+        &["npy"],
+        "float32 weights in .npy format",
+    )?;
     // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
     // on the driver: do it while the inputs load and are classified.
     let choice = args.method.backend;
     let probe = std::thread::spawn(move || choose_backend(choice));
-    let input = load_input(&args.input, args.method.strict)?;
+    let input = load_input(&args.input, args.method.strict, true)?;
     let backend = probe
         .join()
         .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
+    // Opened before the work, so that a full disk or an unwritable folder is
+    // reported now, and a signal during the bind removes the temporary file.
+    let output = PendingOutput::create(&args.out)?;
+    output.check_space(npy_file_bytes(
+        input.mesh.mesh.positions.len(),
+        input.cage.vertex_count(),
+    ))?;
     let weights = compute_weights_on(&input, &args.method, backend)?;
-    write_npy(&args.out, &weights)?;
+    write_npy_to(output, &args.out, &weights)?;
     Ok(())
 }
 
 pub(super) fn deform(args: &DeformArgs) -> Result<()> {
-    let input = load_input(&args.input, args.method.strict)?;
+    let mut inputs = vec![
+        args.input.mesh.as_path(),
+        args.input.cage.as_path(),
+        args.deformed_cage.as_path(),
+    ];
+    inputs.extend(args.weights.as_deref());
+    check_output(&args.out, &inputs, &["obj"], "an OBJ mesh")?;
+    let input = load_input(&args.input, args.method.strict, args.weights.is_none())?;
     let pose = geometry::load_mesh(&args.deformed_cage)?;
     let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
     if found != expected {
@@ -282,6 +343,8 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
 }
 
 pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
+    check_output(&args.mesh, &[], &["obj"], "an OBJ mesh")?;
+    check_output(&args.cage, &[], &["obj"], "an OBJ cage")?;
     let scene = geometry::procedural::table1_scene(&args.scene).context("unknown scene")?;
     let points = geometry::TriMesh {
         positions: scene.points,

@@ -329,6 +329,12 @@ pub fn main() -> ExitCode {
             };
         }
     };
+    if matches!(
+        cli.command,
+        Some(Command::Bind(_) | Command::Deform(_) | Command::Generate(_) | Command::Bench(_))
+    ) {
+        environment::remove_unfinished_outputs_on_signals();
+    }
     let result = match cli.command {
         None => crate::app::run_editor(crate::app::EditorOptions::default())
             .map_err(anyhow::Error::from),
@@ -353,10 +359,27 @@ pub fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(error) => {
-            warn_line!("pmvc: error: {error:#}");
+            warn_line!("pmvc: error: {}", error_line(&error));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line. The library's messages already quote
+/// their cause (`w.npy: cannot write: No space left on device`), so a cause whose
+/// text is there is not repeated.
+fn error_line(error: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+    }
+    line
 }
 
 #[cfg(test)]
@@ -364,6 +387,20 @@ mod tests {
     use super::*;
     use crate::app::compare::{Layout, Overlay};
     use crate::coords::Method;
+
+    #[test]
+    fn an_error_line_quotes_each_cause_once() {
+        let io = std::io::Error::other("No space left on device");
+        let error = anyhow::Error::from(crate::geometry::WriteError {
+            path: "w.npy".into(),
+            source: io,
+        })
+        .context("--out");
+        assert_eq!(
+            error_line(&error),
+            "--out: w.npy: cannot write: No space left on device"
+        );
+    }
 
     fn edit_options(args: &[&str]) -> crate::app::EditorOptions {
         let cli = Cli::try_parse_from(["pmvc", "edit"].iter().chain(args)).expect("parses");

@@ -3,7 +3,7 @@
 //! reads. Writing goes through a temporary file that is renamed over the target.
 
 use super::Weights;
-use crate::geometry::{write_atomically, WriteError};
+use crate::geometry::{PendingOutput, WriteError};
 use std::path::{Path, PathBuf};
 
 /// A weights file could not be written or read. Every variant names the file.
@@ -37,20 +37,33 @@ pub enum NpyError {
 
 /// Write `weights` to `path`.
 pub fn write_npy(path: &Path, weights: &Weights) -> Result<(), NpyError> {
-    let mut header = format!(
-        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {}), }}",
-        weights.rows, weights.cols
-    );
+    write_npy_to(PendingOutput::create(path)?, path, weights)
+}
+
+/// The size of the `.npy` file [`write_npy`] writes for a `rows` × `cols` matrix.
+pub fn npy_file_bytes(rows: usize, cols: usize) -> u64 {
+    (npy_header(rows, cols).len() + 10) as u64 + 4 * rows as u64 * cols as u64
+}
+
+fn npy_header(rows: usize, cols: usize) -> String {
+    let mut header =
+        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
     // Magic, version, length and header end on a 64-byte boundary, with a newline.
     let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
     header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
     header.push('\n');
+    header
+}
+
+/// [`write_npy`] into an output opened before the weights were computed.
+pub fn write_npy_to(output: PendingOutput, path: &Path, weights: &Weights) -> Result<(), NpyError> {
+    let header = npy_header(weights.rows, weights.cols);
     let header_len = u16::try_from(header.len()).map_err(|_| NpyError::HeaderTooLong {
         path: path.to_owned(),
         rows: weights.rows,
         cols: weights.cols,
     })?;
-    write_atomically(path, |out| {
+    output.finish(|out| {
         out.write_all(b"\x93NUMPY\x01\x00")?;
         out.write_all(&header_len.to_le_bytes())?;
         out.write_all(header.as_bytes())?;

@@ -1,8 +1,8 @@
-//! Reading mesh and cage files, and writing results so that a failure never
-//! damages an existing file: output goes to a temporary file beside the target,
-//! which is renamed over it only once complete.
+//! Reading mesh and cage files, and writing meshes by the rules of
+//! [`super::output`].
 
 use super::error::{CageLoadError, WriteError};
+use super::output::write_atomically;
 use super::{obj, off, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
 use std::io::Write;
@@ -77,43 +77,6 @@ pub fn cage_from_file(path: &Path, file: MeshFile) -> Result<(Cage, CageReport),
         path: path.to_owned(),
         source,
     })
-}
-
-/// Write a file through a temporary sibling that is renamed over `path` on success.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), WriteError> {
-    let wrap = |source| WriteError {
-        path: path.to_owned(),
-        source,
-    };
-    let directory = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".pmvc-").suffix(".tmp");
-    // Temporary files are private; the result should have the permissions of the
-    // file it replaces, or those of an ordinary new file.
-    #[cfg(unix)]
-    let permissions = std::fs::metadata(path)
-        .map(|m| m.permissions())
-        .unwrap_or_else(|_| {
-            use std::os::unix::fs::PermissionsExt;
-            std::fs::Permissions::from_mode(0o644)
-        });
-    #[cfg(unix)]
-    builder.permissions(permissions);
-    let mut temporary = builder.tempfile_in(directory).map_err(wrap)?;
-    {
-        let mut buffered = std::io::BufWriter::new(temporary.as_file_mut());
-        write(&mut buffered).map_err(wrap)?;
-        buffered.flush().map_err(wrap)?;
-    }
-    temporary.as_file().sync_all().map_err(wrap)?;
-    temporary.persist(path).map_err(|error| wrap(error.error))?;
-    Ok(())
 }
 
 /// Write a triangle mesh as OBJ.

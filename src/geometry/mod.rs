@@ -10,6 +10,7 @@ mod intersect;
 mod io;
 mod obj;
 mod off;
+mod output;
 pub mod procedural;
 pub mod subdivide;
 
@@ -20,8 +21,11 @@ pub use classify::{
 };
 pub use error::{CageError, CageLoadError, LoadError, WriteError};
 pub use io::{
-    cage_from_file, load_cage, load_mesh, parse_mesh, write_atomically, write_deformed_mesh,
-    write_obj, write_obj_to,
+    cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_obj, write_obj_to,
+};
+pub use output::{
+    extension_warning, human_bytes, refuse_same_file, remove_unfinished_outputs, resolve_output,
+    write_atomically, OutputTarget, PendingOutput,
 };
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 

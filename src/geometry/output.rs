@@ -1,0 +1,439 @@
+//! Where an output goes, and writing it so that nothing is lost.
+//!
+//! - A regular file (or a new name) is written through a temporary sibling that is
+//!   renamed over it only once complete, so a failure leaves the old file whole.
+//! - A symbolic link is followed: its target is replaced the same way, and the
+//!   link stays a link.
+//! - A character device or a named pipe (`/dev/null`, `/dev/stdout`, a FIFO) is
+//!   written directly: renaming over it would replace the node itself.
+//! - A directory, a block device or a socket is refused.
+//! - An output that is the same file as an input is refused ([`refuse_same_file`]).
+//!
+//! While a temporary file is being written it is listed, so that a process ended
+//! by a signal can remove it ([`remove_unfinished_outputs`]).
+
+use super::error::WriteError;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Links followed before giving up, as the kernel's own limit for path lookup.
+const MAX_LINKS: usize = 40;
+
+/// How an output path is written.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OutputTarget {
+    /// A regular file or a new name, with links followed: replaced by rename.
+    File(PathBuf),
+    /// A character device or a named pipe: written in place.
+    Stream(PathBuf),
+}
+
+impl OutputTarget {
+    /// The path that is finally written, links followed.
+    pub fn path(&self) -> &Path {
+        match self {
+            OutputTarget::File(path) | OutputTarget::Stream(path) => path,
+        }
+    }
+}
+
+fn invalid(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidInput, message)
+}
+
+/// Follow `path`'s symbolic links to what an output there would write.
+pub fn resolve_output(path: &Path) -> Result<OutputTarget, WriteError> {
+    let wrap = |source| WriteError {
+        path: path.to_owned(),
+        source,
+    };
+    let mut current = path.to_owned();
+    for _ in 0..=MAX_LINKS {
+        let metadata = match std::fs::symlink_metadata(&current) {
+            Ok(metadata) => metadata,
+            Err(error) if error.kind() == std::io::ErrorKind::NotFound => {
+                return Ok(OutputTarget::File(current))
+            }
+            Err(error) => return Err(wrap(error)),
+        };
+        let file_type = metadata.file_type();
+        if file_type.is_symlink() {
+            let target = std::fs::read_link(&current).map_err(wrap)?;
+            current = match current.parent() {
+                Some(parent) if target.is_relative() => parent.join(target),
+                _ => target,
+            };
+            continue;
+        }
+        if file_type.is_file() {
+            return Ok(OutputTarget::File(current));
+        }
+        if file_type.is_dir() {
+            return Err(wrap(invalid("it is a directory".into())));
+        }
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            if file_type.is_char_device() || file_type.is_fifo() {
+                return Ok(OutputTarget::Stream(current));
+            }
+            if file_type.is_block_device() {
+                return Err(wrap(invalid(
+                    "it is a block device, which pmvc never writes".into(),
+                )));
+            }
+        }
+        return Err(wrap(invalid(
+            "it is neither a regular file nor a device or pipe".into(),
+        )));
+    }
+    Err(wrap(invalid(format!(
+        "more than {MAX_LINKS} symbolic links to follow"
+    ))))
+}
+
+/// Refuse `output` when it is, or links to, the same file as one of `inputs`:
+/// replacing an input with a result computed from it loses the input.
+pub fn refuse_same_file(output: &Path, inputs: &[&Path]) -> Result<(), WriteError> {
+    let target = resolve_output(output)?;
+    let Ok(written) = std::fs::metadata(target.path()) else {
+        return Ok(()); // a new file is nobody's input
+    };
+    for input in inputs {
+        let Ok(read) = std::fs::metadata(input) else {
+            continue;
+        };
+        if same_file(&written, &read, target.path(), input) {
+            return Err(WriteError {
+                path: output.to_owned(),
+                source: invalid(format!(
+                    "it is the input {}, which pmvc never overwrites; choose another output",
+                    input.display()
+                )),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    // A device (`/dev/null` as input and output) is no file to lose.
+    a.is_file() && (a.dev(), a.ino()) == (b.dev(), b.ino())
+}
+
+#[cfg(not(unix))]
+fn same_file(a: &std::fs::Metadata, _: &std::fs::Metadata, pa: &Path, pb: &Path) -> bool {
+    a.is_file()
+        && matches!(
+            (pa.canonicalize(), pb.canonicalize()),
+            (Ok(x), Ok(y)) if x == y
+        )
+}
+
+/// A warning when `path`'s extension is not one of `expected` (lower case, no
+/// dot), e.g. weights written to `mesh.obj`. Devices and pipes have no extension
+/// to check.
+pub fn extension_warning(path: &Path, expected: &[&str], what: &str) -> Option<String> {
+    if matches!(resolve_output(path), Ok(OutputTarget::Stream(_))) {
+        return None;
+    }
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if extension
+        .as_deref()
+        .is_some_and(|found| expected.contains(&found))
+    {
+        return None;
+    }
+    let wanted: Vec<String> = expected.iter().map(|e| format!(".{e}")).collect();
+    Some(format!(
+        "{}: warning: this file will hold {what}, but its name does not end in {}",
+        path.display(),
+        wanted.join(" or ")
+    ))
+}
+
+/// Temporary files being written now, for [`remove_unfinished_outputs`].
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Remove the temporary files of every write still in progress. For a signal
+/// handler that is about to end the process, when destructors will not run.
+/// Returns how many were removed.
+pub fn remove_unfinished_outputs() -> usize {
+    let paths = match UNFINISHED.lock() {
+        Ok(paths) => paths.clone(),
+        Err(poisoned) => poisoned.into_inner().clone(),
+    };
+    paths
+        .iter()
+        .filter(|path| std::fs::remove_file(path).is_ok())
+        .count()
+}
+
+/// Lists a temporary file in [`UNFINISHED`] while it lives.
+struct Listed(PathBuf);
+
+impl Listed {
+    fn new(path: &Path) -> Listed {
+        if let Ok(mut paths) = UNFINISHED.lock() {
+            paths.push(path.to_owned());
+        }
+        Listed(path.to_owned())
+    }
+}
+
+impl Drop for Listed {
+    fn drop(&mut self) {
+        if let Ok(mut paths) = UNFINISHED.lock() {
+            paths.retain(|p| p != &self.0);
+        }
+    }
+}
+
+/// An output opened before the work that produces it: its temporary file exists
+/// (and is removed on a signal) from the start, so an unwritable folder fails
+/// early and the free space can be checked before hours of computing.
+pub struct PendingOutput {
+    path: PathBuf,
+    kind: Pending,
+}
+
+enum Pending {
+    // Field order matters: the file is deleted before it leaves the list.
+    File {
+        temporary: tempfile::NamedTempFile,
+        target: PathBuf,
+        _listed: Listed,
+    },
+    Stream(PathBuf),
+}
+
+impl PendingOutput {
+    /// Resolve `path` by the module's rules and create its temporary file.
+    pub fn create(path: &Path) -> Result<PendingOutput, WriteError> {
+        let wrap = |source| WriteError {
+            path: path.to_owned(),
+            source,
+        };
+        let target = match resolve_output(path)? {
+            OutputTarget::Stream(device) => {
+                return Ok(PendingOutput {
+                    path: path.to_owned(),
+                    kind: Pending::Stream(device),
+                })
+            }
+            OutputTarget::File(target) => target,
+        };
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".pmvc-").suffix(".tmp");
+        // Temporary files are private; the result should have the permissions of
+        // the file it replaces, or those of an ordinary new file.
+        #[cfg(unix)]
+        let permissions = std::fs::metadata(&target)
+            .map(|m| m.permissions())
+            .unwrap_or_else(|_| {
+                use std::os::unix::fs::PermissionsExt;
+                std::fs::Permissions::from_mode(0o644)
+            });
+        #[cfg(unix)]
+        builder.permissions(permissions);
+        let temporary = builder.tempfile_in(folder_of(&target)).map_err(wrap)?;
+        let listed = Listed::new(temporary.path());
+        Ok(PendingOutput {
+            path: path.to_owned(),
+            kind: Pending::File {
+                temporary,
+                target,
+                _listed: listed,
+            },
+        })
+    }
+
+    /// An error unless the file system has room for `bytes` more. Devices and
+    /// pipes have no limit to check.
+    pub fn check_space(&self, bytes: u64) -> Result<(), WriteError> {
+        let Pending::File { target, .. } = &self.kind else {
+            return Ok(());
+        };
+        match free_space(folder_of(target)) {
+            Some(free) if free < bytes => Err(WriteError {
+                path: self.path.clone(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::StorageFull,
+                    format!(
+                        "it needs {}, but its file system has {} free",
+                        human_bytes(bytes),
+                        human_bytes(free)
+                    ),
+                ),
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// Write the output and, for a file, rename it over the target.
+    pub fn finish(
+        self,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
+        let path = self.path;
+        let wrap = |source| WriteError {
+            path: path.clone(),
+            source,
+        };
+        match self.kind {
+            Pending::Stream(device) => {
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(&device)
+                    .map_err(wrap)?;
+                let mut buffered = std::io::BufWriter::new(file);
+                write(&mut buffered).map_err(wrap)?;
+                buffered.flush().map_err(wrap)
+            }
+            Pending::File {
+                mut temporary,
+                target,
+                _listed,
+            } => {
+                {
+                    let mut buffered = std::io::BufWriter::new(temporary.as_file_mut());
+                    write(&mut buffered).map_err(wrap)?;
+                    buffered.flush().map_err(wrap)?;
+                }
+                temporary.as_file().sync_all().map_err(wrap)?;
+                temporary
+                    .persist(&target)
+                    .map_err(|error| wrap(error.error))?;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Write an output by the rules in the module documentation.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), WriteError> {
+    PendingOutput::create(path)?.finish(write)
+}
+
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    }
+}
+
+#[cfg(unix)]
+fn free_space(folder: &Path) -> Option<u64> {
+    let stats = rustix::fs::statvfs(folder).ok()?;
+    Some(stats.f_bavail.saturating_mul(stats.f_frsize))
+}
+
+#[cfg(not(unix))]
+fn free_space(_: &Path) -> Option<u64> {
+    None
+}
+
+/// `1.5 GiB`: sizes in messages, binary units.
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} bytes")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn links_are_followed_to_the_file_they_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("real.npy");
+        std::fs::write(&file, "old").unwrap();
+        let link = dir.path().join("link.npy");
+        std::os::unix::fs::symlink("real.npy", &link).unwrap();
+        assert_eq!(
+            resolve_output(&link).unwrap(),
+            OutputTarget::File(dir.path().join("real.npy"))
+        );
+        let dangling = dir.path().join("dangling.npy");
+        std::os::unix::fs::symlink(dir.path().join("new.npy"), &dangling).unwrap();
+        assert_eq!(
+            resolve_output(&dangling).unwrap(),
+            OutputTarget::File(dir.path().join("new.npy"))
+        );
+        let looped = dir.path().join("loop");
+        std::os::unix::fs::symlink("loop", &looped).unwrap();
+        let error = resolve_output(&looped).unwrap_err();
+        assert!(error.to_string().contains("symbolic links"), "{error}");
+    }
+
+    #[test]
+    fn devices_are_streams_and_directories_are_refused() {
+        assert_eq!(
+            resolve_output(Path::new("/dev/null")).unwrap(),
+            OutputTarget::Stream("/dev/null".into())
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let error = resolve_output(dir.path()).unwrap_err();
+        assert!(error.to_string().contains("directory"), "{error}");
+    }
+
+    #[test]
+    fn a_pending_output_is_listed_until_it_is_finished_or_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("w.npy");
+        let pending = PendingOutput::create(&out).unwrap();
+        let temporaries = || {
+            std::fs::read_dir(dir.path())
+                .unwrap()
+                .filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .file_name()
+                        .to_string_lossy()
+                        .ends_with(".tmp")
+                })
+                .count()
+        };
+        assert_eq!(temporaries(), 1);
+        assert!(pending.check_space(u64::MAX).is_err());
+        pending.check_space(1).unwrap();
+        pending.finish(|w| w.write_all(b"done")).unwrap();
+        assert_eq!(
+            (temporaries(), std::fs::read(&out).unwrap()),
+            (0, b"done".to_vec())
+        );
+        assert_eq!(human_bytes(3 << 29), "1.5 GiB");
+    }
+
+    #[test]
+    fn extension_warning_names_what_is_expected() {
+        let warning = extension_warning(Path::new("mesh.obj"), &["npy"], "weights").unwrap();
+        assert!(warning.contains("mesh.obj") && warning.contains(".npy"));
+        assert_eq!(
+            extension_warning(Path::new("W.NPY"), &["npy"], "weights"),
+            None
+        );
+        assert_eq!(
+            extension_warning(Path::new("/dev/null"), &["npy"], "weights"),
+            None
+        );
+    }
+}

@@ -1,0 +1,169 @@
+#![cfg(unix)]
+//! Outputs never destroy what they should not: an input, a link, a device, or a
+//! folder; a signal leaves no temporary file; a bind that cannot fit is refused
+//! before the work.
+
+mod common;
+use common::*;
+use std::path::Path;
+use std::process::Output;
+
+fn bind(mesh: &Path, cage: &Path, out: &Path) -> Output {
+    pmvc(&[
+        "bind",
+        "--mesh",
+        path_str(mesh),
+        "--cage",
+        path_str(cage),
+        "--out",
+        path_str(out),
+        "--backend",
+        "cpu",
+    ])
+}
+
+fn temporary_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".tmp"))
+        .collect()
+}
+
+const NPY_MAGIC: &[u8] = b"\x93NUMPY";
+
+#[test]
+fn an_output_that_is_an_input_is_refused_and_the_input_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 20);
+    let before = std::fs::read(&mesh).unwrap();
+    let output = pmvc(&[
+        "deform",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage),
+        "--deformed-cage",
+        path_str(&cage),
+        "--out",
+        path_str(&mesh),
+    ]);
+    assert_clean_failure(&output, path_str(&mesh), "never overwrites");
+    assert_eq!(std::fs::read(&mesh).unwrap(), before);
+    // Through a link to the cage, too.
+    let link = dir.path().join("link.npy");
+    std::os::unix::fs::symlink(&cage, &link).unwrap();
+    let cage_before = std::fs::read(&cage).unwrap();
+    assert_clean_failure(&bind(&mesh, &cage, &link), "link.npy", "never overwrites");
+    assert_eq!(std::fs::read(&cage).unwrap(), cage_before);
+}
+
+#[test]
+fn a_symbolic_link_is_written_through_and_stays_a_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 20);
+    let results = dir.path().join("results");
+    std::fs::create_dir(&results).unwrap();
+    let target = results.join("w.npy");
+    std::fs::write(&target, "old").unwrap();
+    let link = dir.path().join("latest.npy");
+    std::os::unix::fs::symlink("results/w.npy", &link).unwrap();
+    let output = bind(&mesh, &cage, &link);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read(&target).unwrap().starts_with(NPY_MAGIC));
+    assert!(temporary_files(dir.path()).is_empty() && temporary_files(&results).is_empty());
+}
+
+#[test]
+fn devices_are_written_in_place_and_folders_refused() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 20);
+    let output = bind(&mesh, &cage, Path::new("/dev/null"));
+    assert!(output.status.success(), "{}", stderr(&output));
+    // No extension warning for a device.
+    assert!(!stderr(&output).contains("warning"), "{}", stderr(&output));
+    // A full device fails cleanly, and stays a device whoever runs the test.
+    let output = bind(&mesh, &cage, Path::new("/dev/full"));
+    assert_clean_failure(&output, "/dev/full", "cannot write");
+    let full = std::fs::metadata("/dev/full").unwrap();
+    assert!(full.file_type().is_char_device());
+    let folder = dir.path().join("folder");
+    std::fs::create_dir(&folder).unwrap();
+    assert_clean_failure(&bind(&mesh, &cage, &folder), "folder", "directory");
+    assert!(folder.is_dir());
+}
+
+#[test]
+fn a_misleading_extension_is_written_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 20);
+    let out = dir.path().join("weights.obj");
+    let output = bind(&mesh, &cage, &out);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stderr(&output);
+    assert!(
+        text.contains("weights.obj: warning:") && text.contains("does not end in .npy"),
+        "{text}"
+    );
+    assert!(std::fs::read(&out).unwrap().starts_with(NPY_MAGIC));
+}
+
+#[test]
+fn a_bind_that_cannot_fit_in_memory_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2,000,000 points × 10,242 cage vertices × 4 bytes = 76 GiB.
+    let points = "v 0 0 0\n".repeat(2_000_000);
+    let mesh = write(dir.path(), "mesh.obj", &points);
+    let sphere = pmvc::geometry::procedural::icosphere(1.0, 5);
+    let cage = write(dir.path(), "cage.obj", &cage_obj(&sphere));
+    let out = dir.path().join("w.npy");
+    let output = bind(&mesh, &cage, &out);
+    assert_clean_failure(&output, "mesh.obj", "memory");
+    let text = stderr(&output);
+    assert!(
+        text.contains("76.3 GiB") && text.contains("2000000 vertices × 10242 cage vertices"),
+        "{text}"
+    );
+    assert!(!out.exists() && temporary_files(dir.path()).is_empty());
+}
+
+#[test]
+fn a_signal_during_a_bind_removes_its_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    // Long enough on the CPU that the signal comes during the bind.
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 200_000);
+    for (signal, name) in [(15, "TERM"), (2, "INT"), (1, "HUP")] {
+        let out = dir.path().join(format!("w-{name}.npy"));
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
+            .args(["bind", "--method", "pmvc", "--backend", "cpu", "--mesh"])
+            .args([&mesh, Path::new("--cage"), &cage, Path::new("--out"), &out])
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // The output's temporary file exists from the start of the bind.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while temporary_files(dir.path()).is_empty() {
+            assert!(std::time::Instant::now() < deadline, "no temporary file");
+            assert!(child.try_wait().unwrap().is_none(), "the bind ended early");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let killed = std::process::Command::new("kill")
+            .args([format!("-{name}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(128 + signal), "SIG{name}");
+        assert_eq!(
+            temporary_files(dir.path()),
+            Vec::<String>::new(),
+            "SIG{name}"
+        );
+        assert!(!out.exists());
+    }
+}
