@@ -1,5 +1,7 @@
 // Deformed mesh: the vertex shader computes p' = p + Σ_k W[i,k] · d_k from the
-// dense weights (row-major f32) and each weights column's displacement d_k
+// dense weights (row-major f32, split by rows over chunk buffers that
+// `chunk_weight` reads; render::weight_chunks appends it and its bindings, whose
+// number depends on the device) and each weights column's displacement d_k
 // (`Method::column_displacements`, uploaded per pose change), so the CPU never
 // touches mesh positions per frame. The displacement form is exact at rest for any
 // weights and keeps its precision far from the origin. Normals come from screen-space derivatives of the deformed
@@ -13,18 +15,12 @@
 #import frame
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// The weights of the method shown.
-@group(0) @binding(1) var<storage, read> weights: array<f32>;
 // xyz: rest position; w: 1 for a vertex outside the cage.
-@group(0) @binding(2) var<storage, read> rest: array<vec4<f32>>;
-// xyz: deformed cage vertex.
-@group(0) @binding(3) var<storage, read> cage: array<vec4<f32>>;
-// The compared method's weights, for the difference view.
-@group(0) @binding(5) var<storage, read> other_weights: array<f32>;
+@group(0) @binding(1) var<storage, read> rest: array<vec4<f32>>;
 // xyz: how far each weights column's vector moved from rest, for the method shown.
-@group(0) @binding(6) var<storage, read> displacements: array<vec4<f32>>;
-// The same for the compared method.
-@group(0) @binding(7) var<storage, read> other_displacements: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> displacements: array<vec4<f32>>;
+// The same for the compared method (the difference view).
+@group(0) @binding(5) var<storage, read> other_displacements: array<vec4<f32>>;
 
 const NEGATIVE = vec3<f32>(0.16, 0.29, 0.80);
 const ZERO = vec3<f32>(0.97, 0.97, 0.97);
@@ -33,23 +29,36 @@ const POSITIVE = vec3<f32>(0.80, 0.08, 0.10);
 override LOG_DECADES: f32 = 3.0;
 const LN_10: f32 = 2.302585093;
 
+// Where a vertex's weights row starts: x, the pool slot of its chunk; y, the
+// index of its first weight there.
+fn row_start(vertex: u32, rows_per_chunk: u32, columns: u32, first_chunk: u32) -> vec2<u32> {
+    let chunk = vertex / max(rows_per_chunk, 1u);
+    let row = vertex - chunk * rows_per_chunk;
+    return vec2<u32>(first_chunk + chunk, row * columns);
+}
+
 fn deformed_position(vertex: u32) -> vec3<f32> {
     if frame.weights_bound == 0u {
         return rest[vertex].xyz;
     }
-    let row = vertex * frame.columns;
+    let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
     var moved = vec3<f32>(0.0);
     for (var column = 0u; column < frame.columns; column++) {
-        moved += weights[row + column] * displacements[column].xyz;
+        moved += chunk_weight(start.x, start.y + column) * displacements[column].xyz;
     }
     return rest[vertex].xyz + moved;
 }
 
 fn other_deformed_position(vertex: u32) -> vec3<f32> {
-    let row = vertex * frame.other_columns;
+    let start = row_start(
+        vertex,
+        frame.other_rows_per_chunk,
+        frame.other_columns,
+        frame.other_first_chunk,
+    );
     var moved = vec3<f32>(0.0);
     for (var column = 0u; column < frame.other_columns; column++) {
-        moved += other_weights[row + column] * other_displacements[column].xyz;
+        moved += chunk_weight(start.x, start.y + column) * other_displacements[column].xyz;
     }
     return rest[vertex].xyz + moved;
 }
@@ -60,16 +69,16 @@ fn vertex_value(vertex: u32, position: vec3<f32>) -> f32 {
     if frame.weights_bound == 0u || columns == 0u {
         return 0.0;
     }
-    let row = vertex * columns;
+    let start = row_start(vertex, frame.rows_per_chunk, columns, 0u);
     switch frame.colouring {
         case COLOURING_COLUMN_WEIGHT: {
             let column = min(frame.colouring_column, columns - 1u);
-            return weights[row + column];
+            return chunk_weight(start.x, start.y + column);
         }
         case COLOURING_MOST_NEGATIVE: {
-            var lowest = weights[row];
+            var lowest = chunk_weight(start.x, start.y);
             for (var column = 1u; column < columns; column++) {
-                lowest = min(lowest, weights[row + column]);
+                lowest = min(lowest, chunk_weight(start.x, start.y + column));
             }
             return lowest;
         }
@@ -155,8 +164,8 @@ fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
 }
 
 // Readback: the same deformation, value and colour into one buffer, so tests and
-// exports can check what the shaders draw (one buffer keeps the compute stage
-// within 8 storage buffers). First per vertex xyz: deformed position, w: the
+// exports can check what the shaders draw (one buffer, for which the pool of
+// weight chunks leaves a storage buffer of the stage free). First per vertex xyz: deformed position, w: the
 // colouring value; then per vertex rgb: the unshaded colour of the value.
 @group(1) @binding(0) var<storage, read_write> output: array<vec4<f32>>;
 

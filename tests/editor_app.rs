@@ -83,13 +83,7 @@ fn default_scene_binds_with_progress_to_completion() {
     assert!(app.document().outside().is_empty());
     // At rest the GPU deformation reproduces the mesh (linear precision).
     let deformed = app.read_back_deformed().unwrap().unwrap();
-    let rest: Vec<glam::Vec3> = app
-        .document()
-        .mesh()
-        .positions
-        .iter()
-        .map(|p| p.as_vec3())
-        .collect();
+    let rest = rest_positions(app);
     assert!(max_distance(&deformed, &rest) < 1e-3);
     assert_viewport_shows_the_mesh(&mut harness);
     harness.snapshot_options("editor_default_scene", &snapshot_options());

@@ -55,6 +55,10 @@ fn frame_uniform_matches_the_wgsl_frame() {
             colouring_column,
             log_scale,
             other_columns,
+            rows_per_chunk,
+            other_rows_per_chunk,
+            other_first_chunk,
+            padding,
         ]
     );
     for source in [

@@ -22,6 +22,14 @@ struct Frame {
     // Columns of the compared method's weights (the difference view); 0 when
     // they are not bound.
     other_columns: u32,
+    // Weights rows per chunk buffer of the method shown (render::weight_chunks).
+    rows_per_chunk: u32,
+    // The same for the compared method.
+    other_rows_per_chunk: u32,
+    // The pool slot of the compared method's first chunk.
+    other_first_chunk: u32,
+    // Makes the size a multiple of 16, as in Rust.
+    padding: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

@@ -11,6 +11,7 @@
 use crate::coords::{BindOptions, BindProgress, Method, WeightQuality, Weights};
 use crate::geometry::{Cage, PointClass};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder};
+use crate::render::weight_chunks::ChunkLimits;
 use glam::DVec3;
 use std::collections::VecDeque;
 use std::sync::{mpsc, Arc, Mutex};
@@ -331,8 +332,16 @@ fn run(
         return Err(JobError::Cancelled);
     }
     // CPU weights serve export and hover read-outs; on a GPU the renderer reads the
-    // resident copy.
-    let gpu_buffer = matches!(backend, Backend::Gpu(_));
+    // resident copy when it fits one storage binding, and uploads the CPU weights in
+    // chunks when it does not.
+    let gpu_buffer = match &backend {
+        Backend::Gpu(context) => {
+            let columns = options.method.columns(&prepared.cage);
+            let rows_per_chunk = ChunkLimits::of(&context.limits).rows_per_chunk(columns);
+            prepared.points.len() as u64 <= rows_per_chunk
+        }
+        Backend::Cpu => false,
+    };
     let binder = Binder::new(backend).with_config(BindConfig {
         cpu_weights: true,
         gpu_buffer,

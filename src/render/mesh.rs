@@ -4,6 +4,7 @@
 
 use super::colormap::LOG_DECADES;
 use super::scene_gpu::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
+use super::weight_chunks::{self, MAX_CHUNK_SLOTS};
 use crate::gpu::shader_source::compose;
 
 const SHADER: &str = include_str!("../../shaders/render_mesh.wgsl");
@@ -11,16 +12,24 @@ const SHADER: &str = include_str!("../../shaders/render_mesh.wgsl");
 /// The shader's `override` constants, from their CPU twins.
 pub(super) const CONSTANTS: &[(&str, f64)] = &[("LOG_DECADES", LOG_DECADES as f64)];
 
-/// `render_mesh.wgsl` with its imports resolved.
+/// `render_mesh.wgsl` with its imports resolved and the largest pool of weight
+/// chunks.
 pub fn shader_source() -> String {
-    // The shared files are compiled in, so only a broken build can fail here.
-    compose("render_mesh.wgsl", SHADER).unwrap_or_else(|error| panic!("{error}"))
+    shader_source_with_chunks(MAX_CHUNK_SLOTS)
 }
 
-pub(super) fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {
+/// `render_mesh.wgsl` with its imports resolved and `chunk_slots` weight chunks.
+pub fn shader_source_with_chunks(chunk_slots: u32) -> String {
+    // The shared files are compiled in, so only a broken build can fail here.
+    let mut source = compose("render_mesh.wgsl", SHADER).unwrap_or_else(|error| panic!("{error}"));
+    source.push_str(&weight_chunks::wgsl(chunk_slots));
+    source
+}
+
+pub(super) fn shader_module(device: &wgpu::Device, chunk_slots: u32) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("render_mesh.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+        source: wgpu::ShaderSource::Wgsl(shader_source_with_chunks(chunk_slots).into()),
     })
 }
 
@@ -32,9 +41,10 @@ impl MeshRenderer {
     pub fn new(
         device: &wgpu::Device,
         scene_layout: &wgpu::BindGroupLayout,
+        chunk_slots: u32,
         sample_count: u32,
     ) -> Self {
-        let module = shader_module(device);
+        let module = shader_module(device, chunk_slots);
         let constants = wgpu::PipelineCompilationOptions {
             constants: CONSTANTS,
             ..Default::default()

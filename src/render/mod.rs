@@ -2,6 +2,8 @@
 //! run one way: the renderers depend on the leaf [`scene_gpu`], and only the
 //! orchestrator [`viewport`] depends on the renderers.
 //! - [`scene_gpu`]: formats, the frame uniform, the scene's buffers and layout;
+//! - [`weight_chunks`]: weights split by rows over several buffers (a leaf that
+//!   [`scene_gpu`] uses);
 //! - [`mesh`]: the deformed mesh (deformation in the vertex shader);
 //! - [`cage`]: the cage's edges and handles;
 //! - [`readback`]: the mesh shader's results read back, for tests and checks;
@@ -20,6 +22,7 @@ pub mod mesh;
 pub mod readback;
 pub mod scene_gpu;
 pub mod viewport;
+pub mod weight_chunks;
 
 pub use camera::{OrbitCamera, ScreenProjection};
 pub use scene_gpu::{FrameUniform, ReadBack};

@@ -13,7 +13,11 @@ pub struct Readback {
 }
 
 impl Readback {
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        chunk_slots: u32,
+    ) -> Self {
         let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deformed output"),
             entries: &[output_entry(0)],
@@ -26,7 +30,7 @@ impl Readback {
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("deform readback"),
             layout: Some(&layout),
-            module: &shader_module(device),
+            module: &shader_module(device, chunk_slots),
             entry_point: Some("cs_deform"),
             compilation_options: wgpu::PipelineCompilationOptions {
                 constants: CONSTANTS,

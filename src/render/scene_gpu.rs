@@ -4,6 +4,7 @@
 //! never on the orchestrator ([`super::viewport`]), as re_renderer's renderers
 //! depend on its global bindings.
 
+use super::weight_chunks::{ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS};
 use crate::coords::Method;
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
@@ -35,17 +36,29 @@ pub struct FrameUniform {
     pub colouring_column: u32,
     pub log_scale: u32,
     pub other_columns: u32,
+    /// Weights rows in each chunk buffer of the family shown
+    /// ([`super::weight_chunks`]).
+    pub rows_per_chunk: u32,
+    /// The same for the compared family.
+    pub other_rows_per_chunk: u32,
+    /// The pool slot of the compared family's first chunk.
+    pub other_first_chunk: u32,
+    /// Rounds the size up to WGSL's 16-byte struct alignment.
+    pub padding: u32,
 }
 
-/// Scene bindings: 0 frame, 1 weights shown, 2 rest positions, 3 cage pose, 4
-/// handle states, 5 compared weights, 6 and 7 the column displacements of each.
-const SCENE_STORAGE_BINDINGS: [u32; 7] = [1, 2, 3, 4, 5, 6, 7];
+/// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family
+/// shown, 3 cage pose, 4 handle states, 5 column displacements of the compared
+/// family; from [`FIRST_CHUNK_BINDING`] the pool of weight chunks.
+const SCENE_STORAGE_BINDINGS: [u32; OTHER_STORAGE_BUFFERS as usize] = [1, 2, 3, 4, 5];
 
-/// Storage buffers the drawing shaders read in one stage.
-pub const STORAGE_BUFFERS_PER_STAGE: u32 = SCENE_STORAGE_BINDINGS.len() as u32;
+/// Storage buffers the drawing shaders read in one stage, with the smallest pool
+/// of weight chunks (one per family).
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = OTHER_STORAGE_BUFFERS + 2;
 
-/// The layout of the scene bind group (group 0 of every viewport shader).
-pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+/// The layout of the scene bind group (group 0 of every viewport shader), with
+/// `chunk_slots` weight chunks.
+pub fn scene_layout(device: &wgpu::Device, chunk_slots: u32) -> wgpu::BindGroupLayout {
     let mut entries = vec![wgpu::BindGroupLayoutEntry {
         binding: 0,
         visibility: wgpu::ShaderStages::VERTEX
@@ -59,6 +72,10 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         count: None,
     }];
     entries.extend(SCENE_STORAGE_BINDINGS.map(|binding| storage_entry(binding, true)));
+    entries.extend(
+        (FIRST_CHUNK_BINDING..FIRST_CHUNK_BINDING + chunk_slots)
+            .map(|binding| storage_entry(binding, true)),
+    );
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("scene"),
         entries: &entries,
@@ -98,10 +115,11 @@ pub fn buffer_with<T: bytemuck::Pod>(
     })
 }
 
-/// One family's weights on the GPU, and how far each of its columns' vectors moved
-/// in the current pose (`Method::column_displacements`).
+/// One family's weights on the GPU, in chunks of whole rows, and how far each of
+/// its columns' vectors moved in the current pose (`Method::column_displacements`).
 pub struct WeightSlot {
-    pub weights: wgpu::Buffer,
+    pub chunks: Vec<wgpu::Buffer>,
+    pub split: ChunkSplit,
     pub displacements: wgpu::Buffer,
     pub columns: u32,
 }
@@ -127,6 +145,8 @@ pub struct SceneGpu {
     /// and only then rounded.
     pub rest_cage: Cage,
     pub pose: Vec<DVec3>,
+    /// How weights are split on this device.
+    pub chunk_limits: ChunkLimits,
     /// Per (family shown, family compared): its bind group, made on first use.
     bind_groups: HashMap<(Method, Option<Method>), wgpu::BindGroup>,
 }
@@ -138,6 +158,7 @@ impl SceneGpu {
         triangles: &[[u32; 3]],
         rest_cage: &Cage,
         cage_edges: &[[u32; 2]],
+        chunk_limits: ChunkLimits,
     ) -> Self {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let rest: Vec<[f32; 4]> = rest_positions
@@ -161,6 +182,7 @@ impl SceneGpu {
             slots: BTreeMap::new(),
             rest_cage: rest_cage.clone(),
             pose,
+            chunk_limits,
             bind_groups: HashMap::new(),
         }
     }
@@ -208,17 +230,24 @@ impl SceneGpu {
         against: Option<Method>,
     ) -> wgpu::BindGroup {
         let slot = |method: Option<Method>| method.and_then(|m| self.slots.get(&m));
-        let weights = |method| slot(method).map_or(&self.placeholder, |s| &s.weights);
         let moves = |method| slot(method).map_or(&self.placeholder, |s| &s.displacements);
         let buffers = [
-            weights(Some(shown)),
             &self.rest,
+            moves(Some(shown)),
             &self.cage,
             &self.handle_state,
-            weights(against),
-            moves(Some(shown)),
             moves(against),
         ];
+        // The pool: the shown family's chunks, then the compared family's.
+        let chunks = [shown].into_iter().chain(against).flat_map(|method| {
+            self.slots
+                .get(&method)
+                .into_iter()
+                .flat_map(|slot| &slot.chunks)
+        });
+        let pool = chunks
+            .chain(std::iter::repeat(&self.placeholder))
+            .take(self.chunk_limits.slots as usize);
         let mut entries = vec![wgpu::BindGroupEntry {
             binding: 0,
             resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
@@ -230,8 +259,10 @@ impl SceneGpu {
         entries.extend(
             SCENE_STORAGE_BINDINGS
                 .iter()
+                .copied()
                 .zip(buffers)
-                .map(|(&binding, buffer)| wgpu::BindGroupEntry {
+                .chain((FIRST_CHUNK_BINDING..).zip(pool))
+                .map(|(binding, buffer)| wgpu::BindGroupEntry {
                     binding,
                     resource: buffer.as_entire_binding(),
                 }),

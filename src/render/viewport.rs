@@ -17,6 +17,7 @@ use super::scene_gpu::{
     buffer_with, points_f32, scene_layout, FrameUniform, ReadBack, SceneGpu, WeightSlot,
     FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
 };
+use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 use crate::coords::{Method, Weights};
 use crate::geometry::Cage;
 use eframe::egui_wgpu;
@@ -39,10 +40,8 @@ const BACKGROUND: wgpu::Color = wgpu::Color {
 /// A failure to put the scene on the GPU.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    #[error(
-        "the weights matrix needs {needed_mib:.1} MiB, but this GPU allows at most {limit_mib:.1} MiB in one storage buffer; use a smaller mesh or cage"
-    )]
-    WeightsTooLarge { needed_mib: f64, limit_mib: f64 },
+    #[error(transparent)]
+    WeightsTooLarge(#[from] ChunksTooLarge),
     #[error("reading the deformed positions back from the GPU failed")]
     ReadBack,
     #[error("no scene is on the GPU")]
@@ -163,7 +162,7 @@ pub struct ViewportRenderer {
     readback: Option<Readback>,
     targets: [Option<OffscreenTarget>; MAX_VIEWS],
     scene: Option<SceneGpu>,
-    max_storage_binding: u64,
+    chunk_limits: ChunkLimits,
     sample_count: u32,
 }
 
@@ -175,16 +174,16 @@ impl ViewportRenderer {
         target_format: wgpu::TextureFormat,
         sample_count: u32,
     ) -> Self {
-        let scene_layout = scene_layout(device);
+        let chunk_limits = ChunkLimits::of(&device.limits());
+        let scene_layout = scene_layout(device, chunk_limits.slots);
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame"),
             size: FRAME_SLOT_BYTES * (MAX_VIEWS as u64 + 1),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let limits = device.limits();
         Self {
-            mesh: MeshRenderer::new(device, &scene_layout, sample_count),
+            mesh: MeshRenderer::new(device, &scene_layout, chunk_limits.slots, sample_count),
             cage: CageRenderer::new(device, &scene_layout, sample_count),
             compositor: Compositor::new(device, target_format),
             readback: None,
@@ -193,9 +192,7 @@ impl ViewportRenderer {
             frame,
             targets: Default::default(),
             scene: None,
-            max_storage_binding: limits
-                .max_storage_buffer_binding_size
-                .min(limits.max_buffer_size),
+            chunk_limits,
         }
     }
 
@@ -209,7 +206,12 @@ impl ViewportRenderer {
             return;
         }
         self.sample_count = sample_count;
-        self.mesh = MeshRenderer::new(device, &self.scene_layout, sample_count);
+        self.mesh = MeshRenderer::new(
+            device,
+            &self.scene_layout,
+            self.chunk_limits.slots,
+            sample_count,
+        );
         self.cage = CageRenderer::new(device, &self.scene_layout, sample_count);
         self.targets = Default::default();
     }
@@ -224,13 +226,15 @@ impl ViewportRenderer {
             scene.triangles,
             scene.cage,
             &edges,
+            self.chunk_limits,
         ));
     }
 
     /// Bind one family's weights (or unbind them with `None`, showing the mesh at
     /// rest in views of that family). A `resident` buffer already holding them on
-    /// this device is used as it is; otherwise they are uploaded. Fails, leaving
-    /// the weights unbound, when the matrix exceeds the GPU's limit.
+    /// this device is used as it is when they fit in one chunk; otherwise they are
+    /// uploaded in chunks ([`super::weight_chunks`]). Fails, leaving the weights
+    /// unbound, when the matrix exceeds what the GPU can bind.
     pub fn set_weights(
         &mut self,
         device: &wgpu::Device,
@@ -238,32 +242,26 @@ impl ViewportRenderer {
         weights: Option<&Weights>,
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
-        let limit = self.max_storage_binding;
         let Some(scene) = self.scene.as_mut() else {
             return Err(RenderError::NoScene);
         };
-        let weights = match weights {
-            Some(weights) if (weights.values.len() as u64) * 4 > limit => {
+        let Some(weights) = weights.filter(|weights| !weights.values.is_empty()) else {
+            scene.set_slot(method, None);
+            return Ok(());
+        };
+        let split = match self.chunk_limits.split(weights.rows, weights.cols) {
+            Ok(split) => split,
+            Err(too_large) => {
                 scene.set_slot(method, None);
-                return Err(RenderError::WeightsTooLarge {
-                    needed_mib: weights.values.len() as f64 * 4.0 / 1048576.0,
-                    limit_mib: limit as f64 / 1048576.0,
-                });
-            }
-            Some(weights) if !weights.values.is_empty() => weights,
-            _ => {
-                scene.set_slot(method, None);
-                return Ok(());
+                return Err(too_large.into());
             }
         };
-        let weights_buffer = match resident {
-            Some(buffer) => buffer.clone(),
-            None => buffer_with(
-                device,
-                "weights",
-                &weights.values,
-                wgpu::BufferUsages::STORAGE,
-            ),
+        let chunks = match resident {
+            Some(buffer) if split.chunks == 1 => vec![buffer.clone()],
+            _ => split
+                .chunks_of(weights)
+                .map(|values| buffer_with(device, "weights", values, wgpu::BufferUsages::STORAGE))
+                .collect(),
         };
         let displacements = buffer_with(
             device,
@@ -274,7 +272,8 @@ impl ViewportRenderer {
         scene.set_slot(
             method,
             Some(WeightSlot {
-                weights: weights_buffer,
+                chunks,
+                split,
                 displacements,
                 columns: weights.cols as u32,
             }),
@@ -333,12 +332,13 @@ impl ViewportRenderer {
 
     fn frame_uniform(&self, params: &FrameParams) -> FrameUniform {
         let shading = &params.shading;
-        let columns_of = |method: Option<Method>| {
+        let slot_of = |method: Option<Method>| {
             let slot = self.scene.as_ref().zip(method);
             slot.and_then(|(scene, method)| scene.slots.get(&method))
-                .map_or(0, |slot| slot.columns)
         };
-        let columns = columns_of(Some(shading.method));
+        let (shown, against) = (slot_of(Some(shading.method)), slot_of(shading.against));
+        let columns = shown.map_or(0, |slot| slot.columns);
+        let rows_per_chunk = |slot: Option<&WeightSlot>| slot.map_or(1, |s| s.split.rows_per_chunk);
         let [colouring, colouring_column] = shading.colouring.code();
         FrameUniform {
             view_projection: params.view_projection.to_cols_array_2d(),
@@ -354,7 +354,12 @@ impl ViewportRenderer {
             colouring,
             colouring_column,
             log_scale: u32::from(shading.scale == Scale::LogMagnitude),
-            other_columns: columns_of(shading.against),
+            other_columns: against.map_or(0, |slot| slot.columns),
+            rows_per_chunk: rows_per_chunk(shown),
+            other_rows_per_chunk: rows_per_chunk(against),
+            // The pool holds the shown family's chunks first (SceneGpu::bind_group).
+            other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
+            padding: 0,
         }
     }
 
@@ -385,9 +390,9 @@ impl ViewportRenderer {
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
-        let readback = self
-            .readback
-            .get_or_insert_with(|| Readback::new(device, &self.scene_layout));
+        let readback = self.readback.get_or_insert_with(|| {
+            Readback::new(device, &self.scene_layout, self.chunk_limits.slots)
+        });
         let Some(scene) = self.scene.as_mut() else {
             return Err(RenderError::NoScene);
         };

@@ -178,3 +178,9 @@ pub fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
         .map(|(p, q)| p.distance(*q))
         .fold(0.0, f32::max)
 }
+
+/// The mesh at rest, in f32.
+pub fn rest_positions(app: &EditorApp) -> Vec<glam::Vec3> {
+    let mesh = app.document().mesh();
+    mesh.positions.iter().map(|p| p.as_vec3()).collect()
+}
