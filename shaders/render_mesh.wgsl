@@ -1,7 +1,8 @@
 // Deformed mesh: the vertex shader computes p' = p + Σ_k W[i,k] · d_k from the
 // dense weights (row-major f32, split by rows over chunk buffers that
-// `chunk_weight` reads; render::weight_chunks appends it and its bindings, whose
-// number depends on the device) and each weights column's displacement d_k
+// `blend_row`, `blend_other_row`, `lowest_in_row` and `chunk_weight` read;
+// render::weight_chunks appends them and their bindings, whose number depends on
+// the device) and each weights column's displacement d_k
 // (`Method::column_displacements`, uploaded per pose change), so the CPU never
 // touches mesh positions per frame. The displacement form is exact at rest for any
 // weights and keeps its precision far from the origin. Normals come from screen-space derivatives of the deformed
@@ -42,11 +43,7 @@ fn deformed_position(vertex: u32) -> vec3<f32> {
         return rest[vertex].xyz;
     }
     let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
-    var moved = vec3<f32>(0.0);
-    for (var column = 0u; column < frame.columns; column++) {
-        moved += chunk_weight(start.x, start.y + column) * displacements[column].xyz;
-    }
-    return rest[vertex].xyz + moved;
+    return rest[vertex].xyz + blend_row(start.x, start.y, frame.columns);
 }
 
 fn other_deformed_position(vertex: u32) -> vec3<f32> {
@@ -56,11 +53,7 @@ fn other_deformed_position(vertex: u32) -> vec3<f32> {
         frame.other_columns,
         frame.other_first_chunk,
     );
-    var moved = vec3<f32>(0.0);
-    for (var column = 0u; column < frame.other_columns; column++) {
-        moved += chunk_weight(start.x, start.y + column) * other_displacements[column].xyz;
-    }
-    return rest[vertex].xyz + moved;
+    return rest[vertex].xyz + blend_other_row(start.x, start.y, frame.other_columns);
 }
 
 // The scalar the mesh is coloured by (0 when shaded or unbound).
@@ -76,11 +69,7 @@ fn vertex_value(vertex: u32, position: vec3<f32>) -> f32 {
             return chunk_weight(start.x, start.y + column);
         }
         case COLOURING_MOST_NEGATIVE: {
-            var lowest = chunk_weight(start.x, start.y);
-            for (var column = 1u; column < columns; column++) {
-                lowest = min(lowest, chunk_weight(start.x, start.y + column));
-            }
-            return lowest;
+            return lowest_in_row(start.x, start.y, columns);
         }
         case COLOURING_METHOD_DISTANCE: {
             if frame.other_columns == 0u {

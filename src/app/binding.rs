@@ -195,6 +195,17 @@ impl EditorApp {
         if let Some(Err(error)) = uploaded {
             self.error(error.to_string());
         }
+        if self.screenshot.is_some() {
+            // A scripted run's record of the bind, for benchmarks.
+            eprintln!(
+                "pmvc editor: bound {} vertices × {} columns ({}, {}) in {:.2} s",
+                outcome.weights.rows,
+                outcome.weights.cols,
+                method.name(),
+                outcome.device,
+                outcome.elapsed.as_secs_f64()
+            );
+        }
         let set = WeightSet {
             weights: outcome.weights,
             options,

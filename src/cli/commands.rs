@@ -343,24 +343,31 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
 }
 
 pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
+    use geometry::procedural::{sculpt_size_scene, table1_scene, SCULPT_SIZE};
     check_output(&args.mesh, &[], &["obj"], "an OBJ mesh")?;
     check_output(&args.cage, &[], &["obj"], "an OBJ cage")?;
-    let scene = geometry::procedural::table1_scene(&args.scene).context("unknown scene")?;
-    let points = geometry::TriMesh {
-        positions: scene.points,
-        ..Default::default()
+    let (mesh, cage) = if args.scene == SCULPT_SIZE {
+        sculpt_size_scene()
+    } else {
+        let scene = table1_scene(&args.scene).context("unknown scene")?;
+        let points = geometry::TriMesh {
+            positions: scene.points,
+            ..Default::default()
+        };
+        (points, scene.cage)
     };
     let cage = geometry::TriMesh {
-        positions: scene.cage.positions().to_vec(),
-        triangles: scene.cage.triangles().to_vec(),
+        positions: cage.positions().to_vec(),
+        triangles: cage.triangles().to_vec(),
         ..Default::default()
     };
-    geometry::write_obj(&args.mesh, &points)?;
+    geometry::write_obj(&args.mesh, &mesh)?;
     geometry::write_obj(&args.cage, &cage)?;
     say!(
-        "{}: {} mesh vertices in a {}-vertex cage",
-        scene.name,
-        points.positions.len(),
+        "{}: {} mesh vertices ({} triangles) in a {}-vertex cage",
+        args.scene,
+        mesh.positions.len(),
+        mesh.triangles.len(),
         cage.positions.len()
     );
     Ok(())

@@ -302,15 +302,22 @@ impl EditArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct GenerateArgs {
-    /// Scene name.
-    #[arg(value_parser = clap::builder::PossibleValuesParser::new(crate::geometry::procedural::table1_scene_names()))]
+    /// Scene name: the paper's Table 1 sizes (point sets), or sculpt-size (a
+    /// million-vertex triangle mesh).
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(generate_scene_names()))]
     pub scene: String,
-    /// Output mesh (a point set) as OBJ.
+    /// Output mesh as OBJ.
     #[arg(long)]
     pub mesh: PathBuf,
     /// Output cage as OBJ.
     #[arg(long)]
     pub cage: PathBuf,
+}
+
+fn generate_scene_names() -> Vec<&'static str> {
+    let mut names = crate::geometry::procedural::table1_scene_names().to_vec();
+    names.push(crate::geometry::procedural::SCULPT_SIZE);
+    names
 }
 
 /// Entry point of the binary: parse, run, report.

@@ -459,3 +459,54 @@ pub fn table1_scene(name: &str) -> Option<Scene> {
     let points = points_inside(&cage, count, 2007, 1e-3);
     Some(Scene { name, cage, points })
 }
+
+/// The name of [`sculpt_size_scene`] for `pmvc generate`.
+pub const SCULPT_SIZE: &str = "sculpt-size";
+
+/// A triangle mesh of about a million vertices, the size of an artist's sculpt, in
+/// a 120-vertex non-convex cage (a six-prong comb, as armadillo-size): a rippled
+/// sheet filling the comb's outline, for the editor's large-mesh benchmark.
+pub fn sculpt_size_scene() -> (TriMesh, Cage) {
+    // Just over a million once the margin strip is left out.
+    const VERTICES: f64 = 1.001e6;
+    const MARGIN: f64 = 0.05;
+    let outline = refine_outline(&comb_outline(6, 1.0, 0.35, 3.0), 60);
+    let cage = extrude(&outline, -0.6, 0.6);
+    let edges = || (0..outline.len()).map(|k| (outline[k], outline[(k + 1) % outline.len()]));
+    let area = 0.5 * edges().map(|(a, b)| a.perp_dot(b)).sum::<f64>();
+    let perimeter: f64 = edges().map(|(a, b)| a.distance(b)).sum();
+    let step = ((area - perimeter * MARGIN) / VERTICES).sqrt();
+    // Inside by the even-odd rule, and MARGIN away from every edge.
+    let keeps = |p: DVec2| {
+        let crossings = edges()
+            .filter(|(a, b)| (a.y > p.y) != (b.y > p.y))
+            .filter(|(a, b)| p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x))
+            .count();
+        let clear = edges().all(|(a, b)| {
+            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            p.distance(a + t * (b - a)) > MARGIN
+        });
+        crossings % 2 == 1 && clear
+    };
+    let (lo, hi) = super::bounds_of(cage.positions());
+    let columns = ((hi.x - lo.x) / step) as usize + 1;
+    let rows = ((hi.y - lo.y) / step) as usize + 1;
+    let mut mesh = TriMesh::default();
+    let mut index = vec![u32::MAX; columns * rows];
+    for (cell, slot) in index.iter_mut().enumerate() {
+        let p = DVec2::new(lo.x, lo.y)
+            + step * DVec2::new((cell % columns) as f64, (cell / columns) as f64);
+        if keeps(p) {
+            *slot = mesh.positions.len() as u32;
+            mesh.positions
+                .push(p.extend(0.3 * (4.0 * p.x).sin() * (3.0 * p.y).cos()));
+        }
+    }
+    for cell in (0..index.len() - columns).filter(|cell| cell % columns + 1 < columns) {
+        let [a, b, c, d] = [cell, cell + 1, cell + columns + 1, cell + columns].map(|k| index[k]);
+        if [a, b, c, d].iter().all(|&k| k != u32::MAX) {
+            mesh.triangles.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    (mesh, cage)
+}
