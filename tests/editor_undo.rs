@@ -187,3 +187,49 @@ fn using_the_pose_as_rest_shape_keeps_the_deformed_mesh_inside_and_is_undoable()
     assert_eq!(app.document().pose(), posed_cage.as_slice());
     assert_gpu_matches_document(app);
 }
+
+/// Saving a pose over the open cage, or exporting over the open mesh (directly or
+/// through a link), is refused with a message and both files stay as they were.
+#[test]
+fn saving_over_the_open_mesh_or_cage_is_refused() {
+    let directory = tempfile::tempdir().unwrap();
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+    let mesh = directory.path().join("mesh.obj");
+    let cage = directory.path().join("cage.obj");
+    std::fs::copy(assets.join("comb_mesh.obj"), &mesh).unwrap();
+    std::fs::copy(assets.join("comb_cage.obj"), &cage).unwrap();
+    let link = directory.path().join("latest.obj");
+    std::os::unix::fs::symlink(&mesh, &link).unwrap();
+    let Some(mut harness) = editor_with(pmvc::app::EditorOptions {
+        mesh: Some(mesh.clone()),
+        cage: Some(cage.clone()),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    let before = (std::fs::read(&mesh).unwrap(), std::fs::read(&cage).unwrap());
+    let app = harness.state_mut();
+    let moved = app.document().pose()[3] + DVec3::new(0.2, 0.0, 0.0);
+    app.set_handle_position(3, moved);
+    app.save_pose(&cage);
+    assert!(app
+        .last_error()
+        .is_some_and(|e| e.contains("never overwrites")));
+    for target in [&mesh, &link] {
+        app.export_deformed(target);
+        let error = app.last_error().unwrap_or_default().to_owned();
+        assert!(
+            error.contains("mesh.obj") && error.contains("never overwrites"),
+            "{error}"
+        );
+    }
+    assert_eq!(
+        (std::fs::read(&mesh).unwrap(), std::fs::read(&cage).unwrap()),
+        before
+    );
+    // Elsewhere, both are written.
+    let elsewhere = directory.path().join("deformed.obj");
+    app.export_deformed(&elsewhere);
+    assert!(elsewhere.exists());
+}

@@ -4,7 +4,9 @@
 use super::document::Document;
 use super::editor::{EditorApp, FileRole};
 use super::scenes::BundledScene;
-use crate::geometry::{load_cage, load_mesh, write_deformed_mesh, write_obj, TriMesh};
+use crate::geometry::{
+    load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_obj, TriMesh,
+};
 use std::path::{Path, PathBuf};
 
 /// Recent files kept in the File menu.
@@ -133,6 +135,9 @@ impl EditorApp {
     }
 
     pub fn save_pose(&mut self, path: &Path) {
+        if !self.refuse_overwriting_open_files(path) {
+            return;
+        }
         let cage = self.document.cage();
         let posed = TriMesh {
             positions: self.document.pose().to_vec(),
@@ -145,8 +150,27 @@ impl EditorApp {
         }
     }
 
+    /// False, with an error, when `path` is (or links to) the open mesh or cage:
+    /// saving a pose over the rest cage, or a deformed mesh over its source, would
+    /// lose the scene's input.
+    fn refuse_overwriting_open_files(&mut self, path: &Path) -> bool {
+        let mut inputs = Vec::new();
+        inputs.extend(self.document.mesh_file().map(|file| file.path.as_path()));
+        inputs.extend(self.document.cage_path());
+        match refuse_same_file(path, &inputs) {
+            Ok(()) => true,
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
+        }
+    }
+
     /// Write the mesh deformed with the active method.
     pub fn export_deformed(&mut self, path: &Path) {
+        if !self.refuse_overwriting_open_files(path) {
+            return;
+        }
         let positions = self.document.deformed_positions(self.active_method());
         let result = match self.document.mesh_file() {
             Some(file) => write_deformed_mesh(file, &positions, path),

@@ -75,8 +75,9 @@ pub struct FamilySpec {
 /// PMVC's default cube-map resolution (texels along one face edge).
 pub const DEFAULT_RESOLUTION: u32 = 32;
 
+// The distance is mvc::FAR_FIELD_DIAGONALS; a test keeps the two in step.
 const OUTSIDE_BY_MVC: &str = "vertices outside the cage get MVC weights (their affine \
-     extension beyond 10 cage diagonals), which sum to one and reproduce their points";
+     extension beyond 4 cage diagonals), which sum to one and reproduce their points";
 
 const MVC: FamilySpec = FamilySpec {
     id: "mvc",
@@ -185,6 +186,15 @@ impl std::fmt::Display for Method {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_outside_policy_names_the_far_field_distance_in_use() {
+        let distance = format!(
+            "beyond {} cage diagonals",
+            crate::coords::mvc::FAR_FIELD_DIAGONALS
+        );
+        assert!(OUTSIDE_BY_MVC.contains(&distance), "{OUTSIDE_BY_MVC}");
+    }
 
     #[test]
     fn identifiers_are_unique_and_round_trip() {
