@@ -9,7 +9,11 @@ use std::path::Path;
 use std::process::Output;
 
 fn bind(mesh: &Path, cage: &Path, out: &Path) -> Output {
-    pmvc(&[
+    bind_with(mesh, cage, out, &[])
+}
+
+fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
         "bind",
         "--mesh",
         path_str(mesh),
@@ -19,7 +23,9 @@ fn bind(mesh: &Path, cage: &Path, out: &Path) -> Output {
         path_str(out),
         "--backend",
         "cpu",
-    ])
+    ];
+    args.extend(extra);
+    pmvc(&args)
 }
 
 fn temporary_files(dir: &Path) -> Vec<String> {
@@ -122,7 +128,8 @@ fn a_bind_that_cannot_fit_in_memory_is_refused_before_the_work() {
     let sphere = pmvc::geometry::procedural::icosphere(1.0, 5);
     let cage = write(dir.path(), "cage.obj", &cage_obj(&sphere));
     let out = dir.path().join("w.npy");
-    let output = bind(&mesh, &cage, &out);
+    // Harmonic coordinates hold every row (one solve for the whole cage).
+    let output = bind_with(&mesh, &cage, &out, &["--method", "harmonic"]);
     assert_clean_failure(&output, "mesh.obj", "memory");
     let text = stderr(&output);
     assert!(
@@ -165,5 +172,33 @@ fn a_signal_during_a_bind_removes_its_temporary_file() {
             "SIG{name}"
         );
         assert!(!out.exists());
+    }
+}
+
+#[test]
+fn a_bind_in_blocks_of_rows_writes_what_the_whole_bind_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 300);
+    for method in ["pmvc", "mvc", "harmonic"] {
+        let whole = dir.path().join(format!("{method}-whole.npy"));
+        let blocks = dir.path().join(format!("{method}-blocks.npy"));
+        let output = bind_with(&mesh, &cage, &whole, &["--method", method]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let args = [
+            "--method",
+            method,
+            "--resolution",
+            "32",
+            "--block-rows",
+            "7",
+        ];
+        let output = bind_with(&mesh, &cage, &blocks, &args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let (whole, blocks) = (
+            std::fs::read(&whole).unwrap(),
+            std::fs::read(&blocks).unwrap(),
+        );
+        assert_eq!(whole.len(), blocks.len(), "{method}");
+        assert!(whole == blocks, "{method}: the weights differ");
     }
 }

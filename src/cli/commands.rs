@@ -1,7 +1,7 @@
 //! The work behind each subcommand.
 
 use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
-use crate::coords::npy::{npy_file_bytes, read_npy, write_npy_to};
+use crate::coords::npy::{npy_file_bytes, npy_preamble, read_npy, write_f32_values, write_npy_to};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{
     self, classify_points, extension_warning, human_bytes, refuse_same_file, Cage, MeshFile,
@@ -20,15 +20,24 @@ pub(super) struct BoundInput {
     pub classes: PointClasses,
 }
 
+/// How many weights rows a command holds in memory at once, given the mesh's
+/// vertex count and the weights' columns: all of them, none, or a block.
+pub(super) type ResidentRows<'a> = &'a dyn Fn(usize, usize) -> usize;
+
 /// Load and validate the inputs, printing the cage's notices and the outside count.
-/// With `will_bind`, a weights matrix that cannot fit in memory is an error before
+/// Weights rows that cannot fit in memory (`resident_rows`) are an error before
 /// any work on the points.
-pub(super) fn load_input(input: &CageInput, strict: bool, will_bind: bool) -> Result<BoundInput> {
+pub(super) fn load_input(
+    input: &CageInput,
+    choice: &MethodChoice,
+    resident_rows: ResidentRows,
+) -> Result<BoundInput> {
+    let strict = choice.strict;
     let mesh = geometry::load_mesh(&input.mesh)?;
     let (cage, report) = geometry::load_cage(&input.cage)?;
-    if will_bind {
-        check_weights_fit(mesh.mesh.positions.len(), cage.vertex_count(), &input.mesh)?;
-    }
+    let columns = choice.method.columns(&cage);
+    let rows = resident_rows(mesh.mesh.positions.len(), columns);
+    check_weights_fit(rows, columns, &input.mesh)?;
     for message in report.messages() {
         warn_line!("pmvc: {}: {message}", input.cage.display());
     }
@@ -82,30 +91,60 @@ fn compute_weights_on(
     choice: &MethodChoice,
     backend: Backend,
 ) -> Result<Weights> {
-    let options = choice.options();
-    let points = &input.mesh.mesh.positions;
-    let bar = progress_bar(points.len() as u64, options.method);
+    let rows = input.mesh.mesh.positions.len();
+    let bar = progress_bar(rows as u64, choice.method);
+    let weights = bind_rows(input, 0..rows, choice, &backend, &bar)?;
+    bar.finish_and_clear();
+    Ok(weights)
+}
+
+/// Bind the points in `range`, moving `bar` on from the range's start.
+fn bind_rows(
+    input: &BoundInput,
+    range: std::ops::Range<usize>,
+    choice: &MethodChoice,
+    backend: &Backend,
+    bar: &indicatif::ProgressBar,
+) -> Result<Weights> {
     let bind_input = BindInput {
-        points: points.as_slice().into(),
-        classes: input.classes.classes.as_slice().into(),
+        points: input.mesh.mesh.positions[range.clone()].into(),
+        classes: input.classes.classes[range.clone()].into(),
         cage: Arc::new(input.cage.clone()),
-        options,
+        options: choice.options(),
     };
     let output = if bar.is_hidden() {
         // Nothing to show: wait on the bind directly, not in steps of the poll below.
-        Binder::new(backend).bind_blocking(&bind_input, &BindProgress::default())?
+        Binder::new(backend.clone()).bind_blocking(&bind_input, &BindProgress::default())?
     } else {
-        let handle = Binder::new(backend).start(bind_input);
+        let handle = Binder::new(backend.clone()).start(bind_input);
         while !handle.is_finished() {
-            bar.set_position(handle.progress().done() as u64);
+            bar.set_position((range.start + handle.progress().done()) as u64);
             std::thread::sleep(Duration::from_millis(50));
         }
-        bar.finish_and_clear();
         handle.wait()?
     };
     output
         .weights
         .context("internal error: the bind returned no CPU weights")
+}
+
+/// Rows a streamed bind computes and writes at a time when `--block-rows` is not
+/// given: 256 MiB of weights, so that memory stays flat however large the mesh.
+const BLOCK_BYTES: usize = 256 << 20;
+
+/// Rows held at once by `pmvc bind`: everything for a family that solves for the
+/// whole cage, a block for one whose rows are independent.
+fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
+    if args.method.method.spec().rows_independent {
+        let block = args
+            .block_rows
+            .map_or(BLOCK_BYTES / (4 * columns.max(1)), |rows| {
+                usize::try_from(rows).unwrap_or(usize::MAX)
+            });
+        rows.min(block.max(1))
+    } else {
+        rows
+    }
 }
 
 /// `auto` binds on a hardware GPU when there is one. With only a software adapter
@@ -183,20 +222,48 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     // on the driver: do it while the inputs load and are classified.
     let choice = args.method.backend;
     let probe = std::thread::spawn(move || choose_backend(choice));
-    let input = load_input(&args.input, args.method.strict, true)?;
+    let input = load_input(&args.input, &args.method, &|rows, columns| {
+        bind_resident_rows(args, rows, columns)
+    })?;
     let backend = probe
         .join()
         .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
+    let rows = input.mesh.mesh.positions.len();
+    let columns = args.method.method.columns(&input.cage);
     // Opened before the work, so that a full disk or an unwritable folder is
     // reported now, and a signal during the bind removes the temporary file.
     let output = PendingOutput::create(&args.out)?;
-    output.check_space(npy_file_bytes(
-        input.mesh.mesh.positions.len(),
-        input.cage.vertex_count(),
-    ))?;
-    let weights = compute_weights_on(&input, &args.method, backend)?;
-    write_npy_to(output, &args.out, &weights)?;
-    Ok(())
+    output.check_space(npy_file_bytes(rows, columns))?;
+    let block = bind_resident_rows(args, rows, columns);
+    if block >= rows {
+        let weights = compute_weights_on(&input, &args.method, backend)?;
+        write_npy_to(output, &args.out, &weights)?;
+        return Ok(());
+    }
+    // In blocks of rows, each written as soon as it is bound: memory stays at one
+    // block, and the disk is the only limit.
+    let preamble = npy_preamble(&args.out, rows, columns)?;
+    let bar = progress_bar(rows as u64, args.method.method);
+    let mut bind_error = None;
+    let written = output.finish(|out| {
+        out.write_all(&preamble)?;
+        for start in (0..rows).step_by(block) {
+            let range = start..(start + block).min(rows);
+            match bind_rows(&input, range, &args.method, &backend, &bar) {
+                Ok(weights) => write_f32_values(out, &weights.values)?,
+                Err(error) => {
+                    bind_error = Some(error);
+                    return Err(std::io::Error::other("the bind failed"));
+                }
+            }
+        }
+        Ok(())
+    });
+    bar.finish_and_clear();
+    match (bind_error, written) {
+        (Some(error), _) => Err(error),
+        (None, result) => Ok(result?),
+    }
 }
 
 pub(super) fn deform(args: &DeformArgs) -> Result<()> {
@@ -207,7 +274,14 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     ];
     inputs.extend(args.weights.as_deref());
     check_output(&args.out, &inputs, &["obj"], "an OBJ mesh")?;
-    let input = load_input(&args.input, args.method.strict, args.weights.is_none())?;
+    let holds_weights = args.weights.is_none();
+    let input = load_input(&args.input, &args.method, &|rows, _| {
+        if holds_weights {
+            rows
+        } else {
+            0
+        }
+    })?;
     let pose = geometry::load_mesh(&args.deformed_cage)?;
     let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
     if found != expected {

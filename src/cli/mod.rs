@@ -134,6 +134,11 @@ pub struct BindArgs {
     /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order.
     #[arg(long, value_name = "W.npy")]
     pub out: PathBuf,
+    /// Bind and write this many rows at a time, so that memory holds one block
+    /// (MVC and PMVC; default: 256 MiB of weights). Harmonic coordinates solve for
+    /// the whole cage at once and hold every row.
+    #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
+    pub block_rows: Option<u64>,
 }
 
 #[derive(Debug, clap::Args)]

@@ -70,6 +70,10 @@ pub struct FamilySpec {
     pub positive_inside: bool,
     /// How a mesh vertex outside the cage is treated, in one sentence.
     pub outside_policy: &'static str,
+    /// Whether each weights row depends only on its own point, so that a large
+    /// bind can be computed and written in blocks of rows. False for a family
+    /// that solves once for the whole cage (harmonic coordinates' grid).
+    pub rows_independent: bool,
 }
 
 /// PMVC's default cube-map resolution (texels along one face edge).
@@ -87,6 +91,7 @@ const MVC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: false,
     outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
 };
 
 const PMVC: FamilySpec = FamilySpec {
@@ -104,6 +109,7 @@ const PMVC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
 };
 
 const HARMONIC: FamilySpec = FamilySpec {
@@ -121,6 +127,7 @@ const HARMONIC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: false,
 };
 
 impl Method {

@@ -55,26 +55,39 @@ fn npy_header(rows: usize, cols: usize) -> String {
     header
 }
 
-/// [`write_npy`] into an output opened before the weights were computed.
-pub fn write_npy_to(output: PendingOutput, path: &Path, weights: &Weights) -> Result<(), NpyError> {
-    let header = npy_header(weights.rows, weights.cols);
+/// The bytes before the values of a `rows` × `cols` float32 `.npy` file: magic,
+/// version, header length and header. For writers that stream the values.
+pub fn npy_preamble(path: &Path, rows: usize, cols: usize) -> Result<Vec<u8>, NpyError> {
+    let header = npy_header(rows, cols);
     let header_len = u16::try_from(header.len()).map_err(|_| NpyError::HeaderTooLong {
         path: path.to_owned(),
-        rows: weights.rows,
-        cols: weights.cols,
+        rows,
+        cols,
     })?;
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&header_len.to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    Ok(bytes)
+}
+
+/// `values` as little-endian float32.
+pub fn write_f32_values(out: &mut dyn std::io::Write, values: &[f32]) -> std::io::Result<()> {
+    // In blocks rather than element by element, which took tens of milliseconds.
+    let mut block = Vec::with_capacity(1 << 16);
+    for values in values.chunks(1 << 14) {
+        block.clear();
+        block.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        out.write_all(&block)?;
+    }
+    Ok(())
+}
+
+/// [`write_npy`] into an output opened before the weights were computed.
+pub fn write_npy_to(output: PendingOutput, path: &Path, weights: &Weights) -> Result<(), NpyError> {
+    let preamble = npy_preamble(path, weights.rows, weights.cols)?;
     output.finish(|out| {
-        out.write_all(b"\x93NUMPY\x01\x00")?;
-        out.write_all(&header_len.to_le_bytes())?;
-        out.write_all(header.as_bytes())?;
-        // In blocks rather than element by element, which took tens of milliseconds.
-        let mut block = Vec::with_capacity(1 << 16);
-        for values in weights.values.chunks(1 << 14) {
-            block.clear();
-            block.extend(values.iter().flat_map(|v| v.to_le_bytes()));
-            out.write_all(&block)?;
-        }
-        Ok(())
+        out.write_all(&preamble)?;
+        write_f32_values(out, &weights.values)
     })?;
     Ok(())
 }
