@@ -156,3 +156,37 @@ fn outside_vertices_are_reported_apart_from_the_inside_ones() {
     harness.get_by_label("outside: with λ < 0 (MVC)");
     harness.get_by_label("inside: vertices with λ < 0");
 }
+
+/// The viewport's rectangle, which must not move under the cursor.
+fn viewport_rect(harness: &Harness<'static, EditorApp>) -> egui::Rect {
+    harness.state().pane_rects()[0].1
+}
+
+/// Selecting a handle (its x/y/z row) and starting a bind (its progress line) must
+/// not widen the side panel and shift the model under the cursor.
+#[test]
+fn selecting_a_handle_or_binding_keeps_the_viewport_still() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let before = viewport_rect(&harness);
+    let (handle, at) = isolated_handle(&harness);
+    click(&mut harness, at);
+    assert_eq!(
+        harness.state().document().selection().len(),
+        1,
+        "handle {handle} selected"
+    );
+    harness.run_steps(3);
+    assert_eq!(viewport_rect(&harness), before, "after selecting a handle");
+    // Long numbers in the handle's x/y/z fields.
+    let far = glam::DVec3::new(-10.1234, -10.1234, -10.1234);
+    harness.state_mut().set_handle_position(handle, far);
+    harness.run_steps(3);
+    assert_eq!(viewport_rect(&harness), before, "with long coordinates");
+    harness.state_mut().set_resolution(24);
+    harness.run_steps(3);
+    assert!(harness.state().is_binding());
+    assert_eq!(viewport_rect(&harness), before, "while binding");
+    run_until_bound(&mut harness);
+    assert_eq!(viewport_rect(&harness), before, "after the bind");
+}

@@ -113,8 +113,16 @@ impl EditorApp {
         if let (1, Some(&handle)) = (selection.len(), selection.iter().next()) {
             let mut position = self.document.pose()[handle];
             let (mut changed, mut drag_started, mut drag_stopped) = (false, false, false);
+            ui.label(format!("Handle {handle}"));
+            // Fields of a fixed share of the panel: a field sized by its number
+            // would widen the panel and move the model under the cursor.
             ui.horizontal(|ui| {
-                ui.label(format!("Handle {handle}"));
+                let spacing = ui.spacing().item_spacing.x;
+                let label_width = 3.0 * (ui.spacing().icon_width + 2.0 * spacing);
+                let field_size = egui::vec2(
+                    ((ui.available_width() - label_width) / 3.0).max(40.0),
+                    ui.spacing().interact_size.y,
+                );
                 for (label, value) in [
                     ("x", &mut position.x),
                     ("y", &mut position.y),
@@ -122,7 +130,10 @@ impl EditorApp {
                 ] {
                     let label = ui.label(label);
                     let field = ui
-                        .add(egui::DragValue::new(value).speed(0.01).max_decimals(4))
+                        .add_sized(
+                            field_size,
+                            egui::DragValue::new(value).speed(0.01).max_decimals(4),
+                        )
                         .labelled_by(label.id);
                     changed |= field.changed();
                     drag_started |= field.drag_started();
