@@ -486,3 +486,74 @@ fn closed_stdout_and_full_stderr_end_cleanly() {
         assert!(dir.path().join("w.npy").exists());
     }
 }
+
+/// Run `pmvc` with a terminal as its stderr (util-linux `script`); what it
+/// printed there.
+fn on_a_terminal(args: &[&str]) -> Option<String> {
+    let command: Vec<String> = std::iter::once(env!("CARGO_BIN_EXE_pmvc"))
+        .chain(args.iter().copied())
+        .map(|a| format!("'{a}'"))
+        .collect();
+    let output = std::process::Command::new("script")
+        .args(["-qec", &command.join(" "), "/dev/null"])
+        .output()
+        .ok()?;
+    assert!(output.status.success(), "{}", stderr(&output));
+    Some(String::from_utf8_lossy(&output.stdout).into_owned())
+}
+
+#[test]
+fn bind_and_deform_say_what_they_wrote_on_a_terminal_and_nothing_on_a_pipe() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, comb, _) = comb_scene(dir.path(), 50);
+    let weights = dir.path().join("w.npy");
+    let deformed = dir.path().join("deformed.obj");
+    let bind = [
+        "bind",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage),
+        "--out",
+        path_str(&weights),
+        "--backend",
+        "cpu",
+    ];
+    let deform = [
+        "deform",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage),
+        "--deformed-cage",
+        path_str(&cage),
+        "--weights",
+        path_str(&weights),
+        "--out",
+        path_str(&deformed),
+    ];
+    let Some(said) = on_a_terminal(&bind) else {
+        println!("not run: no `script` command to give pmvc a terminal");
+        return;
+    };
+    let expected = format!(
+        "pmvc: wrote {}: 50 × {} float32 weights (PMVC 32², CPU) in ",
+        weights.display(),
+        comb.vertex_count()
+    );
+    assert!(said.contains(&expected), "{said}");
+    assert!(said.contains("; all vertices inside the cage"), "{said}");
+    let said = on_a_terminal(&deform).unwrap();
+    let expected = format!(
+        "pmvc: wrote {}: 50 vertices deformed with weights from {} in ",
+        deformed.display(),
+        weights.display()
+    );
+    assert!(said.contains(&expected), "{said}");
+    // A pipe, as in scripts: nothing.
+    for args in [&bind[..], &deform[..]] {
+        let output = pmvc(args);
+        assert!(output.status.success());
+        assert_eq!(stderr(&output), "", "{args:?}");
+    }
+}

@@ -10,6 +10,7 @@ use crate::geometry::{
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
+use std::io::Write as _;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -93,19 +94,20 @@ fn compute_weights_on(
 ) -> Result<Weights> {
     let rows = input.mesh.mesh.positions.len();
     let bar = progress_bar(rows as u64, choice.method);
-    let weights = bind_rows(input, 0..rows, choice, &backend, &bar)?;
+    let (weights, _) = bind_rows(input, 0..rows, choice, &backend, &bar)?;
     bar.finish_and_clear();
     Ok(weights)
 }
 
-/// Bind the points in `range`, moving `bar` on from the range's start.
+/// Bind the points in `range`, moving `bar` on from the range's start. Returns
+/// the weights and where they were computed.
 fn bind_rows(
     input: &BoundInput,
     range: std::ops::Range<usize>,
     choice: &MethodChoice,
     backend: &Backend,
     bar: &indicatif::ProgressBar,
-) -> Result<Weights> {
+) -> Result<(Weights, String)> {
     let bind_input = BindInput {
         points: input.mesh.mesh.positions[range.clone()].into(),
         classes: input.classes.classes[range.clone()].into(),
@@ -123,9 +125,37 @@ fn bind_rows(
         }
         handle.wait()?
     };
-    output
+    let weights = output
         .weights
-        .context("internal error: the bind returned no CPU weights")
+        .context("internal error: the bind returned no CPU weights")?;
+    Ok((weights, output.stats.device))
+}
+
+/// What a bind used, for the summary line: "PMVC 32²", "harmonic grid 64", "MVC".
+fn method_label(choice: &MethodChoice) -> String {
+    use crate::coords::Parameter;
+    let name = choice.method.name();
+    match choice.method.spec().parameter.as_ref().map(|p| p.key) {
+        Some(Parameter::Resolution) => format!("{name} {}²", choice.resolution),
+        Some(Parameter::Grid) => format!("{name} grid {}", choice.grid),
+        None => name.to_owned(),
+    }
+}
+
+/// One line on stderr when it is a terminal: what was written and how. Scripts
+/// reading a pipe get nothing, as before.
+fn summary(line: std::fmt::Arguments) {
+    use std::io::IsTerminal;
+    if std::io::stderr().is_terminal() {
+        let _ = writeln!(std::io::stderr(), "pmvc: {line}");
+    }
+}
+
+fn outside_note(input: &BoundInput) -> String {
+    match input.classes.outside.len() {
+        0 => "all vertices inside the cage".to_owned(),
+        n => format!("{n} vertices outside the cage"),
+    }
 }
 
 /// Rows a streamed bind computes and writes at a time when `--block-rows` is not
@@ -234,23 +264,50 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     // reported now, and a signal during the bind removes the temporary file.
     let output = PendingOutput::create(&args.out)?;
     output.check_space(npy_file_bytes(rows, columns))?;
+    let started = std::time::Instant::now();
+    let device = bind_to(args, &input, backend, output, rows, columns)?;
+    summary(format_args!(
+        "wrote {}: {rows} × {columns} float32 weights ({}, {device}) in {:.2} s; {}",
+        args.out.display(),
+        method_label(&args.method),
+        started.elapsed().as_secs_f64(),
+        outside_note(&input)
+    ));
+    Ok(())
+}
+
+/// Bind and write the weights, whole or in blocks of rows; returns where they
+/// were computed.
+fn bind_to(
+    args: &BindArgs,
+    input: &BoundInput,
+    backend: Backend,
+    output: PendingOutput,
+    rows: usize,
+    columns: usize,
+) -> Result<String> {
     let block = bind_resident_rows(args, rows, columns);
+    let bar = progress_bar(rows as u64, args.method.method);
     if block >= rows {
-        let weights = compute_weights_on(&input, &args.method, backend)?;
+        let (weights, device) = bind_rows(input, 0..rows, &args.method, &backend, &bar)?;
+        bar.finish_and_clear();
         write_npy_to(output, &args.out, &weights)?;
-        return Ok(());
+        return Ok(device);
     }
     // In blocks of rows, each written as soon as it is bound: memory stays at one
     // block, and the disk is the only limit.
     let preamble = npy_preamble(&args.out, rows, columns)?;
-    let bar = progress_bar(rows as u64, args.method.method);
     let mut bind_error = None;
+    let mut device = String::new();
     let written = output.finish(|out| {
         out.write_all(&preamble)?;
         for start in (0..rows).step_by(block) {
             let range = start..(start + block).min(rows);
-            match bind_rows(&input, range, &args.method, &backend, &bar) {
-                Ok(weights) => write_f32_values(out, &weights.values)?,
+            match bind_rows(input, range, &args.method, &backend, &bar) {
+                Ok((weights, used)) => {
+                    device = used;
+                    write_f32_values(out, &weights.values)?
+                }
                 Err(error) => {
                     bind_error = Some(error);
                     return Err(std::io::Error::other("the bind failed"));
@@ -262,11 +319,12 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     bar.finish_and_clear();
     match (bind_error, written) {
         (Some(error), _) => Err(error),
-        (None, result) => Ok(result?),
+        (None, result) => Ok(result.map(|()| device)?),
     }
 }
 
 pub(super) fn deform(args: &DeformArgs) -> Result<()> {
+    let started = std::time::Instant::now();
     let mut inputs = vec![
         args.input.mesh.as_path(),
         args.input.cage.as_path(),
@@ -315,6 +373,17 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         .column_displacements(&input.cage, &pose.mesh.positions);
     let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
     geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+    let source = match &args.weights {
+        Some(path) => format!("weights from {}", path.display()),
+        None => format!("{} weights", method_label(&args.method)),
+    };
+    summary(format_args!(
+        "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",
+        args.out.display(),
+        deformed.len(),
+        started.elapsed().as_secs_f64(),
+        outside_note(&input)
+    ));
     Ok(())
 }
 
