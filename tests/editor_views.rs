@@ -190,3 +190,38 @@ fn selecting_a_handle_or_binding_keeps_the_viewport_still() {
     run_until_bound(&mut harness);
     assert_eq!(viewport_rect(&harness), before, "after the bind");
 }
+
+fn asked_for_focus(harness: &Harness<'static, EditorApp>) -> bool {
+    harness
+        .output()
+        .viewport_output
+        .values()
+        .flat_map(|viewport| &viewport.commands)
+        .any(|command| matches!(command, egui::ViewportCommand::Focus))
+}
+
+/// Under a bare X server the window starts without keyboard focus and a click
+/// does not give it: the editor asks for focus, and again on a click without it.
+#[test]
+fn the_window_asks_for_keyboard_focus_at_start_and_on_a_click() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.run_steps(2);
+    assert!(!asked_for_focus(&harness), "asks once, not every frame");
+    let viewports = &mut harness.input_mut().viewports;
+    viewports.entry(egui::ViewportId::ROOT).or_default().focused = Some(false);
+    let at = egui::pos2(400.0, 600.0);
+    harness.hover_at(at);
+    harness.step();
+    harness.event(egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.step();
+    assert!(
+        asked_for_focus(&harness),
+        "a click without focus asks again"
+    );
+}

@@ -57,6 +57,8 @@ pub struct EditorApp {
     pub(super) recent: Vec<(FileRole, PathBuf)>,
     pub(super) path_input: String,
     pub(super) screenshot: Option<ScreenshotState>,
+    /// Frames drawn, up to a limit, for asking for keyboard focus at start.
+    pub(super) focus_frames: u32,
     /// After a cancel, views stop asking for binds until the user binds again.
     pub(super) binding_paused: bool,
     /// Show no timings, so frames are deterministic (snapshot tests).
@@ -127,6 +129,7 @@ impl EditorApp {
             recent: Vec::new(),
             path_input: String::new(),
             screenshot: options.screenshot.map(ScreenshotState::new),
+            focus_frames: 0,
             binding_paused: false,
             hide_timings: options.hide_timings,
             numeric_drag_start: None,
@@ -457,9 +460,10 @@ impl EditorApp {
 }
 
 impl eframe::App for EditorApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.stats.record_frame(ctx.input(|i| i.time));
+        self.ask_for_keyboard_focus(&ctx, frame);
         self.poll_bind();
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);

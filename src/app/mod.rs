@@ -18,6 +18,7 @@ pub mod compare;
 pub mod document;
 pub mod editor;
 mod files;
+mod focus;
 pub mod history;
 mod readouts;
 pub mod scene_history;
