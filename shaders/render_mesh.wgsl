@@ -26,6 +26,8 @@
 const NEGATIVE = vec3<f32>(0.16, 0.29, 0.80);
 const ZERO = vec3<f32>(0.97, 0.97, 0.97);
 const POSITIVE = vec3<f32>(0.80, 0.08, 0.10);
+// colormap::OUTSIDE: the negativity view's vertices outside the cage.
+const OUTSIDE = vec3<f32>(0.55, 0.55, 0.55);
 // Set from colormap::LOG_DECADES when the pipeline is made.
 override LOG_DECADES: f32 = 3.0;
 const LN_10: f32 = 2.302585093;
@@ -111,11 +113,22 @@ fn heat_colour(value: f32) -> vec3<f32> {
     return diverging(scaled(value, frame.colour_limit, frame.log_scale == 1u));
 }
 
+// A vertex's colour: the heat colour of its value, but grey in the negativity
+// view for a vertex outside the cage, whose weights follow the outside policy.
+fn value_colour(value: f32, outside_cage: bool) -> vec3<f32> {
+    if frame.colouring == COLOURING_MOST_NEGATIVE && outside_cage {
+        return OUTSIDE;
+    }
+    return heat_colour(value);
+}
+
 struct MeshVarying {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) outside: f32,
     @location(2) value: f32,
+    // 1 for a vertex outside the cage, whether or not it is highlighted.
+    @location(3) outside_cage: f32,
 }
 
 @vertex
@@ -126,6 +139,7 @@ fn vs_mesh(@builtin(vertex_index) vertex: u32) -> MeshVarying {
     out.world = world;
     out.outside = rest[vertex].w * f32(frame.highlight_outside);
     out.value = vertex_value(vertex, world);
+    out.outside_cage = rest[vertex].w;
     return out;
 }
 
@@ -147,7 +161,8 @@ fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
         colour = base * (0.18 + diffuse) + vec3<f32>(specular);
     } else {
         // Mostly flat colour, so the map reads true; a little shading keeps the shape.
-        colour = heat_colour(in.value) * (0.55 + 0.53 * diffuse) + vec3<f32>(0.3 * specular);
+        colour = value_colour(in.value, in.outside_cage > 0.5) * (0.55 + 0.53 * diffuse)
+            + vec3<f32>(0.3 * specular);
     }
     return vec4<f32>(min(colour, vec3<f32>(1.0)), 1.0);
 }
@@ -166,5 +181,5 @@ fn cs_deform(@builtin(global_invocation_id) id: vec3<u32>) {
     let position = deformed_position(id.x);
     let value = vertex_value(id.x, position);
     output[id.x] = vec4<f32>(position, value);
-    output[frame.vertex_count + id.x] = vec4<f32>(heat_colour(value), 1.0);
+    output[frame.vertex_count + id.x] = vec4<f32>(value_colour(value, rest[id.x].w > 0.5), 1.0);
 }

@@ -155,6 +155,69 @@ fn outside_vertices_are_reported_apart_from_the_inside_ones() {
     use egui_kittest::kittest::Queryable;
     harness.get_by_label("outside: with λ < 0 (MVC)");
     harness.get_by_label("inside: vertices with λ < 0");
+
+    // The negativity view paints the outside vertex grey, not as negativity, on
+    // a log scale by default; the inside one gets its heat colour.
+    use pmvc::app::compare::Overlay;
+    use pmvc::render::colormap::{self, Scale};
+    harness.state_mut().view_mut().overlay = Overlay::Negativity;
+    harness.run_steps(2);
+    for method in [Method::Mvc, Method::Pmvc] {
+        let shading = harness.state_mut().shading_of(Pane::Method(method));
+        assert_eq!(shading.scale, Scale::LogMagnitude);
+        let read = harness.state().read_back(&shading).unwrap().unwrap();
+        let close = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-3);
+        assert!(
+            close(read.colours[1], colormap::OUTSIDE),
+            "{method}: {:?}",
+            read.colours[1]
+        );
+        let inside = colormap::heat_colour(read.values[0], shading.colour_limit, shading.scale);
+        assert!(close(read.colours[0], inside), "{method}");
+    }
+    // The toolbar's scale buttons set the negativity view's scale alone.
+    *harness.state_mut().view_mut().overlay_scale_mut() = Scale::Linear;
+    assert_eq!(harness.state().view().negativity_scale, Scale::Linear);
+    assert_eq!(harness.state().view().scale, Scale::Linear);
+    harness.state_mut().view_mut().overlay = Overlay::Heatmap;
+    *harness.state_mut().view_mut().overlay_scale_mut() = Scale::LogMagnitude;
+    assert_eq!(harness.state().view().negativity_scale, Scale::Linear);
+}
+
+/// With every weight at zero or above and every row's smallest weight zero (the
+/// mesh's vertices on the cage's corners), the negativity scale ends at its floor:
+/// a magnitude of 0 is not stretched to full colour, nor does the bar claim ±1.
+#[test]
+fn the_negativity_scale_has_a_floor() {
+    use pmvc::app::compare::{Overlay, NEGATIVITY_FLOOR};
+    use pmvc::app::editor::FileRole;
+    let Some(mut harness) = editor_with(EditorOptions::default()) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = pmvc::geometry::procedural::icosphere(1.0, 1);
+    let cage = common::write(dir.path(), "sphere.obj", &common::cage_obj(&sphere));
+    let corners = common::write(
+        dir.path(),
+        "corners.obj",
+        &common::points_obj(sphere.positions()),
+    );
+    assert!(harness.state_mut().open_file(FileRole::Cage, &cage));
+    assert!(harness.state_mut().open_file(FileRole::Mesh, &corners));
+    run_until_bound(&mut harness);
+    harness.state_mut().view_mut().overlay = Overlay::Negativity;
+    harness.run_steps(2);
+    let shading = harness.state_mut().shading_of(Pane::Method(Method::Pmvc));
+    assert_eq!(shading.colour_limit, NEGATIVITY_FLOOR);
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    let white = pmvc::render::colormap::ZERO;
+    for colour in &read.colours {
+        assert!(
+            colour.iter().zip(white).all(|(a, b)| (a - b).abs() < 1e-3),
+            "{colour:?}"
+        );
+    }
 }
 
 /// The viewport's rectangle, which must not move under the cursor.

@@ -108,6 +108,12 @@ impl MethodSet {
 /// also on the log scale's three decades.
 pub const DIFFERENCE_FLOOR: f32 = 1e-3;
 
+/// The smallest magnitude the negativity view's scale ends at: a weight of
+/// −0.001 moves a vertex by a thousandth of its handle's motion. With no larger
+/// negative weight in view (a convex cage), rounding noise of −1e-9 then stays
+/// white instead of being stretched to full blue.
+pub const NEGATIVITY_FLOOR: f32 = 1e-3;
+
 /// The comparison settings, as the toolbar and `pmvc edit --view …` set them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
@@ -115,7 +121,12 @@ pub struct ViewSettings {
     pub overlay: Overlay,
     /// The cage vertex whose coordinate function the heatmap shows.
     pub heat_vertex: usize,
+    /// The scale of the heatmap and the difference view.
     pub scale: Scale,
+    /// The scale of the negativity view: logarithmic by default, because on real
+    /// models MVC's negative weights are mostly a few thousandths and a linear
+    /// scale leaves them almost white.
+    pub negativity_scale: Scale,
     /// The methods the side-by-side layout shows, left to right in
     /// [`Method::ALL`] order.
     pub compared: MethodSet,
@@ -141,6 +152,7 @@ impl Default for ViewSettings {
             overlay: Overlay::Shaded,
             heat_vertex: 0,
             scale: Scale::Linear,
+            negativity_scale: Scale::LogMagnitude,
             compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
             difference: [Method::Mvc, Method::Pmvc],
             difference_pane: false,
@@ -192,6 +204,23 @@ impl ViewSettings {
         }
     }
 
+    /// The colour scale of `colouring`.
+    pub fn scale_of(&self, colouring: Colouring) -> Scale {
+        match colouring {
+            Colouring::MostNegativeWeight => self.negativity_scale,
+            _ => self.scale,
+        }
+    }
+
+    /// The scale the toolbar's Linear/Log buttons set: the negativity view's while
+    /// it is shown, the shared one otherwise.
+    pub fn overlay_scale_mut(&mut self) -> &mut Scale {
+        match self.overlay {
+            Overlay::Negativity => &mut self.negativity_scale,
+            _ => &mut self.scale,
+        }
+    }
+
     /// Whether hovering the mesh in `pane` shows the weights under the cursor.
     pub fn shows_hover(&self, pane: Pane) -> bool {
         self.hover_in_shaded || self.colouring(pane) != Colouring::Shaded
@@ -238,7 +267,10 @@ pub fn column_range(weights: &Weights, column: usize) -> Option<ValueRange> {
 }
 
 /// Range over the mesh of each vertex's most negative (smallest) weight.
-pub fn row_minimum_range(weights: &Weights) -> Option<ValueRange> {
+/// Range of the rows' smallest weights, leaving out the rows in `outside`
+/// (ascending): their weights follow the outside policy, not the family, and the
+/// negativity view paints them apart.
+pub fn row_minimum_range(weights: &Weights, outside: &[u32]) -> Option<ValueRange> {
     if weights.cols == 0 {
         return None;
     }
@@ -246,7 +278,9 @@ pub fn row_minimum_range(weights: &Weights) -> Option<ValueRange> {
         weights
             .values
             .chunks_exact(weights.cols)
-            .map(|row| row.iter().copied().fold(f32::INFINITY, f32::min)),
+            .enumerate()
+            .filter(|(row, _)| outside.binary_search(&(*row as u32)).is_err())
+            .map(|(_, row)| row.iter().copied().fold(f32::INFINITY, f32::min)),
     )
 }
 
@@ -374,11 +408,16 @@ mod tests {
         );
         assert_eq!(column_range(&weights, 3), None);
         assert_eq!(
-            row_minimum_range(&weights),
+            row_minimum_range(&weights, &[]),
             Some(ValueRange {
                 min: -0.1,
                 max: 0.2
             })
+        );
+        // An outside row is left out.
+        assert_eq!(
+            row_minimum_range(&weights, &[0]),
+            Some(ValueRange { min: 0.2, max: 0.2 })
         );
         assert_eq!(
             ValueRange {

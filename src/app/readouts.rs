@@ -107,7 +107,8 @@ impl EditorApp {
                 compare::column_range(self.document.weights(method)?, vertex as usize)
             }
             Colouring::MostNegativeWeight => {
-                compare::row_minimum_range(self.document.weights(method)?)
+                let weights = self.document.weights(method)?;
+                compare::row_minimum_range(weights, self.document.outside())
             }
             Colouring::MethodDistance => {
                 let Pane::Difference { against, shown } = pane else {
@@ -132,6 +133,7 @@ impl EditorApp {
         }
         let floor = match colouring {
             Colouring::MethodDistance => compare::DIFFERENCE_FLOOR,
+            Colouring::MostNegativeWeight => compare::NEGATIVITY_FLOOR,
             _ => 0.0,
         };
         let panes: Vec<Pane> = match colouring {
@@ -164,7 +166,7 @@ impl EditorApp {
                 Pane::Method(_) => None,
             },
             colouring,
-            scale: self.view.scale,
+            scale: self.view.scale_of(colouring),
             colour_limit: self.colour_limit(colouring, pane),
             cage_size: compare::cage_size(self.document.cage().positions()) as f32,
         }

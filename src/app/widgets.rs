@@ -20,6 +20,7 @@ pub fn draw_colour_bar(
     shading: &Shading,
     range: ValueRange,
     title: String,
+    note: Option<String>,
 ) {
     let signed = shading.colouring != Colouring::MethodDistance;
     let limit = shading.colour_limit;
@@ -28,7 +29,10 @@ pub fn draw_colour_bar(
         Pos2::new(rect.left() + 16.0, rect.bottom() - 42.0),
         egui::vec2((rect.width() - 32.0).clamp(60.0, 320.0), 14.0),
     );
-    let backdrop = bar.expand2(egui::vec2(8.0, 22.0));
+    let mut backdrop = bar.expand2(egui::vec2(8.0, 22.0));
+    if note.is_some() {
+        backdrop.min.y -= 18.0;
+    }
     painter.rect_filled(backdrop, 4.0, Color32::from_black_alpha(140));
     let steps = 64;
     let mut mesh = egui::Mesh::default();
@@ -65,9 +69,9 @@ pub fn draw_colour_bar(
     let font = egui::FontId::proportional(12.0);
     let text = Color32::from_gray(235);
     let log = if shading.scale == Scale::LogMagnitude {
-        " · log scale"
+        format!(" · log scale, {} decades", colormap::LOG_DECADES)
     } else {
-        ""
+        " · linear scale".to_owned()
     };
     painter.text(
         bar.left_top() - egui::vec2(0.0, 4.0),
@@ -76,6 +80,20 @@ pub fn draw_colour_bar(
         font.clone(),
         text,
     );
+    if let Some(note) = note {
+        let swatch = Rect::from_min_size(
+            bar.left_top() - egui::vec2(0.0, 36.0),
+            egui::vec2(12.0, 12.0),
+        );
+        painter.rect_filled(swatch, 2.0, colour32(colormap::OUTSIDE));
+        painter.text(
+            swatch.right_center() + egui::vec2(6.0, 0.0),
+            egui::Align2::LEFT_CENTER,
+            note,
+            font.clone(),
+            text,
+        );
+    }
     // Distances read as a share of the cage diagonal; the log scale's left end
     // is where it stops resolving, not zero.
     let number = |value: f32| if signed { short(value) } else { percent(value) };

@@ -210,9 +210,12 @@ pub struct EditArgs {
     /// Colour the mesh by each vertex's most negative weight.
     #[arg(long)]
     pub negativity: bool,
-    /// Show heatmap magnitudes on a log scale (three decades).
+    /// Show heatmap and difference magnitudes on a log scale (three decades).
     #[arg(long)]
     pub log_scale: bool,
+    /// Show the negativity view on a linear scale instead of its default log scale.
+    #[arg(long)]
+    pub linear_negativity: bool,
     /// End the difference view's colour scale at this distance, in % of the cage
     /// diagonal, instead of at the largest distance (at least 0.1%): pictures of
     /// several runs then share one scale.
@@ -284,6 +287,9 @@ impl EditArgs {
         }
         if self.log_scale {
             view.scale = crate::render::colormap::Scale::LogMagnitude;
+        }
+        if self.linear_negativity {
+            view.negativity_scale = crate::render::colormap::Scale::Linear;
         }
         view.difference_limit = self.difference_limit.map(|percent| percent / 100.0);
         crate::app::EditorOptions {
@@ -442,6 +448,10 @@ mod tests {
         assert_eq!(options.view.layout, Layout::Single);
         assert_eq!(options.method, Some(Method::Mvc));
         assert_eq!(options.view.overlay, Overlay::Negativity);
+        use crate::render::colormap::Scale;
+        assert_eq!(options.view.negativity_scale, Scale::LogMagnitude);
+        let linear = edit_options(&["--negativity", "--linear-negativity"]);
+        assert_eq!(linear.view.negativity_scale, Scale::Linear);
         assert_eq!(
             edit_options(&["--view", "difference"]).view.layout,
             Layout::Difference

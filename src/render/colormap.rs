@@ -12,6 +12,10 @@ pub const NEGATIVE: [f32; 3] = [0.16, 0.29, 0.80];
 pub const ZERO: [f32; 3] = [0.97, 0.97, 0.97];
 /// Colour at t = +1.
 pub const POSITIVE: [f32; 3] = [0.80, 0.08, 0.10];
+/// The negativity view's colour for a vertex outside the cage: its weights are
+/// MVC's by the outside policy, not the shown family's, so they are not painted
+/// as that family's negativity.
+pub const OUTSIDE: [f32; 3] = [0.55, 0.55, 0.55];
 /// Decades of magnitude shown by the log scale: |v| from `limit`·10⁻³ to `limit`.
 pub const LOG_DECADES: f32 = 3.0;
 

@@ -42,8 +42,9 @@ impl EditorApp {
                     .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
             }
             if self.view.overlay != Overlay::Shaded || self.view.layout != Layout::Single {
-                ui.selectable_value(&mut self.view.scale, Scale::Linear, "Linear");
-                ui.selectable_value(&mut self.view.scale, Scale::LogMagnitude, "Log");
+                let scale = self.view.overlay_scale_mut();
+                ui.selectable_value(scale, Scale::Linear, "Linear");
+                ui.selectable_value(scale, Scale::LogMagnitude, "Log");
             }
         });
     }

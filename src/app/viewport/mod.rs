@@ -262,7 +262,9 @@ impl EditorApp {
         }
         if shading.colouring != Colouring::Shaded {
             if let Some(range) = self.value_range(shading.colouring, kind) {
-                draw_colour_bar(&painter, rect, &shading, range, self.colour_bar_title(kind));
+                let note = self.colour_bar_note(shading.colouring);
+                let title = self.colour_bar_title(kind);
+                draw_colour_bar(&painter, rect, &shading, range, title, note);
             }
         }
     }
@@ -290,6 +292,14 @@ impl EditorApp {
                 format!("{against} vs {shown}: distance / cage diagonal")
             }
         }
+    }
+
+    /// The negativity view's legend for the vertices outside the cage, when
+    /// there are any: grey, and why.
+    fn colour_bar_note(&self, colouring: Colouring) -> Option<String> {
+        let outside = self.document.outside().len();
+        (colouring == Colouring::MostNegativeWeight && outside > 0)
+            .then(|| format!("{outside} outside the cage (MVC by policy), not counted"))
     }
 
     fn colour_bar_title(&self, kind: Pane) -> String {
