@@ -233,3 +233,80 @@ fn saving_over_the_open_mesh_or_cage_is_refused() {
     app.export_deformed(&elsewhere);
     assert!(elsewhere.exists());
 }
+
+/// The window system's close button, as eframe hands it to egui.
+fn close_window(harness: &mut Harness<'static, EditorApp>) {
+    harness
+        .input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    harness.run_steps(2);
+}
+
+#[test]
+fn quitting_with_an_unsaved_pose_asks_first() {
+    use egui_kittest::kittest::Queryable;
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    let rest = harness.state().document().pose()[3];
+    harness
+        .state_mut()
+        .set_handle_position(3, rest + DVec3::new(0.0, 0.5, 0.0));
+
+    // Ctrl+Q asks; Cancel keeps the editor and the pose.
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Q);
+    harness.run_steps(2);
+    assert!(harness.state().is_asking_to_quit());
+    harness.get_by_label("Cancel").click();
+    harness.run_steps(2);
+    assert!(!harness.state().is_asking_to_quit());
+    assert!(!harness.state().quit_confirmed());
+
+    // The window's close button asks too.
+    close_window(&mut harness);
+    assert!(harness.state().is_asking_to_quit());
+    assert!(!harness.state().quit_confirmed());
+
+    // Save pose… from the question, in the in-window dialog: saved, then closed.
+    harness.get_by_label("Save pose…").click();
+    harness.run_steps(2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("before-quit.obj");
+    harness.get_by_label("File name:").focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::A);
+    harness
+        .get_by_label("File name:")
+        .type_text(path.to_str().unwrap());
+    harness.step();
+    harness.key_press(Key::Enter);
+    harness.run_steps(2);
+    let saved = pmvc::geometry::load_mesh(&path).expect("the pose was saved");
+    assert_eq!(saved.mesh.positions, harness.state().document().pose());
+    assert!(harness.state().quit_confirmed());
+
+    // Quit without saving, in a second editor.
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Quit (Ctrl+Q)").click();
+    harness.run_steps(2);
+    assert!(
+        harness.state().quit_confirmed(),
+        "at rest there is nothing to lose: no question"
+    );
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness
+        .state_mut()
+        .set_handle_position(3, rest + DVec3::new(0.0, 0.5, 0.0));
+    close_window(&mut harness);
+    harness.get_by_label("Quit without saving").click();
+    harness.run_steps(2);
+    assert!(harness.state().quit_confirmed());
+}

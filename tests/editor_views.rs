@@ -288,3 +288,55 @@ fn the_window_asks_for_keyboard_focus_at_start_and_on_a_click() {
         "a click without focus asks again"
     );
 }
+
+#[test]
+fn the_first_run_shows_mvc_and_pmvc_apart_at_once() {
+    use egui_kittest::kittest::Queryable;
+    let Some(mut harness) = editor_with(EditorOptions::first_run()) else {
+        return;
+    };
+    // The side-by-side view binds PMVC, then MVC.
+    for _ in 0..10 {
+        run_until_bound(&mut harness);
+        harness.run_steps(2);
+    }
+    let app = harness.state();
+    assert!(app.document().weights(Method::Mvc).is_some());
+    assert!(app.document().weights(Method::Pmvc).is_some());
+    assert_eq!(app.view().layout, Layout::SideBySide);
+    assert!(app.view().difference_pane);
+    assert_ne!(app.document().pose(), app.document().cage().positions());
+    assert!(
+        !app.pose_is_unsaved(),
+        "the bundled pose is not unsaved work"
+    );
+    harness.get_by_label(pmvc::app::ui::toolbar::FIRST_RUN_LINE);
+
+    // What the views show, as the vertex shader computes it: MVC's and PMVC's
+    // meshes are apart by a visible share of the cage.
+    let deformed = |method| {
+        let shading = pmvc::render::Shading {
+            method,
+            ..Default::default()
+        };
+        app.read_back(&shading).unwrap().unwrap().positions
+    };
+    let apart = max_distance(&deformed(Method::Mvc), &deformed(Method::Pmvc));
+    let diagonal = app.document().cage().diagonal() as f32;
+    assert!(
+        apart > 0.05 * diagonal,
+        "MVC and PMVC differ by only {:.2}% of the cage diagonal",
+        100.0 * apart / diagonal
+    );
+
+    harness.get_by_label("Hide").click();
+    harness.run_steps(2);
+    assert!(harness
+        .query_by_label(pmvc::app::ui::toolbar::FIRST_RUN_LINE)
+        .is_none());
+    // The pose is an ordinary edit: Ctrl+Z returns to rest.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    let app = harness.state();
+    assert_eq!(app.document().pose(), app.document().cage().positions());
+}

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Smoke test of the real editor binary under Xvfb on a software Vulkan driver:
-#  1. `--screenshot` run: the default scene binds and a PNG of the window is saved;
+#  1. `--screenshot` runs: the default scene and the first-run scene bind and a PNG
+#     of the window is saved;
 #     a scripted run with a missing --pose must exit with status 1;
 #  2. an interactive run: xdotool drags across the viewport (orbiting the view, or
 #     moving a handle if one is under the cursor), presses M to switch between MVC
@@ -31,6 +32,11 @@ timeout 300 "$PMVC_EDITOR" edit --screenshot "$out/default-scene.png" 2>"$out/sc
 echo "   saved $out/default-scene.png in $(( $(date +%s) - start )) s"
 grep "frame time" "$out/screenshot-run.log" || true
 test -s "$out/default-scene.png"
+
+echo "== the first-run scene (pmvc alone): MVC, PMVC and their difference"
+timeout 300 "$PMVC_EDITOR" edit --demo --screenshot "$out/first-run.png" 2>"$out/first-run.log" || {
+  cat "$out/first-run.log"; exit 1; }
+test -s "$out/first-run.png"
 
 echo "== a scripted run that fails must say so"
 if timeout 300 "$PMVC_EDITOR" edit --pose "$out/no-such-pose.obj" --screenshot "$out/failed-run.png" \

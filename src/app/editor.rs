@@ -12,7 +12,9 @@ use super::scene_history::SceneHistory;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::drop_dialog::DroppedFile;
+use super::ui::file_dialog::FileDialogs;
 use super::ui::notices::Notices;
+use super::ui::quit_dialog::QuitState;
 use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
@@ -55,7 +57,10 @@ pub struct EditorApp {
     pub(super) show_statistics: bool,
     pub(super) highlight_outside: bool,
     pub(super) recent: Vec<(FileRole, PathBuf)>,
-    pub(super) path_input: String,
+    /// The system's or the in-window file dialog.
+    pub(super) file_dialogs: FileDialogs,
+    /// Quitting asks first when the pose is unsaved.
+    pub(super) quit: QuitState,
     pub(super) screenshot: Option<ScreenshotState>,
     /// Frames drawn, up to a limit, for asking for keyboard focus at start.
     pub(super) focus_frames: u32,
@@ -63,6 +68,8 @@ pub struct EditorApp {
     pub(super) binding_paused: bool,
     /// Show no timings, so frames are deterministic (snapshot tests).
     pub(super) hide_timings: bool,
+    /// The first run's line saying what to look at, until it is dismissed.
+    pub(super) first_run_hint: bool,
     /// The pose when a drag on a numeric position field began.
     pub(super) numeric_drag_start: Option<Vec<DVec3>>,
     /// Documents replaced by opening files, switching scenes and cage edits.
@@ -127,11 +134,13 @@ impl EditorApp {
             show_statistics: false,
             highlight_outside: false,
             recent: Vec::new(),
-            path_input: String::new(),
+            file_dialogs: FileDialogs::default(),
+            quit: QuitState::default(),
             screenshot: options.screenshot.map(ScreenshotState::new),
             focus_frames: 0,
             binding_paused: false,
             hide_timings: options.hide_timings,
+            first_run_hint: false,
             numeric_drag_start: None,
             scene_history: SceneHistory::default(),
             dropped: None,
@@ -149,6 +158,14 @@ impl EditorApp {
         }
         if !opened {
             app.install_document(app.document.clone());
+        }
+        if options.demo_pose && !opened {
+            let pose = scenes::comb_demo_pose(app.document.cage());
+            app.document.edit_pose(pose);
+            // Bundled, so there is nothing to lose on quitting.
+            app.mark_pose_saved();
+            app.first_run_hint = true;
+            app.frame_scene();
         }
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
@@ -218,6 +235,16 @@ impl EditorApp {
     /// The weights under the cursor, and the view they were read in.
     pub fn hover_readout(&self) -> Option<&(usize, HoverReadout)> {
         self.viewport.hover_readout.as_ref()
+    }
+
+    /// A dialog (file, quit or dropped file) waits for the user.
+    pub fn modal_dialog_open(&self) -> bool {
+        self.file_dialogs.is_open() || self.is_asking_to_quit() || self.dropped.is_some()
+    }
+
+    /// Use the in-window file dialog (true) or the system's (false).
+    pub fn set_in_window_file_dialog(&mut self, in_window: bool) {
+        self.file_dialogs.in_window = in_window;
     }
 
     pub fn notices(&self) -> &Notices {
@@ -463,12 +490,16 @@ impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.stats.record_frame(ctx.input(|i| i.time));
+        self.intercept_close(&ctx);
         self.ask_for_keyboard_focus(&ctx, frame);
         self.poll_bind();
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
+        if self.first_run_hint {
+            egui::Panel::top("first run").show(ui, |ui| self.first_run_line(ui));
+        }
         egui::Panel::right("side")
             .default_size(300.0)
             .show(ui, |ui| {
@@ -476,6 +507,9 @@ impl eframe::App for EditorApp {
             });
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
         self.drop_dialog(&ctx);
+        // The question first: its Save pose… opens the file dialog in this frame.
+        self.quit_dialog(&ctx);
+        self.file_dialog_window(&ctx);
         self.request_wanted_binds();
         if self.show_statistics {
             // Keep frames coming so the readout measures rendering, not idling.

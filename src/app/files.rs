@@ -7,7 +7,7 @@ use super::scenes::BundledScene;
 use crate::geometry::{
     load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_obj, TriMesh,
 };
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Recent files kept in the File menu.
 const RECENT_LIMIT: usize = 8;
@@ -116,6 +116,7 @@ impl EditorApp {
         match load_mesh(path) {
             Ok(file) if file.mesh.positions.len() == cage_vertices => {
                 self.document.edit_pose(file.mesh.positions);
+                self.mark_pose_saved();
                 self.info(format!("loaded pose {}", path.display()));
                 true
             }
@@ -134,9 +135,10 @@ impl EditorApp {
         }
     }
 
-    pub fn save_pose(&mut self, path: &Path) {
+    /// Write the pose as a cage-shaped OBJ; true when it was written.
+    pub fn save_pose(&mut self, path: &Path) -> bool {
         if !self.refuse_overwriting_open_files(path) {
-            return;
+            return false;
         }
         let cage = self.document.cage();
         let posed = TriMesh {
@@ -145,8 +147,15 @@ impl EditorApp {
             triangle_faces: cage.triangle_faces().to_vec(),
         };
         match write_obj(path, &posed) {
-            Ok(()) => self.info(format!("saved pose {}", path.display())),
-            Err(error) => self.error(error.to_string()),
+            Ok(()) => {
+                self.mark_pose_saved();
+                self.info(format!("saved pose {}", path.display()));
+                true
+            }
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
         }
     }
 
@@ -166,10 +175,10 @@ impl EditorApp {
         }
     }
 
-    /// Write the mesh deformed with the active method.
-    pub fn export_deformed(&mut self, path: &Path) {
+    /// Write the mesh deformed with the active method; true when it was written.
+    pub fn export_deformed(&mut self, path: &Path) -> bool {
         if !self.refuse_overwriting_open_files(path) {
-            return;
+            return false;
         }
         let positions = self.document.deformed_positions(self.active_method());
         let result = match self.document.mesh_file() {
@@ -183,8 +192,14 @@ impl EditorApp {
             ),
         };
         match result {
-            Ok(()) => self.info(format!("exported {}", path.display())),
-            Err(error) => self.error(error.to_string()),
+            Ok(()) => {
+                self.info(format!("exported {}", path.display()));
+                true
+            }
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
         }
     }
 
@@ -219,21 +234,4 @@ impl EditorApp {
         ));
         self.start_bind();
     }
-}
-
-/// The system's file dialog for opening a mesh-like file.
-pub(super) fn pick_file(title: &str) -> Option<PathBuf> {
-    rfd::FileDialog::new()
-        .set_title(title)
-        .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
-        .pick_file()
-}
-
-/// The system's file dialog for saving an OBJ.
-pub(super) fn save_file(title: &str, name: &str) -> Option<PathBuf> {
-    rfd::FileDialog::new()
-        .set_title(title)
-        .set_file_name(name)
-        .add_filter("OBJ", &["obj"])
-        .save_file()
 }

@@ -55,6 +55,24 @@ pub struct EditorOptions {
     /// Show no timings (bind and elapsed times), so that frames are deterministic
     /// (snapshot tests).
     pub hide_timings: bool,
+    /// Start the bundled comb in its demonstration pose (`scenes::comb_demo_pose`),
+    /// with a line saying what to look at: what `pmvc` with no arguments opens.
+    pub demo_pose: bool,
+}
+
+impl EditorOptions {
+    /// The first run (`pmvc`, `cargo run --release`): the comb with its middle
+    /// finger pulled up, MVC and PMVC side by side with the distance between them,
+    /// so that MVC's pull on the neighbouring fingers shows at once.
+    pub fn first_run() -> Self {
+        let mut options = Self {
+            demo_pose: true,
+            ..Self::default()
+        };
+        options.view.layout = compare::Layout::SideBySide;
+        options.view.difference_pane = true;
+        options
+    }
 }
 
 /// Where the editor binds. On a GPU it binds on the editor's own device, and the

@@ -79,6 +79,36 @@ pub fn comb_cage() -> Cage {
     extrude(&outline, -depth, depth)
 }
 
+/// How far the first run's pose pulls the middle prong's tip: up, along the
+/// finger, by this many finger widths.
+const DEMO_LIFT: f64 = 4.5;
+
+/// The first run's pose of the comb cage: the middle prong's tip pulled up. MVC
+/// give the neighbouring fingers negative weights for those handles, so they
+/// sink and bend toward it; PMVC leave them where they are. The difference is
+/// a visible share of the cage (tests/editor_views.rs measures it).
+pub fn comb_demo_pose(cage: &Cage) -> Vec<DVec3> {
+    let top = cage
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let middle = COMB_FINGERS / 2;
+    let left = middle as f64 * (FINGER_WIDTH + FINGER_GAP) - CAGE_MARGIN;
+    let right = left + FINGER_WIDTH + 2.0 * CAGE_MARGIN;
+    let on_middle_tip = |p: &DVec3| p.y > top - 1e-9 && p.x > left - 1e-9 && p.x < right + 1e-9;
+    cage.positions()
+        .iter()
+        .map(|p| {
+            if on_middle_tip(p) {
+                *p + DVec3::new(0.0, DEMO_LIFT * FINGER_WIDTH, 0.0)
+            } else {
+                *p
+            }
+        })
+        .collect()
+}
+
 /// The default scene's mesh: a rounded-box palm with five capsule-like fingers,
 /// each a finely tessellated superellipsoid (about 7,500 vertices in all).
 pub fn comb_mesh() -> TriMesh {
@@ -174,4 +204,58 @@ fn append_superellipsoid(
 /// under its path in the source tree (which the messages name).
 fn bundled_mesh(path: &str, text: &str) -> Result<MeshFile, LoadError> {
     parse_mesh(Path::new(path), text.to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coords::{bind_cpu, BindOptions, BindProgress, Method};
+    use crate::geometry::classify_points;
+
+    /// The first run's claim: under MVC the fingers beside the pulled one sink by
+    /// a visible share of the cage; under PMVC they do not move.
+    #[test]
+    fn the_demo_pose_sinks_the_neighbouring_fingers_under_mvc_only() {
+        let (mesh, cage) = (comb_mesh(), comb_cage());
+        let classes = classify_points(&cage, &mesh.positions).classes;
+        let pose = comb_demo_pose(&cage);
+        let moves: Vec<DVec3> = pose
+            .iter()
+            .zip(cage.positions())
+            .map(|(a, b)| *a - *b)
+            .collect();
+        assert_eq!(moves.iter().filter(|m| **m != DVec3::ZERO).count(), 4);
+        // Mesh vertices of the second and fourth fingers, above the palm.
+        let pitch = FINGER_WIDTH + FINGER_GAP;
+        let neighbours: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&i| {
+                let p = mesh.positions[i];
+                let finger = (p.x / pitch).floor() as usize;
+                (finger == 1 || finger == 3) && p.y > 1.5 * FINGER_WIDTH
+            })
+            .collect();
+        assert!(neighbours.len() > 1000);
+        let largest_move = |method| {
+            let options = BindOptions::for_method(method);
+            let progress = BindProgress::new(mesh.positions.len());
+            let weights = bind_cpu(&mesh.positions, &classes, &cage, options, &progress).unwrap();
+            let deformed = weights.apply_displacements(&mesh.positions, &moves);
+            let largest = neighbours
+                .iter()
+                .map(|&i| deformed[i] - mesh.positions[i])
+                .max_by(|a, b| a.length().total_cmp(&b.length()))
+                .unwrap();
+            largest / cage.diagonal()
+        };
+        let mvc = largest_move(Method::Mvc);
+        assert!(
+            mvc.y < -0.05,
+            "MVC: the neighbours sink by {mvc:?} diagonals"
+        );
+        let pmvc = largest_move(Method::Pmvc);
+        assert!(
+            pmvc.length() < 1e-6,
+            "PMVC: the neighbours move {pmvc:?} diagonals"
+        );
+    }
 }

@@ -221,6 +221,11 @@ pub struct EditArgs {
     /// several runs then share one scale.
     #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
     pub difference_limit: Option<f32>,
+    /// Open the bundled comb with its middle finger pulled up, MVC and PMVC side
+    /// by side with their difference (unless --view says otherwise): what `pmvc`
+    /// with no arguments opens.
+    #[arg(long, conflicts_with_all = ["mesh", "pose"])]
+    pub demo: bool,
 }
 
 /// What the editor's viewport shows.
@@ -273,6 +278,10 @@ impl EditArgs {
             Some(ViewArg::SideBySide) => view.layout = Layout::SideBySide,
             Some(ViewArg::Difference) => view.layout = Layout::Difference,
             None if !self.compare.is_empty() => view.layout = Layout::SideBySide,
+            None if self.demo => {
+                view.layout = Layout::SideBySide;
+                view.difference_pane = true;
+            }
             None => {}
         }
         if !self.compare.is_empty() {
@@ -307,6 +316,7 @@ impl EditArgs {
             },
             view,
             hide_timings: false,
+            demo_pose: self.demo,
         }
     }
 }
@@ -354,7 +364,7 @@ pub fn main() -> ExitCode {
         environment::remove_unfinished_outputs_on_signals();
     }
     let result = match cli.command {
-        None => crate::app::run_editor(crate::app::EditorOptions::default())
+        None => crate::app::run_editor(crate::app::EditorOptions::first_run())
             .map_err(anyhow::Error::from),
         Some(Command::Edit(args)) => {
             crate::app::run_editor(args.editor_options()).map_err(anyhow::Error::from)
@@ -426,6 +436,19 @@ mod tests {
             Some(Command::Edit(args)) => args.editor_options(),
             other => panic!("not an edit command: {other:?}"),
         }
+    }
+
+    #[test]
+    fn demo_opens_the_posed_comb_side_by_side_unless_a_view_is_given() {
+        let options = edit_options(&["--demo"]);
+        assert!(options.demo_pose);
+        assert_eq!(options.view.layout, Layout::SideBySide);
+        assert!(options.view.difference_pane);
+        let options = edit_options(&["--demo", "--view", "difference"]);
+        assert!(options.demo_pose);
+        assert_eq!(options.view.layout, Layout::Difference);
+        assert!(!edit_options(&[]).demo_pose);
+        assert!(Cli::try_parse_from(["pmvc", "edit", "--demo", "m.obj", "c.obj"]).is_err());
     }
 
     #[test]

@@ -133,6 +133,7 @@ impl EditorApp {
             DropChoice::Pose => {
                 if dropped.vertex_count() == self.document.pose().len() {
                     self.document.edit_pose(dropped.file.mesh.positions);
+                    self.mark_pose_saved();
                     self.info(format!("loaded pose {}", dropped.path.display()));
                 }
             }

@@ -1,10 +1,9 @@
 //! The menu bar: File, Edit, View and Scenes.
 
 use crate::app::editor::{EditorApp, FileRole};
-use crate::app::files::{pick_file, save_file};
 use crate::app::scenes::BundledScene;
+use crate::app::ui::file_dialog::FileAction;
 use crate::render::viewport::MSAA_SAMPLES;
-use std::path::PathBuf;
 
 impl EditorApp {
     pub(in crate::app) fn menu_bar(&mut self, ui: &mut egui::Ui) {
@@ -25,28 +24,11 @@ impl EditorApp {
 
     fn file_menu(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
         if ui.button("Open mesh…").clicked() {
-            if let Some(path) = pick_file("Open mesh") {
-                self.open_file(FileRole::Mesh, &path);
-            }
+            self.ask_for_file(FileAction::OpenMesh);
         }
         if ui.button("Open cage…").clicked() {
-            if let Some(path) = pick_file("Open cage") {
-                self.open_file(FileRole::Cage, &path);
-            }
+            self.ask_for_file(FileAction::OpenCage);
         }
-        ui.horizontal(|ui| {
-            ui.label("Path:");
-            ui.text_edit_singleline(&mut self.path_input);
-        });
-        ui.horizontal(|ui| {
-            let path = PathBuf::from(self.path_input.trim());
-            if ui.button("Open as mesh").clicked() {
-                self.open_file(FileRole::Mesh, &path);
-            }
-            if ui.button("Open as cage").clicked() {
-                self.open_file(FileRole::Cage, &path);
-            }
-        });
         ui.menu_button("Recent files", |ui| {
             if self.recent.is_empty() {
                 ui.label("(none)");
@@ -63,23 +45,23 @@ impl EditorApp {
         });
         ui.separator();
         if ui.button("Load pose…").clicked() {
-            if let Some(path) = pick_file("Load pose") {
-                self.load_pose(&path);
-            }
+            self.ask_for_file(FileAction::LoadPose);
         }
         if ui.button("Save pose…").clicked() {
-            if let Some(path) = save_file("Save pose", "pose.obj") {
-                self.save_pose(&path);
-            }
+            self.ask_for_file(FileAction::SavePose);
         }
         if ui.button("Export deformed mesh…").clicked() {
-            if let Some(path) = save_file("Export deformed mesh", "deformed.obj") {
-                self.export_deformed(&path);
-            }
+            self.ask_for_file(FileAction::ExportMesh);
         }
         ui.separator();
-        if ui.button("Quit").clicked() {
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        ui.checkbox(&mut self.file_dialogs.in_window, "In-window file dialog")
+            .on_hover_text(
+                "Use pmvc's own file dialog instead of the system's. It is chosen by itself \
+                 where the system's cannot appear (no desktop portal).",
+            );
+        ui.separator();
+        if ui.button("Quit (Ctrl+Q)").clicked() {
+            self.request_quit(ctx);
         }
     }
 

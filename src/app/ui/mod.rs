@@ -2,9 +2,11 @@
 //! `impl EditorApp` method that draws its panel and calls the editor's actions.
 
 pub mod drop_dialog;
+pub mod file_dialog;
 pub mod menu;
 pub mod notices;
 pub mod quality_table;
+pub mod quit_dialog;
 pub mod side_panel;
 pub mod statistics;
 pub mod toolbar;

@@ -7,7 +7,22 @@ use crate::coords::Method;
 use crate::render::colormap::Scale;
 use crate::render::Colouring;
 
+/// What the first run shows, in one line.
+pub const FIRST_RUN_LINE: &str = "The middle finger's handles are pulled up. \
+    Left, MVC: negative weights make the fingers beside it sink. Middle, PMVC: they stay. \
+    Right: the distance between the two. Drag any handle to try.";
+
 impl EditorApp {
+    /// The first run's line, with a button that dismisses it.
+    pub(in crate::app) fn first_run_line(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            if ui.small_button("Hide").clicked() {
+                self.first_run_hint = false;
+            }
+            ui.label(egui::RichText::new(FIRST_RUN_LINE).strong());
+        });
+    }
+
     pub(in crate::app) fn toolbar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
             ui.label("Method (M):");

@@ -165,7 +165,13 @@ impl EditorApp {
     }
 
     pub(in crate::app) fn handle_shortcuts(&mut self, ctx: &egui::Context) {
-        if ctx.egui_wants_keyboard_input() {
+        let quit = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
+        if ctx.input_mut(|i| i.consume_shortcut(&quit)) {
+            self.request_quit(ctx);
+        }
+        // A dialog's fields and keys are its own; M or F typed into a path must not
+        // switch the method or move the camera.
+        if ctx.egui_wants_keyboard_input() || self.modal_dialog_open() {
             return;
         }
         let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);

@@ -1,0 +1,392 @@
+//! File dialogs that always appear. The system's dialog (rfd, through the desktop
+//! portal) is used where it works. Where it cannot appear (a bare X session, many
+//! window managers, WSL, containers: no portal answers), or when the user asks for
+//! it in the File menu, a dialog inside the window takes its place: it browses
+//! folders, lists meshes, and takes a typed path for every file action.
+
+use crate::app::editor::{EditorApp, FileRole};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// A system dialog that comes back empty sooner than this was never shown: no
+/// person cancels a dialog that fast.
+const SYSTEM_DIALOG_MIN_TIME: Duration = Duration::from_millis(250);
+
+/// What a file dialog is asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileAction {
+    OpenMesh,
+    OpenCage,
+    LoadPose,
+    SavePose,
+    ExportMesh,
+}
+
+impl FileAction {
+    pub fn title(self) -> &'static str {
+        match self {
+            FileAction::OpenMesh => "Open mesh",
+            FileAction::OpenCage => "Open cage",
+            FileAction::LoadPose => "Load pose",
+            FileAction::SavePose => "Save pose",
+            FileAction::ExportMesh => "Export deformed mesh",
+        }
+    }
+
+    fn saves(self) -> bool {
+        matches!(self, FileAction::SavePose | FileAction::ExportMesh)
+    }
+
+    fn default_name(self) -> &'static str {
+        match self {
+            FileAction::SavePose => "pose.obj",
+            FileAction::ExportMesh => "deformed.obj",
+            _ => "",
+        }
+    }
+
+    fn confirm_label(self) -> &'static str {
+        match self {
+            FileAction::OpenMesh | FileAction::OpenCage => "Open",
+            FileAction::LoadPose => "Load",
+            FileAction::SavePose => "Save",
+            FileAction::ExportMesh => "Export",
+        }
+    }
+}
+
+/// One line of the in-window dialog's listing.
+struct Entry {
+    name: String,
+    is_folder: bool,
+}
+
+/// The in-window dialog while it is open.
+struct FileBrowser {
+    action: FileAction,
+    folder: PathBuf,
+    folder_text: String,
+    entries: Vec<Entry>,
+    name: String,
+    problem: Option<String>,
+    /// A save over this existing file was asked for once; a second Save replaces it.
+    confirm_replace: Option<PathBuf>,
+}
+
+impl FileBrowser {
+    fn new(action: FileAction, folder: PathBuf) -> Self {
+        let mut browser = Self {
+            action,
+            folder: PathBuf::new(),
+            folder_text: String::new(),
+            entries: Vec::new(),
+            name: action.default_name().into(),
+            problem: None,
+            confirm_replace: None,
+        };
+        browser.enter(folder);
+        browser
+    }
+
+    /// List `folder`: its folders, then its OBJ and OFF files, by name. A folder
+    /// that cannot be read leaves the listing as it was and says why.
+    fn enter(&mut self, folder: PathBuf) {
+        let read = match std::fs::read_dir(&folder) {
+            Ok(read) => read,
+            Err(error) => {
+                self.problem = Some(format!("cannot open {}: {error}", folder.display()));
+                self.folder_text = self.folder.display().to_string();
+                return;
+            }
+        };
+        let mut entries: Vec<Entry> = read
+            .flatten()
+            .filter_map(|item| {
+                let name = item.file_name().to_string_lossy().into_owned();
+                // Follows links, so a linked folder opens like a folder.
+                let is_folder = item.path().is_dir();
+                let listed = !name.starts_with('.') && (is_folder || is_mesh_name(&name));
+                listed.then_some(Entry { name, is_folder })
+            })
+            .collect();
+        entries.sort_by_key(|entry| (!entry.is_folder, entry.name.to_lowercase()));
+        self.entries = entries;
+        self.folder_text = folder.display().to_string();
+        self.folder = folder;
+        self.problem = None;
+        self.confirm_replace = None;
+    }
+
+    /// The path the file name field names: absolute, or in the shown folder.
+    fn chosen_path(&self) -> PathBuf {
+        let typed = expand_home(self.name.trim());
+        let path = self.folder.join(typed);
+        if self.action.saves() && path.extension().is_none() {
+            path.with_extension("obj")
+        } else {
+            path
+        }
+    }
+}
+
+fn is_mesh_name(name: &str) -> bool {
+    let lower = name.to_lowercase();
+    lower.ends_with(".obj") || lower.ends_with(".off")
+}
+
+/// `~/x` as the shell reads it.
+fn expand_home(text: &str) -> PathBuf {
+    match (text.strip_prefix("~/"), std::env::var_os("HOME")) {
+        (Some(rest), Some(home)) => Path::new(&home).join(rest),
+        _ => PathBuf::from(text),
+    }
+}
+
+/// Which dialog file actions use, and the in-window one while it is open.
+pub struct FileDialogs {
+    /// Use the in-window dialog (the File menu's switch, or the system's failed).
+    pub in_window: bool,
+    browser: Option<FileBrowser>,
+    /// Where the next in-window dialog starts: the folder last used.
+    folder: Option<PathBuf>,
+}
+
+impl Default for FileDialogs {
+    /// The system's dialog where a desktop session bus can carry the portal's
+    /// request; the in-window one where there is none to ask.
+    fn default() -> Self {
+        let no_portal = cfg!(target_os = "linux")
+            && std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_none_or(|v| v.is_empty());
+        Self {
+            in_window: no_portal,
+            browser: None,
+            folder: None,
+        }
+    }
+}
+
+impl FileDialogs {
+    /// The in-window dialog is open (it takes the keyboard from the viewport).
+    pub fn is_open(&self) -> bool {
+        self.browser.is_some()
+    }
+
+    fn start_folder(&self) -> PathBuf {
+        self.folder
+            .clone()
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("/"))
+    }
+}
+
+impl EditorApp {
+    /// Ask for a file for `action` and carry it out: the system's dialog when it
+    /// works, else the in-window one (which finishes in a later frame).
+    pub fn ask_for_file(&mut self, action: FileAction) {
+        if !self.file_dialogs.in_window {
+            let asked = Instant::now();
+            match system_dialog(action, &self.file_dialogs.start_folder()) {
+                Some(path) => {
+                    self.finish_file_action(action, &path);
+                    return;
+                }
+                None if asked.elapsed() >= SYSTEM_DIALOG_MIN_TIME => {
+                    self.file_action_cancelled(action);
+                    return;
+                }
+                None => {
+                    self.file_dialogs.in_window = true;
+                    self.info(
+                        "the system's file dialog did not open (no desktop portal?): using the \
+                         in-window dialog (File > In-window file dialog)",
+                    );
+                }
+            }
+        }
+        let folder = self.file_dialogs.start_folder();
+        self.file_dialogs.browser = Some(FileBrowser::new(action, folder));
+    }
+
+    /// The action the in-window dialog is open for, if it is.
+    pub fn open_file_dialog(&self) -> Option<FileAction> {
+        self.file_dialogs.browser.as_ref().map(|b| b.action)
+    }
+
+    /// Carry out `action` on `path`; true when it succeeded.
+    fn finish_file_action(&mut self, action: FileAction, path: &Path) -> bool {
+        if let Some(folder) = path.parent().filter(|f| f.is_dir()) {
+            self.file_dialogs.folder = Some(folder.to_owned());
+        }
+        let done = match action {
+            FileAction::OpenMesh => self.open_file(FileRole::Mesh, path),
+            FileAction::OpenCage => self.open_file(FileRole::Cage, path),
+            FileAction::LoadPose => self.load_pose(path),
+            FileAction::SavePose => self.save_pose(path),
+            FileAction::ExportMesh => self.export_deformed(path),
+        };
+        if action == FileAction::SavePose {
+            self.pose_save_finished(done);
+        }
+        done
+    }
+
+    fn file_action_cancelled(&mut self, action: FileAction) {
+        if action == FileAction::SavePose {
+            self.pose_save_finished(false);
+        }
+    }
+
+    /// The in-window dialog, while it is open.
+    pub(in crate::app) fn file_dialog_window(&mut self, ctx: &egui::Context) {
+        let Some(browser) = self.file_dialogs.browser.as_mut() else {
+            return;
+        };
+        let action = browser.action;
+        let mut confirm = false;
+        let mut cancel = ctx.input(|i| i.key_pressed(egui::Key::Escape));
+        egui::Window::new(format!("{} (in-window dialog)", action.title()))
+            .collapsible(false)
+            .resizable(false)
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+            .default_width(520.0)
+            .show(ctx, |ui| {
+                ui.weak(
+                    "pmvc's own dialog; File > In-window file dialog switches back to the system's",
+                );
+                ui.horizontal(|ui| {
+                    let label = ui.label("Folder:");
+                    if ui.button("Up").clicked() {
+                        if let Some(parent) = browser.folder.parent().map(Path::to_owned) {
+                            browser.enter(parent);
+                        }
+                    }
+                    let field = ui
+                        .add(
+                            egui::TextEdit::singleline(&mut browser.folder_text)
+                                .desired_width(380.0),
+                        )
+                        .labelled_by(label.id);
+                    if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                        let typed = expand_home(browser.folder_text.trim());
+                        browser.enter(typed);
+                    }
+                });
+                let mut enter = None;
+                egui::ScrollArea::vertical()
+                    .max_height(260.0)
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| {
+                        if browser.entries.is_empty() {
+                            ui.weak("(no folders, OBJ or OFF files here)");
+                        }
+                        for entry in &browser.entries {
+                            if entry.is_folder {
+                                if ui
+                                    .selectable_label(false, format!("{}/", entry.name))
+                                    .clicked()
+                                {
+                                    enter = Some(browser.folder.join(&entry.name));
+                                }
+                            } else {
+                                let chosen = browser.name == entry.name;
+                                let row = ui.selectable_label(chosen, &entry.name);
+                                if row.clicked() {
+                                    browser.name = entry.name.clone();
+                                    browser.confirm_replace = None;
+                                }
+                                confirm |= row.double_clicked();
+                            }
+                        }
+                    });
+                if let Some(folder) = enter {
+                    browser.enter(folder);
+                }
+                ui.horizontal(|ui| {
+                    let label = ui.label("File name:");
+                    let field = ui
+                        .add(egui::TextEdit::singleline(&mut browser.name).desired_width(380.0))
+                        .labelled_by(label.id);
+                    if field.changed() {
+                        browser.confirm_replace = None;
+                    }
+                    confirm |= field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                });
+                if let Some(problem) = &browser.problem {
+                    ui.colored_label(ui.visuals().error_fg_color, problem);
+                }
+                ui.horizontal(|ui| {
+                    confirm |= ui.button(action.confirm_label()).clicked();
+                    cancel |= ui.button("Cancel").clicked();
+                });
+            });
+        if cancel {
+            self.file_dialogs.browser = None;
+            self.file_action_cancelled(action);
+        } else if confirm {
+            self.confirm_in_window_dialog();
+        }
+    }
+
+    /// The in-window dialog's confirm: a folder opens, a missing file or an
+    /// unconfirmed replacement is said in the dialog, anything else is carried out.
+    fn confirm_in_window_dialog(&mut self) {
+        let Some(browser) = self.file_dialogs.browser.as_mut() else {
+            return;
+        };
+        let action = browser.action;
+        let path = browser.chosen_path();
+        if browser.name.trim().is_empty() {
+            browser.problem = Some("type a file name or pick a file".into());
+            return;
+        }
+        if path.is_dir() {
+            browser.enter(path);
+            browser.name = action.default_name().into();
+            return;
+        }
+        if !action.saves() && !path.is_file() {
+            browser.problem = Some(format!("{} does not exist", path.display()));
+            return;
+        }
+        if action.saves() && path.exists() && browser.confirm_replace.as_ref() != Some(&path) {
+            browser.problem = Some(format!(
+                "{} exists: {} again to replace it",
+                path.display(),
+                action.confirm_label()
+            ));
+            browser.confirm_replace = Some(path);
+            return;
+        }
+        let notices_before = self.notices.all().len();
+        if self.finish_file_action(action, &path) {
+            self.file_dialogs.browser = None;
+        } else if let Some(browser) = self.file_dialogs.browser.as_mut() {
+            // The dialog stays, so another file can be chosen; it says what failed.
+            let failed = self.notices.all().get(notices_before..).and_then(|new| {
+                new.iter()
+                    .rev()
+                    .find(|n| n.is_error)
+                    .map(|n| n.text.clone())
+            });
+            browser.problem = Some(failed.unwrap_or_else(|| "failed".into()));
+            browser.confirm_replace = None;
+        }
+    }
+}
+
+/// The system's file dialog for `action`; None when cancelled or not shown.
+fn system_dialog(action: FileAction, folder: &Path) -> Option<PathBuf> {
+    let dialog = rfd::FileDialog::new()
+        .set_title(action.title())
+        .set_directory(folder);
+    if action.saves() {
+        dialog
+            .set_file_name(action.default_name())
+            .add_filter("OBJ", &["obj"])
+            .save_file()
+    } else {
+        dialog
+            .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
+            .pick_file()
+    }
+}

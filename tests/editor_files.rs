@@ -1,0 +1,165 @@
+//! File actions through the in-window dialog, the one used where the system's
+//! dialog cannot appear (no desktop portal): browsing, loading a pose, saving it,
+//! exporting, and a bad file that keeps the dialog and the scene.
+
+mod common;
+
+use common::editor::*;
+use egui::{Key, Modifiers};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use glam::DVec3;
+use pmvc::app::ui::file_dialog::FileAction;
+use pmvc::app::EditorApp;
+use pmvc::geometry::load_mesh;
+
+fn choose_in_file_menu(harness: &mut Harness<'static, EditorApp>, entry: &str) {
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label(entry).click();
+    harness.run_steps(2);
+}
+
+/// Replace the text of the dialog's field labelled `label` with `text`, typed.
+fn type_into(harness: &mut Harness<'static, EditorApp>, label: &str, text: &str) {
+    harness.get_by_label(label).focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::A);
+    harness.step();
+    harness.get_by_label(label).type_text(text);
+    harness.step();
+}
+
+fn press_enter(harness: &mut Harness<'static, EditorApp>) {
+    harness.key_press(Key::Enter);
+    harness.run_steps(2);
+}
+
+#[test]
+fn the_in_window_dialog_browses_loads_saves_and_exports() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    let dir = tempfile::tempdir().unwrap();
+    let poses = dir.path().join("poses");
+    std::fs::create_dir(&poses).unwrap();
+    let cage = harness.state().document().cage().clone();
+    let posed: Vec<DVec3> = cage
+        .positions()
+        .iter()
+        .map(|&p| p + DVec3::new(0.05 * p.y, 0.0, 0.0))
+        .collect();
+    common::write(
+        &poses,
+        "lean.obj",
+        &common::triangles_obj(&posed, cage.triangles()),
+    );
+    common::write(&poses, "notes.txt", "not a mesh");
+
+    // Load pose: go to the folder by typing it, then pick the file from the list.
+    choose_in_file_menu(&mut harness, "Load pose…");
+    assert_eq!(
+        harness.state().open_file_dialog(),
+        Some(FileAction::LoadPose)
+    );
+    harness.get_by_label_contains("(in-window dialog)");
+    let method = harness.state().active_method();
+    type_into(&mut harness, "File name:", poses.to_str().unwrap());
+    press_enter(&mut harness);
+    assert!(
+        harness.query_by_label("notes.txt").is_none(),
+        "only meshes are listed"
+    );
+    let entry = harness.get_by_label("lean.obj").rect().center();
+    click(&mut harness, entry);
+    harness.get_by_label("Load").click();
+    harness.run_steps(2);
+    let app = harness.state();
+    assert_eq!(
+        app.open_file_dialog(),
+        None,
+        "the dialog closes once loaded"
+    );
+    assert_eq!(app.document().pose(), posed.as_slice());
+    assert_eq!(
+        app.active_method(),
+        method,
+        "keys typed into the dialog do not reach the viewport (M)"
+    );
+    assert!(!app.pose_is_unsaved(), "a loaded pose is on disk");
+
+    // Save pose: the dialog starts in the folder used last; an existing name asks
+    // for a second Save; a name without an extension gets .obj.
+    harness
+        .state_mut()
+        .set_handle_position(0, posed[0] + DVec3::X);
+    assert!(harness.state().pose_is_unsaved());
+    choose_in_file_menu(&mut harness, "Save pose…");
+    type_into(&mut harness, "File name:", "lean.obj");
+    harness.get_by_label("Save").click();
+    harness.run_steps(2);
+    harness.get_by_label_contains("exists: Save again to replace it");
+    type_into(&mut harness, "File name:", "moved");
+    press_enter(&mut harness);
+    let saved = load_mesh(&poses.join("moved.obj")).expect("the pose was saved");
+    let app = harness.state();
+    assert_eq!(app.open_file_dialog(), None);
+    assert_eq!(saved.mesh.positions, app.document().pose());
+    assert!(!app.pose_is_unsaved());
+    let untouched = load_mesh(&poses.join("lean.obj")).unwrap();
+    assert_eq!(
+        untouched.mesh.positions, posed,
+        "one Save did not replace it"
+    );
+
+    // Export, typed as an absolute path.
+    choose_in_file_menu(&mut harness, "Export deformed mesh…");
+    let exported = dir.path().join("deformed.obj");
+    type_into(&mut harness, "File name:", exported.to_str().unwrap());
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    let mesh = load_mesh(&exported).expect("the mesh was exported");
+    assert_eq!(
+        mesh.mesh.positions.len(),
+        harness.state().document().mesh().positions.len()
+    );
+}
+
+#[test]
+fn a_bad_file_in_the_in_window_dialog_keeps_the_dialog_and_the_scene() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    let dir = tempfile::tempdir().unwrap();
+    let broken = common::write(dir.path(), "broken.obj", "v 0 0 0\nv 1 x 0\n");
+    let vertices = harness.state().document().mesh().positions.len();
+
+    choose_in_file_menu(&mut harness, "Open mesh…");
+    type_into(
+        &mut harness,
+        "File name:",
+        dir.path().join("missing.obj").to_str().unwrap(),
+    );
+    harness.get_by_label("Open").click();
+    harness.run_steps(2);
+    harness.get_by_label_contains("missing.obj does not exist");
+
+    type_into(&mut harness, "File name:", broken.to_str().unwrap());
+    harness.get_by_label("Open").click();
+    harness.run_steps(2);
+    // The reader's message, with the file and its line, in the dialog (and in
+    // the side panel's notices).
+    assert_eq!(
+        harness.query_all_by_label_contains("broken.obj:2").count(),
+        2
+    );
+    let app = harness.state();
+    assert_eq!(app.open_file_dialog(), Some(FileAction::OpenMesh));
+    assert_eq!(app.document().mesh().positions.len(), vertices);
+
+    // Escape, like Cancel, closes it and changes nothing.
+    harness.key_press(Key::Escape);
+    harness.run_steps(2);
+    assert_eq!(harness.state().open_file_dialog(), None);
+    assert!(!harness.state().is_binding());
+}
