@@ -340,3 +340,62 @@ fn the_first_run_shows_mvc_and_pmvc_apart_at_once() {
     let app = harness.state();
     assert_eq!(app.document().pose(), app.document().cage().positions());
 }
+
+/// The colour drawn at `at` (points), from a fresh render.
+fn pixel_at(harness: &mut Harness<'static, EditorApp>, at: egui::Pos2) -> [u8; 4] {
+    let image = harness.render().expect("render");
+    let scale = harness.ctx.pixels_per_point();
+    image
+        .get_pixel((at.x * scale) as u32, (at.y * scale) as u32)
+        .0
+}
+
+#[test]
+fn the_cage_can_be_hidden_handles_resized_and_the_selection_framed() {
+    use egui::Key;
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.run_steps(2);
+    let framed = harness.state().camera();
+    let (handle, at) = isolated_handle(&harness);
+    let shown = pixel_at(&mut harness, at);
+
+    // H hides the cage: its handle is no longer drawn and cannot be picked.
+    harness.key_press(Key::H);
+    harness.run_steps(2);
+    assert!(!harness.state().view().show_cage);
+    assert_ne!(pixel_at(&mut harness, at), shown, "the handle is not drawn");
+    click(&mut harness, at);
+    assert!(harness.state().document().selection().is_empty());
+    harness.key_press(Key::H);
+    harness.run_steps(2);
+    assert_eq!(pixel_at(&mut harness, at), shown);
+
+    // A larger handle is picked farther from its centre.
+    let beside = at + egui::vec2(12.0, 0.0);
+    click(&mut harness, beside);
+    assert!(harness.state().document().selection().is_empty());
+    harness.state_mut().view_mut().handle_size = 10.0;
+    harness.run_steps(2);
+    click(&mut harness, beside);
+    let selection: Vec<usize> = harness
+        .state()
+        .document()
+        .selection()
+        .iter()
+        .copied()
+        .collect();
+    assert_eq!(selection, vec![handle]);
+
+    // F frames the selected handle; Home frames everything again.
+    harness.key_press(Key::F);
+    harness.run_steps(2);
+    let camera = harness.state().camera();
+    let position = harness.state().document().pose()[handle].as_vec3();
+    assert!(camera.target.distance(position) < 1e-4);
+    assert!(camera.distance < 0.5 * framed.distance);
+    harness.key_press(Key::Home);
+    harness.run_steps(2);
+    assert_eq!(harness.state().camera().target, framed.target);
+    assert_eq!(harness.state().camera().distance, framed.distance);
+}

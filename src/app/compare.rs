@@ -143,7 +143,14 @@ pub struct ViewSettings {
     pub cameras_locked: bool,
     /// Show the weights under the cursor even on a plainly shaded mesh.
     pub hover_in_shaded: bool,
+    /// Draw the cage's edges and handles; hidden ones cannot be picked.
+    pub show_cage: bool,
+    /// Handle radius in points (`HANDLE_SIZES`).
+    pub handle_size: f32,
 }
+
+/// The handle radii the View menu offers, in points; the default is 4.
+pub const HANDLE_SIZES: std::ops::RangeInclusive<f32> = 1.5..=12.0;
 
 impl Default for ViewSettings {
     fn default() -> Self {
@@ -159,6 +166,8 @@ impl Default for ViewSettings {
             difference_limit: None,
             cameras_locked: true,
             hover_in_shaded: false,
+            show_cage: true,
+            handle_size: 4.0,
         }
     }
 }

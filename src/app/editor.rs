@@ -454,6 +454,21 @@ impl EditorApp {
         self.viewport.frame(centre.as_vec3(), radius as f32);
     }
 
+    /// Frame the selected handles (F), or the whole scene when none is selected.
+    /// A single handle is framed with room around it: a tenth of the cage.
+    pub fn frame_selection(&mut self) {
+        let pose = self.document.pose();
+        let selected: Vec<DVec3> = self.document.selection().iter().map(|&i| pose[i]).collect();
+        if selected.is_empty() {
+            self.frame_scene();
+            return;
+        }
+        let (lo, hi) = crate::geometry::bounds_of(&selected);
+        let radius = ((hi - lo).length() / 2.0).max(0.1 * self.document.cage().diagonal());
+        self.viewport
+            .frame(((lo + hi) / 2.0).as_vec3(), radius as f32);
+    }
+
     /// Lock all views to one camera (the first view's) or give each its own.
     pub fn set_cameras_locked(&mut self, locked: bool) {
         if locked != self.view.cameras_locked {

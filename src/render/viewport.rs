@@ -140,6 +140,8 @@ pub struct FrameParams {
     pub size_px: [u32; 2],
     pub handle_radius_px: f32,
     pub highlight_outside: bool,
+    /// Draw the cage's edges and handles over the mesh.
+    pub show_cage: bool,
 }
 
 /// What the viewport draws, uploaded when the scene changes.
@@ -387,6 +389,7 @@ impl ViewportRenderer {
             size_px: [1, 1],
             handle_radius_px: 0.0,
             highlight_outside: false,
+            show_cage: false,
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
@@ -472,7 +475,9 @@ impl ViewportRenderer {
         if let (Some(scene), Some(bind_group)) = (&self.scene, bind_group) {
             let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
             self.mesh.draw(&mut pass, scene, &bind_group, offset);
-            self.cage.draw(&mut pass, scene, &bind_group, offset);
+            if params.show_cage {
+                self.cage.draw(&mut pass, scene, &bind_group, offset);
+            }
         }
     }
 

@@ -1,5 +1,6 @@
 //! The menu bar: File, Edit, View and Scenes.
 
+use crate::app::compare::HANDLE_SIZES;
 use crate::app::editor::{EditorApp, FileRole};
 use crate::app::scenes::BundledScene;
 use crate::app::ui::file_dialog::FileAction;
@@ -117,8 +118,21 @@ impl EditorApp {
             let samples = if antialiased { MSAA_SAMPLES } else { 1 };
             self.with_renderer(|renderer, device, _| renderer.set_sample_count(device, samples));
         }
-        if ui.button("Frame scene (F)").clicked() {
+        if ui.button("Frame selection (F)").clicked() {
+            self.frame_selection();
+        }
+        if ui.button("Frame all (Home)").clicked() {
             self.frame_scene();
         }
+        ui.separator();
+        ui.checkbox(&mut self.view.show_cage, "Cage and handles (H)")
+            .on_hover_text("Hidden handles cannot be picked or box-selected");
+        let label = ui.label("Handle size");
+        ui.add(
+            egui::Slider::new(&mut self.view.handle_size, HANDLE_SIZES)
+                .suffix(" pt")
+                .step_by(0.5),
+        )
+        .labelled_by(label.id);
     }
 }

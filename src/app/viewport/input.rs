@@ -177,13 +177,15 @@ impl EditorApp {
         let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
         let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
         let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
-        let (redo, undo, escape, frame, next_method) = ctx.input_mut(|i| {
+        let (redo, undo, escape, frame, next_method, frame_all, toggle_cage) = ctx.input_mut(|i| {
             (
                 i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y),
                 i.consume_shortcut(&undo),
                 i.key_pressed(Key::Escape),
                 i.key_pressed(Key::F) && i.modifiers.is_none(),
                 i.key_pressed(Key::M) && i.modifiers.is_none(),
+                i.key_pressed(Key::Home),
+                i.key_pressed(Key::H) && i.modifiers.is_none(),
             )
         });
         if next_method {
@@ -199,7 +201,13 @@ impl EditorApp {
             self.select_only([]);
         }
         if frame {
+            self.frame_selection();
+        }
+        if frame_all {
             self.frame_scene();
+        }
+        if toggle_cage {
+            self.view.show_cage = !self.view.show_cage;
         }
     }
 }

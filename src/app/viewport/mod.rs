@@ -16,8 +16,6 @@ use egui::{Color32, Pos2, Rect, Sense, Stroke};
 use glam::{DVec3, Vec2, Vec3};
 pub(super) use input::Drag;
 
-/// Handle half-size in points.
-const HANDLE_RADIUS: f32 = 4.0;
 /// Gap between side-by-side views, in points.
 const PANE_GAP: f32 = 2.0;
 
@@ -218,8 +216,9 @@ impl EditorApp {
                     (rect.width() * pixels_per_point).round().max(1.0) as u32,
                     (rect.height() * pixels_per_point).round().max(1.0) as u32,
                 ],
-                handle_radius_px: HANDLE_RADIUS * pixels_per_point,
+                handle_radius_px: self.view.handle_size * pixels_per_point,
                 highlight_outside: self.highlight_outside,
+                show_cage: self.view.show_cage,
             };
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,

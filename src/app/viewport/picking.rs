@@ -7,14 +7,20 @@ use crate::app::widgets::hover_box;
 use egui::{Pos2, Rect};
 use glam::Vec2;
 
-/// Handles are picked within this many points of the cursor.
+/// Handles are picked within this many points of the cursor, or of their rim
+/// when they are drawn larger.
 const PICK_RADIUS: f32 = 9.0;
+const PICK_MARGIN: f32 = 5.0;
 /// The hover read-out picks mesh vertices within this many points of the cursor.
 const HOVER_RADIUS: f32 = 6.0;
 
 impl EditorApp {
     /// The handle nearest to `pointer` within the pick radius, in the view under it.
     pub(super) fn pick(&self, pointer: Pos2) -> Option<usize> {
+        if !self.view.show_cage {
+            return None;
+        }
+        let radius = PICK_RADIUS.max(self.view.handle_size + PICK_MARGIN);
         let pane = self.viewport.pane_at(pointer)?;
         let projection = self.viewport.projection(pane)?;
         let pointer = Vec2::new(pointer.x, pointer.y);
@@ -25,7 +31,7 @@ impl EditorApp {
             .filter_map(|(i, p)| {
                 let screen = projection.project(p.as_vec3())?;
                 let distance = screen.distance(pointer);
-                (distance <= PICK_RADIUS).then_some((i, distance))
+                (distance <= radius).then_some((i, distance))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(i, _)| i)
@@ -34,6 +40,9 @@ impl EditorApp {
     /// Select the handles inside `band` in view `pane` (added to the selection
     /// when `additive`).
     pub(super) fn box_select(&mut self, pane: usize, band: Rect, additive: bool) {
+        if !self.view.show_cage {
+            return;
+        }
         let Some(projection) = self.viewport.projection(pane) else {
             return;
         };
