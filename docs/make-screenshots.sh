@@ -14,6 +14,7 @@ shoot() { # NAME ARGS...
   echo "docs/images/$name.png"
 }
 shoot default-scene
+shoot first-run --demo
 shoot pmvc-posed --pose docs/poses/middle-finger-sideways.obj
 shoot mvc-posed --method mvc --pose docs/poses/middle-finger-sideways.obj
 shoot scanned-elephant assets/scan_mesh.obj assets/scan_cage.obj
