@@ -9,12 +9,14 @@ use crate::coords::{quality, Method, Weights};
 use crate::render::colormap::Scale;
 use crate::render::Colouring;
 use glam::{DVec3, Mat4, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// How many of a vertex's weights the hover read-out lists.
 pub const HOVER_TOP_WEIGHTS: usize = 5;
 
 /// The arrangement of views.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Layout {
     /// One view, of the active method.
     #[default]
@@ -26,7 +28,8 @@ pub enum Layout {
 }
 
 /// What the method views colour the mesh by.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Overlay {
     #[default]
     Shaded,
@@ -64,8 +67,10 @@ impl Pane {
     }
 }
 
-/// A set of coordinate families, iterated in [`Method::ALL`] order.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// A set of coordinate families, iterated in [`Method::ALL`] order; saved as a
+/// list of identifiers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(from = "Vec<Method>", into = "Vec<Method>")]
 pub struct MethodSet(u32);
 
 impl MethodSet {
@@ -115,7 +120,9 @@ pub const DIFFERENCE_FLOOR: f32 = 1e-3;
 pub const NEGATIVITY_FLOOR: f32 = 1e-3;
 
 /// The comparison settings, as the toolbar and `pmvc edit --view …` set them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Sessions save them; a field missing from a session takes its default.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct ViewSettings {
     pub layout: Layout,
     pub overlay: Overlay,
@@ -151,6 +158,18 @@ pub struct ViewSettings {
 
 /// The handle radii the View menu offers, in points; the default is 4.
 pub const HANDLE_SIZES: std::ops::RangeInclusive<f32> = 1.5..=12.0;
+
+impl From<Vec<Method>> for MethodSet {
+    fn from(methods: Vec<Method>) -> Self {
+        Self::of(&methods)
+    }
+}
+
+impl From<MethodSet> for Vec<Method> {
+    fn from(set: MethodSet) -> Self {
+        set.iter().collect()
+    }
+}
 
 impl Default for ViewSettings {
     fn default() -> Self {

@@ -7,6 +7,7 @@
 //! weights without the GPU copy and the caches learning about it.
 
 use super::history::PoseHistory;
+use super::scenes::BundledScene;
 use crate::coords::{BindOptions, Method, WeightQuality, Weights};
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use glam::DVec3;
@@ -37,6 +38,32 @@ pub struct Changes {
     pub weights: BTreeSet<Method>,
 }
 
+/// A pose kept under a name, to come back to or to blend towards.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedPose {
+    pub name: String,
+    pub positions: Vec<DVec3>,
+}
+
+/// What one undo step restores: the pose and the named poses, and the action
+/// that changed them from this state ("pose edit", "store pose wave").
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseSnapshot {
+    pose: Vec<DVec3>,
+    named_poses: Arc<Vec<NamedPose>>,
+    action: String,
+}
+
+impl PoseSnapshot {
+    /// The action that undo (or redo) of this step reverses (or repeats).
+    pub fn action(&self) -> &str {
+        &self.action
+    }
+}
+
+/// What undo calls a plain pose change.
+const POSE_EDIT: &str = "pose edit";
+
 /// A mesh, its cage, the pose and the weights.
 #[derive(Clone, Debug)]
 pub struct Document {
@@ -59,6 +86,10 @@ pub struct Document {
     pose_revision: u64,
     /// Pose edits recorded for undo (not undo or redo themselves).
     edits: u64,
+    /// Poses kept under a name (sessions save them).
+    named_poses: Arc<Vec<NamedPose>>,
+    /// The bundled scene this document's mesh and cage are, when they are one.
+    bundled: Option<BundledScene>,
 }
 
 impl Document {
@@ -82,7 +113,31 @@ impl Document {
             },
             pose_revision: 0,
             edits: 0,
+            named_poses: Arc::new(Vec::new()),
+            bundled: None,
         }
+    }
+
+    /// The same document, marked as the bundled scene `scene`.
+    pub fn bundled_as(mut self, scene: BundledScene) -> Self {
+        self.bundled = Some(scene);
+        self
+    }
+
+    /// The same document posed as `pose` and with `named_poses`, none of it an undo
+    /// step (a session being opened). Poses of the wrong length are left out.
+    pub fn with_poses(mut self, pose: Vec<DVec3>, named_poses: Vec<NamedPose>) -> Self {
+        let count = self.pose.len();
+        if pose.len() == count {
+            self.pose = pose;
+        }
+        self.named_poses = Arc::new(
+            named_poses
+                .into_iter()
+                .filter(|named| named.positions.len() == count)
+                .collect(),
+        );
+        self
     }
 
     /// The same document with the file paths it was loaded from.
@@ -97,6 +152,7 @@ impl Document {
     pub fn with_cage(&self, cage: Cage, cage_path: Option<PathBuf>, pose: Vec<DVec3>) -> Self {
         let mut document = Document::new(self.title.clone(), (*self.mesh).clone(), cage);
         document.mesh_file = self.mesh_file.clone();
+        document.bundled = self.bundled;
         document.cage_path = cage_path;
         if pose.len() == document.pose.len() {
             document.pose = pose;
@@ -143,6 +199,15 @@ impl Document {
 
     pub fn history(&self) -> &PoseHistory {
         &self.history
+    }
+
+    /// The bundled scene this is, if it is one and unchanged.
+    pub fn bundled(&self) -> Option<BundledScene> {
+        self.bundled
+    }
+
+    pub fn named_poses(&self) -> &[NamedPose] {
+        &self.named_poses
     }
 
     /// `method`'s weights and their bind, once bound.
@@ -226,8 +291,7 @@ impl Document {
     /// Change the pose as one undo step.
     pub fn edit_pose(&mut self, pose: Vec<DVec3>) {
         if pose.len() == self.pose.len() && pose != self.pose {
-            self.history.record(self.pose.clone());
-            self.edits += 1;
+            self.record(self.pose.clone(), POSE_EDIT);
             self.pose = pose;
             self.pose_changed();
         }
@@ -236,24 +300,112 @@ impl Document {
     /// Record `before` as the pose to return to: the start of a drag that has
     /// since moved the pose with [`Self::preview_pose`].
     pub fn record_undo_point(&mut self, before: Vec<DVec3>) {
+        self.record_undo_point_as(before, POSE_EDIT);
+    }
+
+    /// [`Self::record_undo_point`] with the name undo gives the step.
+    pub fn record_undo_point_as(&mut self, before: Vec<DVec3>, action: &str) {
         if before != self.pose {
-            self.history.record(before);
-            self.edits += 1;
+            self.record(before, action);
+        }
+    }
+
+    fn record(&mut self, pose: Vec<DVec3>, action: &str) {
+        self.history.record(PoseSnapshot {
+            pose,
+            named_poses: Arc::clone(&self.named_poses),
+            action: action.to_owned(),
+        });
+        self.edits += 1;
+    }
+
+    /// The current state, to be put on the other stack by undo or redo of a step
+    /// named `action`.
+    fn snapshot(&self, action: &str) -> PoseSnapshot {
+        PoseSnapshot {
+            pose: self.pose.clone(),
+            named_poses: Arc::clone(&self.named_poses),
+            action: action.to_owned(),
+        }
+    }
+
+    fn restore(&mut self, snapshot: PoseSnapshot) {
+        self.named_poses = snapshot.named_poses;
+        if snapshot.pose != self.pose {
+            self.pose = snapshot.pose;
+            self.pose_changed();
         }
     }
 
     pub fn undo(&mut self) {
-        if let Some(pose) = self.history.undo(&self.pose) {
-            self.pose = pose;
-            self.pose_changed();
+        let Some(action) = self.history.last().map(|s| s.action.clone()) else {
+            return;
+        };
+        if let Some(snapshot) = self.history.undo(self.snapshot(&action)) {
+            self.restore(snapshot);
         }
     }
 
     pub fn redo(&mut self) {
-        if let Some(pose) = self.history.redo(&self.pose) {
-            self.pose = pose;
-            self.pose_changed();
+        let Some(action) = self.history.next().map(|s| s.action.clone()) else {
+            return;
+        };
+        if let Some(snapshot) = self.history.redo(self.snapshot(&action)) {
+            self.restore(snapshot);
         }
+    }
+
+    // ---- named poses ----------------------------------------------------------
+
+    /// Keep the current pose as `name` (replacing a pose of that name), as one
+    /// undo step.
+    pub fn store_named_pose(&mut self, name: &str) {
+        let mut named = (*self.named_poses).clone();
+        let pose = NamedPose {
+            name: name.to_owned(),
+            positions: self.pose.clone(),
+        };
+        match named.iter_mut().find(|n| n.name == name) {
+            Some(existing) => *existing = pose,
+            None => named.push(pose),
+        }
+        self.change_named_poses(named, &format!("store pose {name}"));
+    }
+
+    /// Forget the named pose at `index`, as one undo step.
+    pub fn delete_named_pose(&mut self, index: usize) {
+        let mut named = (*self.named_poses).clone();
+        if index < named.len() {
+            let removed = named.remove(index);
+            self.change_named_poses(named, &format!("delete pose {}", removed.name));
+        }
+    }
+
+    /// Rename the named pose at `index`, as one undo step; false when another
+    /// pose has that name.
+    pub fn rename_named_pose(&mut self, index: usize, name: &str) -> bool {
+        let mut named = (*self.named_poses).clone();
+        if named
+            .iter()
+            .enumerate()
+            .any(|(i, n)| i != index && n.name == name)
+        {
+            return false;
+        }
+        let Some(pose) = named.get_mut(index) else {
+            return false;
+        };
+        if pose.name != name {
+            let action = format!("rename pose {} to {name}", pose.name);
+            pose.name = name.to_owned();
+            self.change_named_poses(named, &action);
+        }
+        true
+    }
+
+    fn change_named_poses(&mut self, named: Vec<NamedPose>, action: &str) {
+        self.record(self.pose.clone(), action);
+        self.named_poses = Arc::new(named);
     }
 
     pub fn reset_pose(&mut self) {

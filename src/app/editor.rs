@@ -8,11 +8,13 @@ use super::bind_queue::BindQueue;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::readouts::ReadoutCache;
+use super::recent::RecentFiles;
 use super::scene_history::SceneHistory;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::drop_dialog::DroppedFile;
 use super::ui::file_dialog::FileDialogs;
+use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
 use super::ui::quit_dialog::QuitState;
 use super::ui::statistics::FrameStats;
@@ -56,7 +58,11 @@ pub struct EditorApp {
     pub(super) stats: FrameStats,
     pub(super) show_statistics: bool,
     pub(super) highlight_outside: bool,
-    pub(super) recent: Vec<(FileRole, PathBuf)>,
+    pub(super) recent: RecentFiles,
+    /// The session file last opened or saved: File > Save session writes there.
+    pub(super) session_path: Option<PathBuf>,
+    /// The rest-to-pose blend slider's state.
+    pub(super) pose_blend: PoseBlend,
     /// The system's or the in-window file dialog.
     pub(super) file_dialogs: FileDialogs,
     /// Quitting asks first when the pose is unsaved.
@@ -123,7 +129,8 @@ impl EditorApp {
         }
         let mut app = Self {
             gpu,
-            document: Document::new(BundledScene::Comb.title(), mesh, cage),
+            document: Document::new(BundledScene::Comb.title(), mesh, cage)
+                .bundled_as(BundledScene::Comb),
             queue: BindQueue::new(backend, move || wake_ctx.request_repaint()),
             bind_options,
             view: options.view,
@@ -133,10 +140,12 @@ impl EditorApp {
             stats: FrameStats::default(),
             show_statistics: false,
             highlight_outside: false,
-            recent: Vec::new(),
+            recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
+            session_path: None,
+            pose_blend: PoseBlend::default(),
             file_dialogs: FileDialogs::default(),
             quit: QuitState::default(),
-            screenshot: options.screenshot.map(ScreenshotState::new),
+            screenshot: options.screenshot.clone().map(ScreenshotState::new),
             focus_frames: 0,
             binding_paused: false,
             hide_timings: options.hide_timings,
@@ -151,9 +160,15 @@ impl EditorApp {
             app.error("no wgpu device: the viewport cannot draw (run with the wgpu renderer)");
         }
         let mut opened = false;
-        match (&options.mesh, &options.cage) {
-            (Some(mesh), Some(cage)) => opened = app.open_pair(mesh, cage),
-            (None, None) => {}
+        match (&options.mesh, &options.cage, &options.session) {
+            (_, _, Some(session)) => {
+                opened = app.open_session(session);
+                if opened {
+                    app.command_line_over_session(&options);
+                }
+            }
+            (Some(mesh), Some(cage), None) => opened = app.open_pair(mesh, cage),
+            (None, None, None) => {}
             _ => app.error("give both a mesh and a cage; showing the default scene"),
         }
         if !opened {
@@ -181,7 +196,11 @@ impl EditorApp {
         }
         // Opening the files asked for is where editing starts, not an undo step.
         app.scene_history.clear();
-        app.start_bind();
+        // A session opened above has started its binds; starting again would
+        // cancel them, and a cancel pauses binding until the user asks.
+        if options.session.is_none() || !opened {
+            app.start_bind();
+        }
         app
     }
 
@@ -420,16 +439,16 @@ impl EditorApp {
 
     /// What Undo would reverse, for its menu entry ("move handles", "open cage.obj").
     pub fn undo_label(&self) -> Option<String> {
-        if self.document.history().can_undo() {
-            return Some("pose edit".into());
+        if let Some(step) = self.document.history().last() {
+            return Some(step.action().to_owned());
         }
         self.scene_history.undo_action().map(Into::into)
     }
 
     /// What Redo would repeat, for its menu entry.
     pub fn redo_label(&self) -> Option<String> {
-        if self.document.history().can_redo() {
-            return Some("pose edit".into());
+        if let Some(step) = self.document.history().next() {
+            return Some(step.action().to_owned());
         }
         self.scene_history
             .redo_action(&self.document)
@@ -510,6 +529,7 @@ impl eframe::App for EditorApp {
         self.poll_bind();
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);
+        self.file_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         if self.first_run_hint {
@@ -531,6 +551,19 @@ impl eframe::App for EditorApp {
             ctx.request_repaint();
         }
         self.drive_screenshot(&ctx);
+    }
+
+    /// Recent files outlive the run; a scripted run leaves them as they were.
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.screenshot.is_none() {
+            self.recent.save(storage);
+        }
+    }
+
+    /// Only the recent files are kept: panels and windows open as they always
+    /// do, so screenshots and snapshot tests start from the same state.
+    fn persist_egui_memory(&self) -> bool {
+        false
     }
 }
 

@@ -3,14 +3,14 @@
 
 use super::document::Document;
 use super::editor::{EditorApp, FileRole};
+use super::recent::RecentEntry;
 use super::scenes::BundledScene;
+use super::session::{self, SessionSettings};
+use super::ui::file_dialog::FileAction;
 use crate::geometry::{
     load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_obj, TriMesh,
 };
 use std::path::Path;
-
-/// Recent files kept in the File menu.
-const RECENT_LIMIT: usize = 8;
 
 fn file_title(path: &Path) -> String {
     path.file_name()
@@ -18,11 +18,141 @@ fn file_title(path: &Path) -> String {
 }
 
 impl EditorApp {
-    fn remember(&mut self, role: FileRole, path: &Path) {
-        let entry = (role, path.to_owned());
-        self.recent.retain(|e| *e != entry);
-        self.recent.insert(0, entry);
-        self.recent.truncate(RECENT_LIMIT);
+    /// File > Recent, most recent first.
+    pub fn recent_files(&self) -> &super::recent::RecentFiles {
+        &self.recent
+    }
+
+    fn remember(&mut self, entry: RecentEntry) {
+        self.recent.remember(entry);
+    }
+
+    /// Open a File > Recent entry; one that no longer opens leaves the list.
+    pub fn open_recent(&mut self, entry: &RecentEntry) -> bool {
+        let opened = match entry {
+            RecentEntry::Session(path) => self.open_session(path),
+            RecentEntry::Scene { mesh, cage } => {
+                let opened = self.open_pair(mesh, cage);
+                if opened {
+                    self.start_bind();
+                }
+                opened
+            }
+            RecentEntry::Mesh(path) => self.open_file(FileRole::Mesh, path),
+            RecentEntry::Cage(path) => self.open_file(FileRole::Cage, path),
+        };
+        if !opened {
+            self.recent.forget(entry);
+        }
+        opened
+    }
+
+    /// Open a session: its mesh, cage, poses, method, parameters and views. On
+    /// any failure the current scene stays; opening can be undone.
+    pub fn open_session(&mut self, path: &Path) -> bool {
+        let opened = match session::open_session(path) {
+            Ok(opened) => opened,
+            Err(error) => {
+                self.error(error.to_string());
+                return false;
+            }
+        };
+        for note in opened.notes {
+            self.info(note);
+        }
+        self.replace_document(
+            opened.document,
+            format!("open session {}", file_title(path)),
+        );
+        let settings = opened.settings;
+        self.bind_options = settings.bind_options;
+        self.view = settings.view;
+        let mut cameras = self.viewport.cameras();
+        for (slot, camera) in cameras.iter_mut().zip(settings.cameras) {
+            *slot = camera;
+        }
+        self.viewport.set_cameras(cameras);
+        self.mark_pose_saved();
+        self.session_path = Some(path.to_owned());
+        self.remember(RecentEntry::Session(path.to_owned()));
+        self.info(format!("opened session {}", path.display()));
+        self.start_bind();
+        true
+    }
+
+    /// What `pmvc edit --session` was told beside the session wins over it.
+    pub(super) fn command_line_over_session(&mut self, options: &super::EditorOptions) {
+        self.view = session::view_with_overrides(self.view, options.view);
+        if let Some(method) = options.method {
+            self.bind_options.method = method;
+        }
+        if let Some(resolution) = options.resolution {
+            self.bind_options.resolution = resolution.max(1);
+        }
+        if let Some(grid) = options.grid {
+            self.bind_options.grid = grid.max(crate::coords::harmonic::MIN_GRID);
+        }
+    }
+
+    /// Save the session to `path`; true when it was written.
+    pub fn save_session(&mut self, path: &Path) -> bool {
+        if !self.refuse_overwriting_open_files(path) {
+            return false;
+        }
+        let settings = SessionSettings {
+            bind_options: self.bind_options,
+            view: self.view,
+            cameras: self.viewport.cameras().to_vec(),
+        };
+        match session::save_session(path, &self.document, &settings) {
+            Ok(()) => {
+                self.mark_pose_saved();
+                self.session_path = Some(path.to_owned());
+                self.remember(RecentEntry::Session(path.to_owned()));
+                self.info(format!("saved session {}", path.display()));
+                true
+            }
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
+        }
+    }
+
+    /// Ctrl+O, Ctrl+S and Ctrl+Shift+S, as in Blender; not while a dialog or a
+    /// text field has the keyboard.
+    pub(super) fn file_shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() || self.modal_dialog_open() {
+            return;
+        }
+        let command = egui::Modifiers::COMMAND;
+        let save_as = egui::KeyboardShortcut::new(command | egui::Modifiers::SHIFT, egui::Key::S);
+        let save = egui::KeyboardShortcut::new(command, egui::Key::S);
+        let open = egui::KeyboardShortcut::new(command, egui::Key::O);
+        let (save_as, save, open) = ctx.input_mut(|i| {
+            (
+                i.consume_shortcut(&save_as),
+                i.consume_shortcut(&save),
+                i.consume_shortcut(&open),
+            )
+        });
+        if save_as {
+            self.ask_for_file(FileAction::SaveSession);
+        } else if save {
+            self.save_session_again();
+        } else if open {
+            self.ask_for_file(FileAction::OpenSession);
+        }
+    }
+
+    /// File > Save session: where it was last saved or opened, else ask.
+    pub fn save_session_again(&mut self) {
+        match self.session_path.clone() {
+            Some(path) => {
+                self.save_session(&path);
+            }
+            None => self.ask_for_file(FileAction::SaveSession),
+        }
     }
 
     /// Open a mesh and cage together; on any failure the current scene stays.
@@ -52,8 +182,10 @@ impl EditorApp {
             file_title(cage_path)
         );
         self.replace_document(document, action);
-        self.remember(FileRole::Mesh, mesh_path);
-        self.remember(FileRole::Cage, cage_path);
+        self.remember(RecentEntry::Scene {
+            mesh: mesh_path.to_owned(),
+            cage: cage_path.to_owned(),
+        });
         true
     }
 
@@ -92,7 +224,10 @@ impl EditorApp {
             FileRole::Cage => "cage",
         };
         self.replace_document(document, format!("open {role_name} {}", file_title(path)));
-        self.remember(role, path);
+        self.remember(match role {
+            FileRole::Mesh => RecentEntry::Mesh(path.to_owned()),
+            FileRole::Cage => RecentEntry::Cage(path.to_owned()),
+        });
         self.info(format!("opened {}", path.display()));
         self.start_bind();
         true
@@ -103,7 +238,8 @@ impl EditorApp {
         match bundled.build() {
             Ok((mesh, cage)) => {
                 let action = format!("open the {} scene", bundled.title());
-                self.replace_document(Document::new(bundled.title(), mesh, cage), action);
+                let document = Document::new(bundled.title(), mesh, cage).bundled_as(bundled);
+                self.replace_document(document, action);
                 self.start_bind();
             }
             Err(error) => self.error(error.to_string()),

@@ -21,9 +21,11 @@ mod files;
 mod focus;
 pub mod history;
 mod readouts;
+pub mod recent;
 pub mod scene_history;
 pub mod scenes;
 mod screenshot;
+pub mod session;
 pub mod ui;
 mod viewport;
 pub mod widgets;
@@ -38,6 +40,8 @@ pub struct EditorOptions {
     /// Mesh to open instead of the default scene (needs `cage` too).
     pub mesh: Option<PathBuf>,
     pub cage: Option<PathBuf>,
+    /// A session to open (instead of `mesh` and `cage`).
+    pub session: Option<PathBuf>,
     /// A pose (cage OBJ with the same vertex count) applied once loaded.
     pub pose: Option<PathBuf>,
     /// PMVC cube-map resolution; `None` for the default.
@@ -103,6 +107,9 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
             .with_inner_size([1280.0, 800.0])
             .with_drag_and_drop(true),
         renderer: eframe::Renderer::Wgpu,
+        // A scripted run's window is always the size asked for, whatever size
+        // the last session's window had.
+        persist_window: options.screenshot.is_none(),
         ..Default::default()
     };
     if let eframe::egui_wgpu::WgpuSetup::CreateNew(setup) =

@@ -39,6 +39,18 @@ pub enum BundledScene {
 impl BundledScene {
     pub const ALL: [BundledScene; 2] = [BundledScene::Comb, BundledScene::Scan];
 
+    /// The name sessions save the scene by.
+    pub fn id(self) -> &'static str {
+        match self {
+            BundledScene::Comb => "comb",
+            BundledScene::Scan => "scan",
+        }
+    }
+
+    pub fn from_id(id: &str) -> Option<BundledScene> {
+        Self::ALL.into_iter().find(|scene| scene.id() == id)
+    }
+
     pub fn title(self) -> &'static str {
         match self {
             BundledScene::Comb => "Comb of close fingers",

@@ -177,6 +177,10 @@ pub struct EditArgs {
     pub mesh: Option<PathBuf>,
     /// Its cage.
     pub cage: Option<PathBuf>,
+    /// A session saved by the editor (File > Save session): mesh, cage, poses,
+    /// method and views. Other options given with it override what it holds.
+    #[arg(long, value_name = "FILE.json", conflicts_with_all = ["mesh", "cage"])]
+    pub session: Option<PathBuf>,
     /// A deformed cage with the same vertex count, applied after binding.
     #[arg(long, value_name = "POSE.obj")]
     pub pose: Option<PathBuf>,
@@ -304,6 +308,7 @@ impl EditArgs {
         crate::app::EditorOptions {
             mesh: self.mesh,
             cage: self.cage,
+            session: self.session,
             pose: self.pose,
             resolution: self.resolution,
             grid: self.grid,

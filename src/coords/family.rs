@@ -47,6 +47,18 @@ pub enum Parameter {
     Grid,
 }
 
+impl Parameter {
+    pub const ALL: [Parameter; 2] = [Parameter::Resolution, Parameter::Grid];
+
+    /// The name saved files give it.
+    pub fn id(self) -> &'static str {
+        match self {
+            Parameter::Resolution => "resolution",
+            Parameter::Grid => "grid",
+        }
+    }
+}
+
 /// What a family's weights matrix holds per mesh vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColumnLayout {
@@ -181,6 +193,27 @@ impl Method {
                 .map(|(posed, rested)| *posed - *rested)
                 .collect(),
         }
+    }
+}
+
+/// Saved files name a family by its identifier ("pmvc"), so adding or reordering
+/// families never changes what an old file means.
+impl serde::Serialize for Method {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.id())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Method {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let id = String::deserialize(deserializer)?;
+        Method::from_id(&id).ok_or_else(|| {
+            let known: Vec<&str> = Method::ALL.iter().map(|m| m.id()).collect();
+            serde::de::Error::custom(format!(
+                "unknown method \"{id}\" (known: {})",
+                known.join(", ")
+            ))
+        })
     }
 }
 

@@ -20,7 +20,8 @@ pub const OUTSIDE: [f32; 3] = [0.55, 0.55, 0.55];
 pub const LOG_DECADES: f32 = 3.0;
 
 /// How a value's magnitude maps to the colour's strength.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Scale {
     #[default]
     Linear,

@@ -20,6 +20,8 @@ pub enum FileAction {
     LoadPose,
     SavePose,
     ExportMesh,
+    OpenSession,
+    SaveSession,
 }
 
 impl FileAction {
@@ -30,26 +32,55 @@ impl FileAction {
             FileAction::LoadPose => "Load pose",
             FileAction::SavePose => "Save pose",
             FileAction::ExportMesh => "Export deformed mesh",
+            FileAction::OpenSession => "Open session",
+            FileAction::SaveSession => "Save session",
         }
     }
 
     fn saves(self) -> bool {
-        matches!(self, FileAction::SavePose | FileAction::ExportMesh)
+        matches!(
+            self,
+            FileAction::SavePose | FileAction::ExportMesh | FileAction::SaveSession
+        )
+    }
+
+    fn is_session(self) -> bool {
+        matches!(self, FileAction::OpenSession | FileAction::SaveSession)
+    }
+
+    /// The extension a saved file gets when none is typed.
+    fn extension(self) -> &'static str {
+        if self.is_session() {
+            "json"
+        } else {
+            "obj"
+        }
+    }
+
+    /// Files the dialog lists for this action.
+    fn lists(self, name: &str) -> bool {
+        let lower = name.to_lowercase();
+        if self.is_session() {
+            lower.ends_with(".json")
+        } else {
+            lower.ends_with(".obj") || lower.ends_with(".off")
+        }
     }
 
     fn default_name(self) -> &'static str {
         match self {
             FileAction::SavePose => "pose.obj",
             FileAction::ExportMesh => "deformed.obj",
+            FileAction::SaveSession => "scene.session.json",
             _ => "",
         }
     }
 
     fn confirm_label(self) -> &'static str {
         match self {
-            FileAction::OpenMesh | FileAction::OpenCage => "Open",
+            FileAction::OpenMesh | FileAction::OpenCage | FileAction::OpenSession => "Open",
             FileAction::LoadPose => "Load",
-            FileAction::SavePose => "Save",
+            FileAction::SavePose | FileAction::SaveSession => "Save",
             FileAction::ExportMesh => "Export",
         }
     }
@@ -71,6 +102,9 @@ struct FileBrowser {
     problem: Option<String>,
     /// A save over this existing file was asked for once; a second Save replaces it.
     confirm_replace: Option<PathBuf>,
+    /// The name field takes the keyboard when the dialog opens, so a typed name
+    /// and Enter work at once.
+    focus_name: bool,
 }
 
 impl FileBrowser {
@@ -83,6 +117,7 @@ impl FileBrowser {
             name: action.default_name().into(),
             problem: None,
             confirm_replace: None,
+            focus_name: true,
         };
         browser.enter(folder);
         browser
@@ -99,13 +134,14 @@ impl FileBrowser {
                 return;
             }
         };
+        let action = self.action;
         let mut entries: Vec<Entry> = read
             .flatten()
             .filter_map(|item| {
                 let name = item.file_name().to_string_lossy().into_owned();
                 // Follows links, so a linked folder opens like a folder.
                 let is_folder = item.path().is_dir();
-                let listed = !name.starts_with('.') && (is_folder || is_mesh_name(&name));
+                let listed = !name.starts_with('.') && (is_folder || action.lists(&name));
                 listed.then_some(Entry { name, is_folder })
             })
             .collect();
@@ -122,16 +158,25 @@ impl FileBrowser {
         let typed = expand_home(self.name.trim());
         let path = self.folder.join(typed);
         if self.action.saves() && path.extension().is_none() {
-            path.with_extension("obj")
+            path.with_extension(self.action.extension())
         } else {
             path
         }
     }
 }
 
-fn is_mesh_name(name: &str) -> bool {
-    let lower = name.to_lowercase();
-    lower.ends_with(".obj") || lower.ends_with(".off")
+/// Select the name up to its first dot, as system dialogs do, so typing
+/// replaces "scene" in "scene.session.json" and keeps the extension.
+fn select_stem(ctx: &egui::Context, id: egui::Id, name: &str) {
+    use egui::text::{CCursor, CCursorRange};
+    let stem = name.find('.').unwrap_or(name.len());
+    let chars = name[..stem].chars().count();
+    let mut state = egui::TextEdit::load_state(ctx, id).unwrap_or_default();
+    state.cursor.set_char_range(Some(CCursorRange::two(
+        CCursor::new(0),
+        CCursor::new(chars),
+    )));
+    state.store(ctx, id);
 }
 
 /// `~/x` as the shell reads it.
@@ -223,6 +268,8 @@ impl EditorApp {
             FileAction::LoadPose => self.load_pose(path),
             FileAction::SavePose => self.save_pose(path),
             FileAction::ExportMesh => self.export_deformed(path),
+            FileAction::OpenSession => self.open_session(path),
+            FileAction::SaveSession => self.save_session(path),
         };
         if action == FileAction::SavePose {
             self.pose_save_finished(done);
@@ -277,7 +324,11 @@ impl EditorApp {
                     .auto_shrink([false, false])
                     .show(ui, |ui| {
                         if browser.entries.is_empty() {
-                            ui.weak("(no folders, OBJ or OFF files here)");
+                            ui.weak(if browser.action.is_session() {
+                                "(no folders or session files here)"
+                            } else {
+                                "(no folders, OBJ or OFF files here)"
+                            });
                         }
                         for entry in &browser.entries {
                             if entry.is_folder {
@@ -306,6 +357,10 @@ impl EditorApp {
                     let field = ui
                         .add(egui::TextEdit::singleline(&mut browser.name).desired_width(380.0))
                         .labelled_by(label.id);
+                    if std::mem::take(&mut browser.focus_name) {
+                        field.request_focus();
+                        select_stem(ui.ctx(), field.id, &browser.name);
+                    }
                     if field.changed() {
                         browser.confirm_replace = None;
                     }
@@ -379,14 +434,18 @@ fn system_dialog(action: FileAction, folder: &Path) -> Option<PathBuf> {
     let dialog = rfd::FileDialog::new()
         .set_title(action.title())
         .set_directory(folder);
-    if action.saves() {
-        dialog
+    match (action.saves(), action.is_session()) {
+        (true, true) => dialog
+            .set_file_name(action.default_name())
+            .add_filter("Session", &["json"])
+            .save_file(),
+        (true, false) => dialog
             .set_file_name(action.default_name())
             .add_filter("OBJ", &["obj"])
-            .save_file()
-    } else {
-        dialog
+            .save_file(),
+        (false, true) => dialog.add_filter("Session", &["json"]).pick_file(),
+        (false, false) => dialog
             .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
-            .pick_file()
+            .pick_file(),
     }
 }

@@ -1,7 +1,7 @@
 //! The menu bar: File, Edit, View and Scenes.
 
 use crate::app::compare::HANDLE_SIZES;
-use crate::app::editor::{EditorApp, FileRole};
+use crate::app::editor::EditorApp;
 use crate::app::scenes::BundledScene;
 use crate::app::ui::file_dialog::FileAction;
 use crate::render::viewport::MSAA_SAMPLES;
@@ -30,20 +30,30 @@ impl EditorApp {
         if ui.button("Open cage…").clicked() {
             self.ask_for_file(FileAction::OpenCage);
         }
-        ui.menu_button("Recent files", |ui| {
-            if self.recent.is_empty() {
+        ui.menu_button("Recent", |ui| {
+            if self.recent.entries().is_empty() {
                 ui.label("(none)");
             }
-            for (role, path) in self.recent.clone() {
-                let kind = match role {
-                    FileRole::Mesh => "mesh",
-                    FileRole::Cage => "cage",
-                };
-                if ui.button(format!("{kind} {}", path.display())).clicked() {
-                    self.open_file(role, &path);
+            for entry in self.recent.entries().to_vec() {
+                if ui
+                    .button(entry.label())
+                    .on_hover_text(entry.paths())
+                    .clicked()
+                {
+                    self.open_recent(&entry);
                 }
             }
         });
+        ui.separator();
+        if ui.button("Open session… (Ctrl+O)").clicked() {
+            self.ask_for_file(FileAction::OpenSession);
+        }
+        if ui.button("Save session (Ctrl+S)").clicked() {
+            self.save_session_again();
+        }
+        if ui.button("Save session as… (Ctrl+Shift+S)").clicked() {
+            self.ask_for_file(FileAction::SaveSession);
+        }
         ui.separator();
         if ui.button("Load pose…").clicked() {
             self.ask_for_file(FileAction::LoadPose);

@@ -4,6 +4,7 @@
 pub mod drop_dialog;
 pub mod file_dialog;
 pub mod menu;
+pub mod named_poses;
 pub mod notices;
 pub mod quality_table;
 pub mod quit_dialog;

@@ -1,0 +1,523 @@
+//! Sessions: a small JSON file that brings back a piece of work. It names the
+//! mesh and cage (files relative to the session, or a bundled scene), holds the
+//! rest cage when it was edited, the pose, the named poses, the method and its
+//! parameters, and the view settings with the cameras.
+//!
+//! A rest mesh that no longer matches its source ("Use pose as rest shape") is
+//! written beside the session as `NAME.rest-mesh.obj`, so the session stays small.
+
+use super::compare::ViewSettings;
+use super::document::{Document, NamedPose};
+use super::scenes::BundledScene;
+use crate::coords::{BindOptions, Method, Parameter};
+use crate::geometry::{
+    load_cage, load_mesh, refuse_same_file, write_atomically, write_deformed_mesh, write_obj, Cage,
+    CageError, CageLoadError, LoadError, MeshFile, TriMesh, WriteError,
+};
+use crate::render::OrbitCamera;
+use glam::{DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The format version this editor writes and reads.
+pub const SESSION_VERSION: u32 = 1;
+
+/// Where the mesh comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshSource {
+    /// A bundled scene's mesh, by its id ("comb").
+    Bundled(String),
+    /// A file, relative to the session's folder.
+    File(PathBuf),
+}
+
+/// Where the rest cage comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CageSource {
+    Bundled(String),
+    File(PathBuf),
+    /// An edited cage (subdivided, rested in a pose), written out in full.
+    Inline {
+        positions: Vec<[f64; 3]>,
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NamedPoseEntry {
+    pub name: String,
+    pub positions: Vec<[f64; 3]>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraEntry {
+    pub target: [f32; 3],
+    pub distance: f32,
+    pub yaw: f32,
+    pub pitch: f32,
+}
+
+/// A session file as written.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SessionFile {
+    /// [`SESSION_VERSION`]; also what marks the file as a pmvc session.
+    pub pmvc_session: u32,
+    pub title: String,
+    pub mesh: MeshSource,
+    pub cage: CageSource,
+    /// One position per cage vertex.
+    pub pose: Vec<[f64; 3]>,
+    #[serde(default)]
+    pub named_poses: Vec<NamedPoseEntry>,
+    /// The method a single view shows.
+    pub method: Method,
+    /// Each family's parameter by name ("resolution": 32).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, u32>,
+    #[serde(default)]
+    pub view: ViewSettings,
+    /// One camera per view (the first is every view's while they are locked).
+    #[serde(default)]
+    pub cameras: Vec<CameraEntry>,
+}
+
+/// A session could not be read or written; each message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    #[error("{path}: cannot read: {source}", path = path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: line {line}, column {column}: {message}", path = path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{path}: a session of format {found}; this editor reads format {SESSION_VERSION}", path = path.display())]
+    Version { path: PathBuf, found: u32 },
+    #[error("{path}: no bundled scene is called \"{id}\"", path = path.display())]
+    UnknownScene { path: PathBuf, id: String },
+    #[error("{path}: the rest cage: {source}", path = path.display())]
+    InlineCage { path: PathBuf, source: CageError },
+    #[error("{path}: {what} has {found} positions but the cage has {expected} vertices", path = path.display())]
+    PoseLength {
+        path: PathBuf,
+        what: String,
+        found: usize,
+        expected: usize,
+    },
+    #[error("{path}: {what} has a coordinate that is not a finite number", path = path.display())]
+    NonFinite { path: PathBuf, what: String },
+    #[error("{path}: the mesh: {source}", path = path.display())]
+    Mesh { path: PathBuf, source: LoadError },
+    #[error("{path}: the cage: {source}", path = path.display())]
+    Cage {
+        path: PathBuf,
+        source: CageLoadError,
+    },
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    #[error("{path}: cannot encode the session: {message}", path = path.display())]
+    Encode { path: PathBuf, message: String },
+}
+
+/// What the editor keeps besides the document: the method, parameters and views.
+#[derive(Clone, Debug)]
+pub struct SessionSettings {
+    pub bind_options: BindOptions,
+    pub view: ViewSettings,
+    pub cameras: Vec<OrbitCamera>,
+}
+
+/// A session read back: the document to open, and the settings to apply.
+pub struct OpenedSession {
+    pub document: Document,
+    pub settings: SessionSettings,
+    /// Things worth saying that did not stop the session from opening.
+    pub notes: Vec<String>,
+}
+
+fn to_array(p: DVec3) -> [f64; 3] {
+    p.to_array()
+}
+
+fn to_points(points: &[[f64; 3]]) -> Vec<DVec3> {
+    points.iter().map(|&p| DVec3::from_array(p)).collect()
+}
+
+/// `path` written relative to `folder` when it is inside it, else absolute.
+fn relative_to(path: &Path, folder: &Path) -> PathBuf {
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
+    let folder = std::path::absolute(folder).unwrap_or_else(|_| folder.to_owned());
+    absolute
+        .strip_prefix(&folder)
+        .map(Path::to_owned)
+        .unwrap_or(absolute)
+}
+
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Where a session saved as `session` keeps a rest mesh that changed.
+pub fn rest_mesh_path(session: &Path) -> PathBuf {
+    let name = session
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "session".into());
+    let stem = name
+        .strip_suffix(".json")
+        .unwrap_or(&name)
+        .trim_end_matches(".session");
+    session.with_file_name(format!("{stem}.rest-mesh.obj"))
+}
+
+/// Pretty JSON with each array of plain numbers (a point, a triangle) on one
+/// line: a 40-vertex pose is 40 lines, not 200.
+fn one_point_per_line(pretty: &str) -> String {
+    let lines: Vec<&str> = pretty.lines().collect();
+    let mut out = String::with_capacity(pretty.len());
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if line.trim_end().ends_with('[') {
+            // The numbers up to the closing bracket, if that is all there is.
+            let numbers: Vec<&str> = lines[i + 1..]
+                .iter()
+                .map(|l| l.trim().trim_end_matches(','))
+                .take_while(|l| l.parse::<f64>().is_ok())
+                .collect();
+            if let Some(close) = lines.get(i + 1 + numbers.len()) {
+                let close = close.trim();
+                if !numbers.is_empty() && (close == "]" || close == "],") {
+                    out.push_str(line.trim_end());
+                    out.push_str(&numbers.join(", "));
+                    out.push_str(close);
+                    out.push('\n');
+                    i += numbers.len() + 2;
+                    continue;
+                }
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+        i += 1;
+    }
+    out
+}
+
+/// Write `document` and `settings` as a session at `path` (through a temporary
+/// file, by the output rules). A rest mesh that differs from its source is
+/// written beside it first.
+pub fn save_session(
+    path: &Path,
+    document: &Document,
+    settings: &SessionSettings,
+) -> Result<(), SessionError> {
+    let folder = folder_of(path);
+    let mesh = mesh_source(path, &folder, document)?;
+    let cage = cage_source(&folder, document);
+    let session = SessionFile {
+        pmvc_session: SESSION_VERSION,
+        title: document.title().to_owned(),
+        mesh,
+        cage,
+        pose: document.pose().iter().copied().map(to_array).collect(),
+        named_poses: document
+            .named_poses()
+            .iter()
+            .map(|named| NamedPoseEntry {
+                name: named.name.clone(),
+                positions: named.positions.iter().copied().map(to_array).collect(),
+            })
+            .collect(),
+        method: settings.bind_options.method,
+        parameters: Parameter::ALL
+            .into_iter()
+            .map(|p| (p.id().to_owned(), settings.bind_options.get(p)))
+            .collect(),
+        view: settings.view,
+        cameras: settings
+            .cameras
+            .iter()
+            .map(|camera| CameraEntry {
+                target: camera.target.to_array(),
+                distance: camera.distance,
+                yaw: camera.yaw,
+                pitch: camera.pitch,
+            })
+            .collect(),
+    };
+    let text = serde_json::to_string_pretty(&session).map_err(|error| SessionError::Encode {
+        path: path.to_owned(),
+        message: error.to_string(),
+    })?;
+    let text = one_point_per_line(&text);
+    write_atomically(path, |out| out.write_all(text.as_bytes()))?;
+    Ok(())
+}
+
+fn mesh_source(
+    session: &Path,
+    folder: &Path,
+    document: &Document,
+) -> Result<MeshSource, SessionError> {
+    if let Some(scene) = document.bundled() {
+        return Ok(MeshSource::Bundled(scene.id().to_owned()));
+    }
+    let positions = &document.mesh().positions;
+    if let Some(file) = document.mesh_file() {
+        if &file.mesh.positions == positions {
+            return Ok(MeshSource::File(relative_to(&file.path, folder)));
+        }
+    }
+    // The mesh rests elsewhere than any file says: keep it beside the session.
+    let sidecar = rest_mesh_path(session);
+    let mut inputs: Vec<&Path> = document
+        .mesh_file()
+        .map(|f| f.path.as_path())
+        .into_iter()
+        .collect();
+    inputs.extend(document.cage_path());
+    refuse_same_file(&sidecar, &inputs)?;
+    match document.mesh_file() {
+        Some(file) => write_deformed_mesh(file, positions, &sidecar)?,
+        None => write_obj(&sidecar, document.mesh())?,
+    }
+    Ok(MeshSource::File(relative_to(&sidecar, folder)))
+}
+
+fn cage_source(folder: &Path, document: &Document) -> CageSource {
+    let cage = document.cage();
+    let same = |other: &Cage| {
+        other.positions() == cage.positions() && other.triangles() == cage.triangles()
+    };
+    if let Some(scene) = document.bundled() {
+        if scene.build().is_ok_and(|(_, bundled)| same(&bundled)) {
+            return CageSource::Bundled(scene.id().to_owned());
+        }
+    }
+    if let Some(path) = document.cage_path() {
+        if load_cage(path).is_ok_and(|(file_cage, _)| same(&file_cage)) {
+            return CageSource::File(relative_to(path, folder));
+        }
+    }
+    CageSource::Inline {
+        positions: cage.positions().iter().copied().map(to_array).collect(),
+        triangles: cage.triangles().to_vec(),
+    }
+}
+
+/// Read the session at `path` and everything it names. Nothing is changed on
+/// failure; the error names the file and what is wrong.
+pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SessionError::Read {
+        path: path.to_owned(),
+        source,
+    })?;
+    let session: SessionFile = serde_json::from_str(&text).map_err(|error| {
+        // serde_json counts lines and columns from 1, as editors do.
+        let message = error.to_string();
+        let message = message
+            .rsplit_once(" at line ")
+            .map_or(message.as_str(), |(head, _)| head)
+            .to_owned();
+        SessionError::Parse {
+            path: path.to_owned(),
+            line: error.line(),
+            column: error.column(),
+            message,
+        }
+    })?;
+    if session.pmvc_session != SESSION_VERSION {
+        return Err(SessionError::Version {
+            path: path.to_owned(),
+            found: session.pmvc_session,
+        });
+    }
+    let folder = folder_of(path);
+    let scene = |id: &str| {
+        BundledScene::from_id(id).ok_or_else(|| SessionError::UnknownScene {
+            path: path.to_owned(),
+            id: id.to_owned(),
+        })
+    };
+    let cage_error = |source| SessionError::Cage {
+        path: path.to_owned(),
+        source,
+    };
+    let mut notes = Vec::new();
+    let (mesh, mesh_file, bundled_mesh): (TriMesh, Option<MeshFile>, Option<BundledScene>) =
+        match &session.mesh {
+            MeshSource::Bundled(id) => {
+                let bundled = scene(id)?;
+                (bundled.build().map_err(cage_error)?.0, None, Some(bundled))
+            }
+            MeshSource::File(file) => {
+                let file = load_mesh(&folder.join(file)).map_err(|source| SessionError::Mesh {
+                    path: path.to_owned(),
+                    source,
+                })?;
+                (file.mesh.clone(), Some(file), None)
+            }
+        };
+    let (cage, cage_path) = match &session.cage {
+        CageSource::Bundled(id) => (scene(id)?.build().map_err(cage_error)?.1, None),
+        CageSource::File(file) => {
+            let cage_path = folder.join(file);
+            let (cage, report) = load_cage(&cage_path).map_err(cage_error)?;
+            notes.extend(report.messages());
+            (cage, Some(cage_path))
+        }
+        CageSource::Inline {
+            positions,
+            triangles,
+        } => {
+            let mesh = TriMesh {
+                positions: to_points(positions),
+                triangle_faces: (0..triangles.len() as u32).collect(),
+                triangles: triangles.clone(),
+            };
+            let (cage, report) = Cage::new(mesh).map_err(|source| SessionError::InlineCage {
+                path: path.to_owned(),
+                source,
+            })?;
+            notes.extend(report.messages());
+            (cage, None)
+        }
+    };
+    let check = |what: String, points: &[[f64; 3]]| -> Result<Vec<DVec3>, SessionError> {
+        if points.len() != cage.vertex_count() {
+            return Err(SessionError::PoseLength {
+                path: path.to_owned(),
+                what,
+                found: points.len(),
+                expected: cage.vertex_count(),
+            });
+        }
+        if points.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(SessionError::NonFinite {
+                path: path.to_owned(),
+                what,
+            });
+        }
+        Ok(to_points(points))
+    };
+    let pose = check("the pose".into(), &session.pose)?;
+    let mut named_poses = Vec::new();
+    for (index, named) in session.named_poses.iter().enumerate() {
+        let what = format!("named pose {} (\"{}\")", index + 1, named.name);
+        named_poses.push(NamedPose {
+            name: named.name.clone(),
+            positions: check(what, &named.positions)?,
+        });
+    }
+
+    let mut bind_options = BindOptions::for_method(session.method);
+    for (name, &value) in &session.parameters {
+        match Parameter::ALL.into_iter().find(|p| p.id() == name) {
+            Some(parameter) => bind_options.set(parameter, value.max(1)),
+            None => notes.push(format!(
+                "{}: ignored the unknown parameter \"{name}\"",
+                path.display()
+            )),
+        }
+    }
+    let mut view = session.view;
+    if view.heat_vertex >= cage.vertex_count() {
+        view.heat_vertex = 0;
+    }
+    let cameras = session
+        .cameras
+        .iter()
+        .filter(|c| {
+            c.target.iter().all(|v| v.is_finite())
+                && c.distance.is_finite()
+                && c.distance > 0.0
+                && c.yaw.is_finite()
+                && c.pitch.is_finite()
+        })
+        .map(|c| OrbitCamera {
+            target: Vec3::from_array(c.target),
+            distance: c.distance,
+            yaw: c.yaw,
+            pitch: c.pitch.clamp(-1.55, 1.55),
+        })
+        .collect();
+
+    let mut document = Document::new(session.title.clone(), mesh, cage)
+        .with_files(mesh_file, cage_path)
+        .with_poses(pose, named_poses);
+    if let Some(bundled) = bundled_mesh {
+        document = document.bundled_as(bundled);
+    }
+    Ok(OpenedSession {
+        document,
+        settings: SessionSettings {
+            bind_options,
+            view,
+            cameras,
+        },
+        notes,
+    })
+}
+
+/// `session`'s view settings with every setting that `asked` changes from the
+/// default put over them: options given on the command line beside `--session`
+/// win, the rest comes from the session. New settings need no code here.
+pub fn view_with_overrides(session: ViewSettings, asked: ViewSettings) -> ViewSettings {
+    let to_map = |view: &ViewSettings| match serde_json::to_value(view) {
+        Ok(serde_json::Value::Object(map)) => Some(map),
+        _ => None,
+    };
+    let (Some(mut merged), Some(asked_map), Some(default)) = (
+        to_map(&session),
+        to_map(&asked),
+        to_map(&ViewSettings::default()),
+    ) else {
+        return session;
+    };
+    for (key, value) in asked_map {
+        if default.get(&key) != Some(&value) {
+            merged.insert(key, value);
+        }
+    }
+    serde_json::from_value(serde_json::Value::Object(merged)).unwrap_or(session)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_take_one_line_each_and_read_back_the_same() {
+        let value = serde_json::json!({
+            "pose": [[0.1, -2.0, 3e-9], [1.0, 2.0, 3.0]],
+            "names": ["a", "b"],
+            "empty": [],
+            "nested": {"triangles": [[0, 1, 2]]}
+        });
+        let pretty = serde_json::to_string_pretty(&value).unwrap();
+        let compact = one_point_per_line(&pretty);
+        assert!(compact.contains("    [0.1, -2.0, 3e-9],\n"), "{compact}");
+        assert!(compact.contains("[0, 1, 2]"), "{compact}");
+        assert!(
+            compact.contains("\"a\",\n"),
+            "strings stay one per line: {compact}"
+        );
+        assert_eq!(
+            serde_json::from_str::<serde_json::Value>(&compact).unwrap(),
+            value
+        );
+        assert!(compact.lines().count() < pretty.lines().count());
+    }
+}
