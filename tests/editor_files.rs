@@ -163,3 +163,92 @@ fn a_bad_file_in_the_in_window_dialog_keeps_the_dialog_and_the_scene() {
     assert_eq!(harness.state().open_file_dialog(), None);
     assert!(!harness.state().is_binding());
 }
+
+#[test]
+fn save_image_writes_the_views_as_drawn() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("view.png");
+    assert!(harness.state_mut().save_image(&path));
+    harness.run_steps(3);
+    assert_eq!(harness.state().last_error(), None);
+    let image = image::open(&path).unwrap().to_rgba8();
+    // The panes only: no menu, toolbar or side panel.
+    let panes = harness
+        .state()
+        .pane_rects()
+        .into_iter()
+        .map(|(_, rect)| rect)
+        .reduce(|a, b| a.union(b))
+        .unwrap();
+    let scale = harness.ctx.pixels_per_point();
+    assert_eq!(image.width(), (panes.width() * scale).round() as u32);
+    assert_eq!(image.height(), (panes.height() * scale).round() as u32);
+    // The mesh is in it: a good share of pixels differ from the background.
+    let background = *image.get_pixel(2, image.height() - 2);
+    let drawn = image.pixels().filter(|p| **p != background).count();
+    assert!(
+        drawn > image.pixels().len() / 20,
+        "{drawn} drawn pixels of {}",
+        image.pixels().len()
+    );
+    harness.get_by_label_contains("saved image");
+}
+
+#[test]
+fn the_coloured_export_has_the_colours_the_gpu_draws() {
+    use pmvc::app::compare::{Overlay, Pane};
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("heat.ply");
+    // Plain shading has no colours to export.
+    assert!(!harness.state_mut().export_coloured_mesh(&path));
+    assert!(harness
+        .state()
+        .last_error()
+        .unwrap()
+        .contains("plainly shaded"));
+    assert!(!path.exists());
+
+    let app = harness.state_mut();
+    app.view_mut().overlay = Overlay::Heatmap;
+    app.view_mut().heat_vertex = 3;
+    harness.run_steps(3);
+    let app = harness.state_mut();
+    assert!(app.export_coloured_mesh(&path), "{:?}", app.last_error());
+    let pane = Pane::Method(app.active_method());
+    let shading = app.shading_of(pane);
+    let drawn = app.read_back(&shading).unwrap().unwrap().colours;
+    let vertex_count = app.document().mesh().positions.len();
+    let triangle_count = app.document().mesh().triangles.len();
+
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (header, body) = text.split_once("end_header\n").unwrap();
+    assert!(header.contains(&format!("element vertex {vertex_count}")));
+    assert!(header.contains(&format!("element face {triangle_count}")));
+    assert!(header.contains("coordinate of cage vertex 3"), "{header}");
+    assert!(header.contains("linear scale"), "{header}");
+    let rows: Vec<Vec<f64>> = body
+        .lines()
+        .take(vertex_count)
+        .map(|line| line.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let mut coloured = 0;
+    for (row, gpu) in rows.iter().zip(&drawn) {
+        for k in 0..3 {
+            let expected = f64::from(gpu[k].clamp(0.0, 1.0)) * 255.0;
+            assert!(
+                (row[3 + k] - expected).abs() <= 1.01,
+                "PLY {:?} GPU {gpu:?}",
+                &row[3..]
+            );
+        }
+        coloured += usize::from(row[3] != row[5]);
+    }
+    assert!(
+        coloured > vertex_count / 10,
+        "the heatmap is in the colours"
+    );
+}

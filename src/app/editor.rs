@@ -7,6 +7,7 @@
 use super::bind_queue::BindQueue;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
+use super::exports::ImageRequest;
 use super::readouts::ReadoutCache;
 use super::recent::RecentFiles;
 use super::scene_history::SceneHistory;
@@ -63,6 +64,8 @@ pub struct EditorApp {
     pub(super) session_path: Option<PathBuf>,
     /// The rest-to-pose blend slider's state.
     pub(super) pose_blend: PoseBlend,
+    /// File > Save image… waiting for the next frame.
+    pub(super) image_request: ImageRequest,
     /// The system's or the in-window file dialog.
     pub(super) file_dialogs: FileDialogs,
     /// Quitting asks first when the pose is unsaved.
@@ -143,6 +146,7 @@ impl EditorApp {
             recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
             session_path: None,
             pose_blend: PoseBlend::default(),
+            image_request: ImageRequest::default(),
             file_dialogs: FileDialogs::default(),
             quit: QuitState::default(),
             screenshot: options.screenshot.clone().map(ScreenshotState::new),
@@ -551,6 +555,7 @@ impl eframe::App for EditorApp {
             ctx.request_repaint();
         }
         self.drive_screenshot(&ctx);
+        self.drive_image_request(&ctx);
     }
 
     /// Recent files outlive the run; a scripted run leaves them as they were.

@@ -298,7 +298,7 @@ impl EditorApp {
     /// False, with an error, when `path` is (or links to) the open mesh or cage:
     /// saving a pose over the rest cage, or a deformed mesh over its source, would
     /// lose the scene's input.
-    fn refuse_overwriting_open_files(&mut self, path: &Path) -> bool {
+    pub(super) fn refuse_overwriting_open_files(&mut self, path: &Path) -> bool {
         let mut inputs = Vec::new();
         inputs.extend(self.document.mesh_file().map(|file| file.path.as_path()));
         inputs.extend(self.document.cage_path());
@@ -327,6 +327,15 @@ impl EditorApp {
                 },
             ),
         };
+        self.report_export(result, path)
+    }
+
+    /// Say what an export wrote, or why it failed; true when it was written.
+    pub(super) fn report_export(
+        &mut self,
+        result: Result<(), crate::geometry::WriteError>,
+        path: &Path,
+    ) -> bool {
         match result {
             Ok(()) => {
                 self.info(format!("exported {}", path.display()));

@@ -17,6 +17,7 @@ mod binding;
 pub mod compare;
 pub mod document;
 pub mod editor;
+mod exports;
 mod files;
 mod focus;
 pub mod history;

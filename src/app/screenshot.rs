@@ -3,7 +3,8 @@
 //! script learns of it: the command then exits with status 1.
 
 use super::editor::EditorApp;
-use std::path::{Path, PathBuf};
+use super::exports::save_png;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -84,7 +85,7 @@ impl EditorApp {
             let failures = state.failures();
             let repaint = ctx.clone();
             ctx.request_screenshot(move |image| {
-                if let Err(error) = save_png(&path, &image) {
+                if let Err(error) = save_png(&path, &image, None) {
                     let text = format!("cannot save {}: {error}", path.display());
                     eprintln!("pmvc editor: {text}");
                     if let Ok(mut failures) = failures.lock() {
@@ -97,16 +98,4 @@ impl EditorApp {
         }
         ctx.request_repaint();
     }
-}
-
-fn save_png(path: &Path, image: &egui::ColorImage) -> Result<(), image::ImageError> {
-    let [width, height] = image.size;
-    let bytes: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
-    image::save_buffer(
-        path,
-        &bytes,
-        width as u32,
-        height as u32,
-        image::ColorType::Rgba8,
-    )
 }

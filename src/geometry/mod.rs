@@ -11,6 +11,7 @@ mod io;
 mod obj;
 mod off;
 mod output;
+mod ply;
 pub mod procedural;
 pub mod subdivide;
 
@@ -27,6 +28,7 @@ pub use output::{
     extension_warning, human_bytes, refuse_same_file, remove_unfinished_outputs, resolve_output,
     write_atomically, OutputTarget, PendingOutput,
 };
+pub use ply::{colour_byte, write_coloured_ply};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;

@@ -22,6 +22,8 @@ pub enum FileAction {
     ExportMesh,
     OpenSession,
     SaveSession,
+    SaveImage,
+    ExportColouredMesh,
 }
 
 impl FileAction {
@@ -34,37 +36,43 @@ impl FileAction {
             FileAction::ExportMesh => "Export deformed mesh",
             FileAction::OpenSession => "Open session",
             FileAction::SaveSession => "Save session",
+            FileAction::SaveImage => "Save image",
+            FileAction::ExportColouredMesh => "Export coloured mesh",
         }
     }
 
     fn saves(self) -> bool {
         matches!(
             self,
-            FileAction::SavePose | FileAction::ExportMesh | FileAction::SaveSession
+            FileAction::SavePose
+                | FileAction::ExportMesh
+                | FileAction::SaveSession
+                | FileAction::SaveImage
+                | FileAction::ExportColouredMesh
         )
     }
 
-    fn is_session(self) -> bool {
-        matches!(self, FileAction::OpenSession | FileAction::SaveSession)
+    /// The extensions of the files this action lists; a saved file without
+    /// one gets the first.
+    fn extensions(self) -> &'static [&'static str] {
+        match self {
+            FileAction::OpenSession | FileAction::SaveSession => &["json"],
+            FileAction::SaveImage => &["png"],
+            FileAction::ExportColouredMesh => &["ply"],
+            _ => &["obj", "off"],
+        }
     }
 
-    /// The extension a saved file gets when none is typed.
     fn extension(self) -> &'static str {
-        if self.is_session() {
-            "json"
-        } else {
-            "obj"
-        }
+        self.extensions()[0]
     }
 
     /// Files the dialog lists for this action.
     fn lists(self, name: &str) -> bool {
         let lower = name.to_lowercase();
-        if self.is_session() {
-            lower.ends_with(".json")
-        } else {
-            lower.ends_with(".obj") || lower.ends_with(".off")
-        }
+        self.extensions()
+            .iter()
+            .any(|extension| lower.ends_with(&format!(".{extension}")))
     }
 
     fn default_name(self) -> &'static str {
@@ -72,6 +80,8 @@ impl FileAction {
             FileAction::SavePose => "pose.obj",
             FileAction::ExportMesh => "deformed.obj",
             FileAction::SaveSession => "scene.session.json",
+            FileAction::SaveImage => "view.png",
+            FileAction::ExportColouredMesh => "coloured.ply",
             _ => "",
         }
     }
@@ -80,8 +90,8 @@ impl FileAction {
         match self {
             FileAction::OpenMesh | FileAction::OpenCage | FileAction::OpenSession => "Open",
             FileAction::LoadPose => "Load",
-            FileAction::SavePose | FileAction::SaveSession => "Save",
-            FileAction::ExportMesh => "Export",
+            FileAction::SavePose | FileAction::SaveSession | FileAction::SaveImage => "Save",
+            FileAction::ExportMesh | FileAction::ExportColouredMesh => "Export",
         }
     }
 }
@@ -270,6 +280,8 @@ impl EditorApp {
             FileAction::ExportMesh => self.export_deformed(path),
             FileAction::OpenSession => self.open_session(path),
             FileAction::SaveSession => self.save_session(path),
+            FileAction::SaveImage => self.save_image(path),
+            FileAction::ExportColouredMesh => self.export_coloured_mesh(path),
         };
         if action == FileAction::SavePose {
             self.pose_save_finished(done);
@@ -324,11 +336,10 @@ impl EditorApp {
                     .auto_shrink([false, false])
                     .show(ui, |ui| {
                         if browser.entries.is_empty() {
-                            ui.weak(if browser.action.is_session() {
-                                "(no folders or session files here)"
-                            } else {
-                                "(no folders, OBJ or OFF files here)"
-                            });
+                            ui.weak(format!(
+                                "(no folders or {} files here)",
+                                browser.action.extensions().join(" or ").to_uppercase()
+                            ));
                         }
                         for entry in &browser.entries {
                             if entry.is_folder {
@@ -434,18 +445,16 @@ fn system_dialog(action: FileAction, folder: &Path) -> Option<PathBuf> {
     let dialog = rfd::FileDialog::new()
         .set_title(action.title())
         .set_directory(folder);
-    match (action.saves(), action.is_session()) {
-        (true, true) => dialog
+    let extensions = action.extensions();
+    let kind = extensions.join("/").to_uppercase();
+    if action.saves() {
+        dialog
             .set_file_name(action.default_name())
-            .add_filter("Session", &["json"])
-            .save_file(),
-        (true, false) => dialog
-            .set_file_name(action.default_name())
-            .add_filter("OBJ", &["obj"])
-            .save_file(),
-        (false, true) => dialog.add_filter("Session", &["json"]).pick_file(),
-        (false, false) => dialog
-            .add_filter("Meshes", &["obj", "off", "OBJ", "OFF"])
-            .pick_file(),
+            .add_filter(&kind, &extensions[..1])
+            .save_file()
+    } else {
+        let mut both_cases: Vec<String> = extensions.iter().map(|e| e.to_string()).collect();
+        both_cases.extend(extensions.iter().map(|e| e.to_uppercase()));
+        dialog.add_filter(&kind, &both_cases).pick_file()
     }
 }

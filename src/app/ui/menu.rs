@@ -64,6 +64,23 @@ impl EditorApp {
         if ui.button("Export deformed mesh…").clicked() {
             self.ask_for_file(FileAction::ExportMesh);
         }
+        if ui
+            .button("Export coloured mesh (PLY)…")
+            .on_hover_text(
+                "The deformed mesh with each vertex in the colour the view gives it \
+                 (heatmap, negativity or difference); the header names the scale and range.",
+            )
+            .clicked()
+        {
+            self.ask_for_file(FileAction::ExportColouredMesh);
+        }
+        if ui
+            .button("Save image…")
+            .on_hover_text("The views as drawn, with their titles and colour bars, as PNG.")
+            .clicked()
+        {
+            self.ask_for_file(FileAction::SaveImage);
+        }
         ui.separator();
         ui.checkbox(&mut self.file_dialogs.in_window, "In-window file dialog")
             .on_hover_text(

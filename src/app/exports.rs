@@ -1,0 +1,234 @@
+//! Pictures and coloured meshes out of the editor: File > Save image… (the
+//! viewport's panes as PNG, with their titles and colour bars) and File > Export
+//! coloured mesh… (the deformed mesh as PLY, each vertex in the colour the view
+//! gives it, with the scale and range in the header).
+
+use super::compare::{self, Layout, Pane};
+use super::editor::EditorApp;
+use crate::geometry::{write_atomically, write_coloured_ply, WriteError};
+use crate::render::colormap::{heat_colour, Scale, OUTSIDE};
+use crate::render::Colouring;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// A Save image… waiting for the next frame's pixels, and what became of it.
+#[derive(Default)]
+pub struct ImageRequest {
+    pending: Option<PathBuf>,
+    /// Filled by the screenshot callback: the file written, or why not.
+    finished: Arc<Mutex<Option<Result<PathBuf, String>>>>,
+}
+
+/// Write `image`, cropped to `crop` (in pixels), as PNG by the output rules.
+pub fn save_png(
+    path: &Path,
+    image: &egui::ColorImage,
+    crop: Option<[usize; 4]>,
+) -> Result<(), WriteError> {
+    let [width, height] = image.size;
+    let [x0, y0, x1, y1] = crop.unwrap_or([0, 0, width, height]);
+    let (x1, y1) = (x1.min(width), y1.min(height));
+    let (x0, y0) = (x0.min(x1), y0.min(y1));
+    let mut bytes = Vec::with_capacity((x1 - x0) * (y1 - y0) * 4);
+    for row in y0..y1 {
+        for pixel in &image.pixels[row * width + x0..row * width + x1] {
+            bytes.extend_from_slice(&pixel.to_array());
+        }
+    }
+    write_atomically(path, |out| {
+        let mut encoded = std::io::Cursor::new(Vec::new());
+        image::write_buffer_with_format(
+            &mut encoded,
+            &bytes,
+            (x1 - x0) as u32,
+            (y1 - y0) as u32,
+            image::ColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(std::io::Error::other)?;
+        out.write_all(encoded.get_ref())
+    })
+}
+
+impl EditorApp {
+    /// File > Save image…: the panes as drawn in the next frame.
+    pub fn save_image(&mut self, path: &Path) -> bool {
+        if !self.refuse_overwriting_open_files(path) {
+            return false;
+        }
+        self.image_request.pending = Some(path.to_owned());
+        true
+    }
+
+    /// Ask for the pixels of a pending Save image…, and report the result.
+    pub(super) fn drive_image_request(&mut self, ctx: &egui::Context) {
+        let finished = self
+            .image_request
+            .finished
+            .lock()
+            .ok()
+            .and_then(|mut slot| slot.take());
+        match finished {
+            Some(Ok(path)) => self.info(format!("saved image {}", path.display())),
+            Some(Err(error)) => self.error(error),
+            None => {}
+        }
+        let Some(path) = self.image_request.pending.take() else {
+            return;
+        };
+        let scale = ctx.pixels_per_point();
+        let crop = self
+            .pane_rects()
+            .into_iter()
+            .map(|(_, rect)| rect)
+            .reduce(|a, b| a.union(b))
+            .map(|rect| {
+                [rect.left(), rect.top(), rect.right(), rect.bottom()]
+                    .map(|v| (v * scale).round().max(0.0) as usize)
+            });
+        let finished = Arc::clone(&self.image_request.finished);
+        let repaint = ctx.clone();
+        ctx.request_screenshot(move |image| {
+            let result = save_png(&path, &image, crop)
+                .map(|()| path.clone())
+                .map_err(|error| error.to_string());
+            if let Ok(mut slot) = finished.lock() {
+                *slot = Some(result);
+            }
+            repaint.request_repaint();
+        });
+        ctx.request_repaint();
+    }
+
+    /// The view a coloured export takes its colours from: the difference view in
+    /// that layout, else the shown method's.
+    fn exported_pane(&self) -> Pane {
+        match self.view.layout {
+            Layout::Difference => self.view.difference_pane_kind(),
+            _ => Pane::Method(self.active_method()),
+        }
+    }
+
+    /// File > Export coloured mesh…: the mesh deformed by the shown method, each
+    /// vertex in the colour the view gives it (unlit), as PLY.
+    pub fn export_coloured_mesh(&mut self, path: &Path) -> bool {
+        if !self.refuse_overwriting_open_files(path) {
+            return false;
+        }
+        let pane = self.exported_pane();
+        let colouring = self.view.colouring(pane);
+        let Some(values) = self.vertex_values(colouring, pane) else {
+            self.error(match colouring {
+                Colouring::Shaded => {
+                    "the mesh is plainly shaded: colour it by a heatmap, the negativity or \
+                     the difference first"
+                        .to_owned()
+                }
+                _ => format!("{} is not bound yet", pane.method()),
+            });
+            return false;
+        };
+        let limit = self.colour_limit(colouring, pane);
+        let scale = self.view.scale_of(colouring);
+        let outside: std::collections::HashSet<u32> =
+            self.document.outside().iter().copied().collect();
+        let colours: Vec<[f32; 3]> = values
+            .iter()
+            .enumerate()
+            .map(|(vertex, &value)| {
+                if colouring == Colouring::MostNegativeWeight && outside.contains(&(vertex as u32))
+                {
+                    OUTSIDE
+                } else {
+                    heat_colour(value, limit, scale)
+                }
+            })
+            .collect();
+        let comments = self.colour_comments(colouring, pane, limit, scale);
+        let positions = self.document.deformed_positions(pane.method());
+        let result = write_coloured_ply(
+            path,
+            &positions,
+            &self.document.mesh().triangles,
+            &colours,
+            &comments,
+        );
+        self.report_export(result, path)
+    }
+
+    /// The value each mesh vertex is coloured by, as the vertex shader computes it.
+    fn vertex_values(&mut self, colouring: Colouring, pane: Pane) -> Option<Vec<f32>> {
+        match colouring {
+            Colouring::Shaded => None,
+            Colouring::CageVertexWeight(column) => {
+                let weights = self.document.weights(pane.method())?;
+                let column = (column as usize).min(weights.cols.saturating_sub(1));
+                Some((0..weights.rows).map(|r| weights.row(r)[column]).collect())
+            }
+            Colouring::MostNegativeWeight => {
+                let weights = self.document.weights(pane.method())?;
+                Some(
+                    (0..weights.rows)
+                        .map(|r| weights.row(r).iter().copied().fold(f32::INFINITY, f32::min))
+                        .collect(),
+                )
+            }
+            Colouring::MethodDistance => {
+                let Pane::Difference { against, shown } = pane else {
+                    return None;
+                };
+                let a = self.deformed_on_cpu(against)?;
+                let b = self.deformed_on_cpu(shown)?;
+                let size = compare::cage_size(self.document.cage().positions()) as f32;
+                Some(
+                    b.iter()
+                        .zip(a.iter())
+                        .map(|(p, q)| (*p - *q).length() / size.max(1e-30))
+                        .collect(),
+                )
+            }
+        }
+    }
+
+    fn colour_comments(
+        &self,
+        colouring: Colouring,
+        pane: Pane,
+        limit: f32,
+        scale: Scale,
+    ) -> Vec<String> {
+        let what = match (colouring, pane) {
+            (Colouring::CageVertexWeight(vertex), _) => {
+                format!("{} coordinate of cage vertex {vertex}", pane.method())
+            }
+            (Colouring::MostNegativeWeight, _) => {
+                format!("{} most negative weight per vertex", pane.method())
+            }
+            (_, Pane::Difference { against, shown }) => {
+                format!("distance between the {shown} and {against} deformations / cage diagonal")
+            }
+            _ => "plain shading".into(),
+        };
+        let scale = match scale {
+            Scale::Linear => "linear scale".to_owned(),
+            Scale::LogMagnitude => format!(
+                "log scale over {} decades below the limit",
+                crate::render::colormap::LOG_DECADES
+            ),
+        };
+        let mut comments = vec![
+            format!("colours: {what}"),
+            format!(
+                "colour scale: blue -{limit:.6} .. white 0 .. red +{limit:.6}, {scale}; values beyond saturate"
+            ),
+            format!("positions: the mesh deformed with {}", pane.method()),
+        ];
+        if colouring == Colouring::MostNegativeWeight {
+            comments.push(
+                "grey vertices are outside the cage: their weights follow the outside policy"
+                    .into(),
+            );
+        }
+        comments
+    }
+}
