@@ -6,7 +6,8 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(3) var<storage, read> cage: array<vec4<f32>>;
-// Per cage vertex: 0 idle, 1 selected, 2 hovered.
+// Per cage vertex: 0 idle, 1 selected, 2 hovered, 3 + 255·w a handle that
+// follows the selection with weight w (soft selection).
 @group(0) @binding(4) var<storage, read> handle_state: array<u32>;
 
 struct CageVarying {
@@ -39,6 +40,10 @@ fn vs_handle(@builtin(vertex_index) corner: u32, @builtin(instance_index) handle
     } else if state == 2u {
         colour = vec3<f32>(0.3, 1.0, 0.9);
         radius *= 1.4;
+    } else if state >= 3u {
+        let follows = f32(state - 3u) / 255.0;
+        colour = mix(colour, vec3<f32>(1.0, 0.55, 0.05), 0.25 + 0.75 * follows);
+        radius *= 1.0 + 0.4 * follows;
     }
     var clip = frame.view_projection * vec4<f32>(cage[handle].xyz, 1.0);
     clip.z -= 2e-4 * clip.w;

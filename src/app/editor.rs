@@ -8,6 +8,7 @@ use super::bind_queue::BindQueue;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::exports::ImageRequest;
+use super::pose_tools::PoseToolSettings;
 use super::readouts::ReadoutCache;
 use super::recent::RecentFiles;
 use super::scene_history::SceneHistory;
@@ -64,6 +65,8 @@ pub struct EditorApp {
     pub(super) session_path: Option<PathBuf>,
     /// The rest-to-pose blend slider's state.
     pub(super) pose_blend: PoseBlend,
+    /// Pivot, symmetry and soft selection of pose edits.
+    pub(super) pose_tools: PoseToolSettings,
     /// File > Save image… waiting for the next frame.
     pub(super) image_request: ImageRequest,
     /// The system's or the in-window file dialog.
@@ -147,6 +150,7 @@ impl EditorApp {
             session_path: None,
             pose_blend: PoseBlend::default(),
             image_request: ImageRequest::default(),
+            pose_tools: PoseToolSettings::default(),
             file_dialogs: FileDialogs::default(),
             quit: QuitState::default(),
             screenshot: options.screenshot.clone().map(ScreenshotState::new),
@@ -393,20 +397,9 @@ impl EditorApp {
         if changes.scene || changes.pose || !changes.weights.is_empty() {
             self.readouts.invalidate(&changes);
         }
-        if changes.scene || changes.selection || self.viewport.take_hover_changed() {
-            let selection = self.document.selection();
-            let hovered = self.viewport.hovered;
-            let states: Vec<u32> = (0..self.document.pose().len())
-                .map(|i| {
-                    if selection.contains(&i) {
-                        1
-                    } else if hovered == Some(i) {
-                        2
-                    } else {
-                        0
-                    }
-                })
-                .collect();
+        let hover_changed = self.viewport.take_hover_changed();
+        if changes.scene || changes.selection || hover_changed || self.pose_tools.soft_selection {
+            let states = self.handle_states();
             self.with_renderer(|renderer, _, queue| renderer.set_handle_states(queue, &states));
         }
     }
@@ -521,54 +514,6 @@ impl EditorApp {
     /// The views drawn last frame and their screen rectangles.
     pub fn pane_rects(&self) -> Vec<(Pane, egui::Rect)> {
         self.viewport.pane_rects()
-    }
-}
-
-impl eframe::App for EditorApp {
-    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        self.stats.record_frame(ctx.input(|i| i.time));
-        self.intercept_close(&ctx);
-        self.ask_for_keyboard_focus(&ctx, frame);
-        self.poll_bind();
-        self.handle_dropped_files(&ctx);
-        self.handle_shortcuts(&ctx);
-        self.file_shortcuts(&ctx);
-        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
-        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
-        if self.first_run_hint {
-            egui::Panel::top("first run").show(ui, |ui| self.first_run_line(ui));
-        }
-        egui::Panel::right("side")
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui))
-            });
-        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
-        self.drop_dialog(&ctx);
-        // The question first: its Save pose… opens the file dialog in this frame.
-        self.quit_dialog(&ctx);
-        self.file_dialog_window(&ctx);
-        self.request_wanted_binds();
-        if self.show_statistics {
-            // Keep frames coming so the readout measures rendering, not idling.
-            ctx.request_repaint();
-        }
-        self.drive_screenshot(&ctx);
-        self.drive_image_request(&ctx);
-    }
-
-    /// Recent files outlive the run; a scripted run leaves them as they were.
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        if self.screenshot.is_none() {
-            self.recent.save(storage);
-        }
-    }
-
-    /// Only the recent files are kept: panels and windows open as they always
-    /// do, so screenshots and snapshot tests start from the same state.
-    fn persist_egui_memory(&self) -> bool {
-        false
     }
 }
 

@@ -20,7 +20,9 @@ pub mod editor;
 mod exports;
 mod files;
 mod focus;
+mod frame;
 pub mod history;
+pub mod pose_tools;
 mod readouts;
 pub mod recent;
 pub mod scene_history;
@@ -32,6 +34,7 @@ mod viewport;
 pub mod widgets;
 
 pub use editor::{EditorApp, FileRole};
+pub use viewport::TransformKind;
 
 use std::path::PathBuf;
 

@@ -6,6 +6,7 @@ pub mod file_dialog;
 pub mod menu;
 pub mod named_poses;
 pub mod notices;
+pub mod pose_panel;
 pub mod quality_table;
 pub mod quit_dialog;
 pub mod side_panel;

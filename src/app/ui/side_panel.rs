@@ -21,9 +21,11 @@ impl EditorApp {
         ui.separator();
         self.selection_section(ui);
         ui.separator();
+        self.pose_tools_section(ui);
+        ui.separator();
         self.named_poses_section(ui);
         ui.separator();
-        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · F: frame selection · Home: frame all · H: cage · M: next method · Esc: deselect");
+        ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · G/R/S: move/rotate/scale · O: soft selection · Shift+right click: 3D cursor · F: frame selection · Home: frame all · H: cage · M: next method · Esc: deselect");
         if self.show_statistics {
             ui.separator();
             self.statistics(ui);

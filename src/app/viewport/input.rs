@@ -57,6 +57,19 @@ impl EditorApp {
             )
         });
 
+        // A G, R or S transform takes the pointer until it is confirmed or cancelled.
+        if self.viewport.modal.is_some() {
+            if response.hovered() {
+                self.transform_pointer(response);
+            }
+            return;
+        }
+        if response.clicked_by(PointerButton::Secondary) && modifiers.shift {
+            if let Some(pointer) = response.interact_pointer_pos() {
+                self.place_cursor(pane, pointer);
+            }
+        }
+
         // Hover highlight (not while dragging, so the highlight does not flicker, and
         // not in `--screenshot` runs, where the pointer rests wherever the display
         // server put it).
@@ -174,6 +187,9 @@ impl EditorApp {
         if ctx.egui_wants_keyboard_input() || self.modal_dialog_open() {
             return;
         }
+        if self.transform_keys(ctx) {
+            return;
+        }
         let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
         let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
         let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
@@ -188,6 +204,9 @@ impl EditorApp {
                 i.key_pressed(Key::H) && i.modifiers.is_none(),
             )
         });
+        if ctx.input(|i| i.key_pressed(Key::O) && i.modifiers.is_none()) {
+            self.pose_tools.soft_selection = !self.pose_tools.soft_selection;
+        }
         if next_method {
             self.toggle_method();
         }

@@ -3,7 +3,10 @@
 //! [`picking`].
 
 mod input;
+mod modal;
 mod picking;
+
+pub use modal::TransformKind;
 
 use super::compare::{HoverReadout, Pane};
 use super::editor::EditorApp;
@@ -27,6 +30,8 @@ pub struct ViewportState {
     /// The views drawn last frame, each with its screen rectangle and projection.
     panes: Vec<(Pane, Rect, ScreenProjection)>,
     pub(super) drag: Option<Drag>,
+    /// A G, R or S transform under way.
+    pub(super) modal: Option<modal::Modal>,
     /// The handle under the cursor.
     pub(super) hovered: Option<usize>,
     hover_changed: bool,
@@ -259,6 +264,7 @@ impl EditorApp {
                 Color32::from_gray(200),
             );
         }
+        self.draw_transform(&painter, index, rect);
         if shading.colouring != Colouring::Shaded {
             if let Some(range) = self.value_range(shading.colouring, kind) {
                 let note = self.colour_bar_note(shading.colouring);
@@ -323,30 +329,23 @@ impl EditorApp {
     /// `start_pose` with the selection moved by a pointer motion of `motion` points:
     /// in the view plane, or along `axis` by the motion's component along the axis's
     /// screen direction.
-    fn moved_pose(
+    /// How far a pointer motion of `motion` moves a point at `centre` in view
+    /// `pane`: in the view plane, or along `axis` as far as the pointer went
+    /// along the axis's image on screen.
+    pub(super) fn drag_offset(
         &self,
         pane: usize,
-        start_pose: &[DVec3],
+        centre: DVec3,
         motion: egui::Vec2,
         axis: Option<DVec3>,
         rect: Rect,
-    ) -> Vec<DVec3> {
-        let mut pose = start_pose.to_vec();
-        let selection = self.document.selection();
-        if selection.is_empty() {
-            return pose;
-        }
-        let centre = selection
-            .iter()
-            .filter_map(|&i| start_pose.get(i))
-            .sum::<DVec3>()
-            / selection.len() as f64;
+    ) -> DVec3 {
         let camera = self.camera_of(pane);
         let short_side = rect.height().min(rect.width());
         let scale = camera.units_per_pixel(camera.depth_of(centre.as_vec3()), short_side);
         let (right, up) = camera.right_up();
         let in_plane = (right * motion.x - up * motion.y) * scale;
-        let offset = match (axis, self.viewport.projection(pane)) {
+        match (axis, self.viewport.projection(pane)) {
             (Some(axis), Some(projection)) => {
                 let from = projection.project(centre.as_vec3());
                 let to = projection.project((centre + axis).as_vec3());
@@ -361,12 +360,32 @@ impl EditorApp {
                 }
             }
             _ => in_plane.as_dvec3(),
-        };
-        for &i in selection {
-            if let Some(p) = pose.get_mut(i) {
-                *p += offset;
-            }
         }
-        pose
+    }
+
+    /// `start_pose` with the selection dragged by `motion`, soft selection and
+    /// symmetry applied.
+    fn moved_pose(
+        &self,
+        pane: usize,
+        start_pose: &[DVec3],
+        motion: egui::Vec2,
+        axis: Option<DVec3>,
+        rect: Rect,
+    ) -> Vec<DVec3> {
+        let selection = self.document.selection();
+        if selection.is_empty() {
+            return start_pose.to_vec();
+        }
+        let centre = selection
+            .iter()
+            .filter_map(|&i| start_pose.get(i))
+            .sum::<DVec3>()
+            / selection.len() as f64;
+        let offset = self.drag_offset(pane, centre, motion, axis, rect);
+        self.pose_transformed(
+            start_pose,
+            &crate::app::pose_tools::Transform::Translate(offset),
+        )
     }
 }

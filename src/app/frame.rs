@@ -1,0 +1,52 @@
+//! The frame loop: what the editor does each frame, in order, and what it keeps
+//! across runs (the recent files).
+
+use super::editor::EditorApp;
+
+impl eframe::App for EditorApp {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.stats.record_frame(ctx.input(|i| i.time));
+        self.intercept_close(&ctx);
+        self.ask_for_keyboard_focus(&ctx, frame);
+        self.poll_bind();
+        self.handle_dropped_files(&ctx);
+        self.handle_shortcuts(&ctx);
+        self.file_shortcuts(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
+        if self.first_run_hint {
+            egui::Panel::top("first run").show(ui, |ui| self.first_run_line(ui));
+        }
+        egui::Panel::right("side")
+            .default_size(300.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui))
+            });
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        self.drop_dialog(&ctx);
+        // The question first: its Save pose… opens the file dialog in this frame.
+        self.quit_dialog(&ctx);
+        self.file_dialog_window(&ctx);
+        self.request_wanted_binds();
+        if self.show_statistics {
+            // Keep frames coming so the readout measures rendering, not idling.
+            ctx.request_repaint();
+        }
+        self.drive_screenshot(&ctx);
+        self.drive_image_request(&ctx);
+    }
+
+    /// Recent files outlive the run; a scripted run leaves them as they were.
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.screenshot.is_none() {
+            self.recent.save(storage);
+        }
+    }
+
+    /// Only the recent files are kept: panels and windows open as they always
+    /// do, so screenshots and snapshot tests start from the same state.
+    fn persist_egui_memory(&self) -> bool {
+        false
+    }
+}

@@ -1,0 +1,266 @@
+//! Posing tools, as Blender's users know them: move, rotate and scale about a
+//! pivot, optionally along one axis; symmetry across a plane; soft selection,
+//! where handles near the selection follow with a smooth falloff. Pure geometry
+//! on poses: no UI here, so every rule is tested on its own.
+
+use glam::{DMat3, DVec3};
+use std::collections::BTreeSet;
+
+/// What a move, rotate or scale does to a point, about a pivot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Transform {
+    Translate(DVec3),
+    /// Right-handed rotation by `angle` radians about `axis` (unit length).
+    Rotate {
+        axis: DVec3,
+        angle: f64,
+    },
+    /// A factor per world axis (uniform scaling has three equal ones).
+    Scale(DVec3),
+}
+
+impl Transform {
+    pub fn apply(&self, point: DVec3, pivot: DVec3) -> DVec3 {
+        match *self {
+            Transform::Translate(offset) => point + offset,
+            Transform::Rotate { axis, angle } => {
+                pivot + DMat3::from_axis_angle(axis.normalize_or_zero(), angle) * (point - pivot)
+            }
+            Transform::Scale(factors) => pivot + (point - pivot) * factors,
+        }
+    }
+}
+
+/// Where rotations and scalings turn about.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Pivot {
+    /// The centre of the selected handles.
+    #[default]
+    SelectionCentre,
+    /// The 3D cursor, placed by Shift+right-click.
+    Cursor,
+}
+
+/// The posing tools' settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoseToolSettings {
+    pub pivot: Pivot,
+    pub cursor: DVec3,
+    /// Mirror edits across the plane through the rest cage's centre that is
+    /// perpendicular to this world axis (0 = x, 1 = y, 2 = z).
+    pub symmetry: Option<usize>,
+    /// Handles near the selection follow its edits.
+    pub soft_selection: bool,
+    /// How far they follow from, as a fraction of the cage diagonal.
+    pub soft_radius: f64,
+}
+
+impl Default for PoseToolSettings {
+    fn default() -> Self {
+        Self {
+            pivot: Pivot::default(),
+            cursor: DVec3::ZERO,
+            symmetry: None,
+            soft_selection: false,
+            soft_radius: 0.15,
+        }
+    }
+}
+
+pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
+
+/// Each handle's mirror partner across the plane `axis = centre`, matched by rest
+/// position within `tolerance`: itself for a handle on the plane, `None` for one
+/// with no partner.
+pub fn mirror_partners(
+    rest: &[DVec3],
+    axis: usize,
+    centre: f64,
+    tolerance: f64,
+) -> Vec<Option<usize>> {
+    rest.iter()
+        .map(|&p| {
+            let mut mirrored = p;
+            mirrored[axis] = 2.0 * centre - p[axis];
+            rest.iter()
+                .enumerate()
+                .map(|(j, &q)| (j, (q - mirrored).length()))
+                .filter(|&(_, distance)| distance <= tolerance)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(j, _)| j)
+        })
+        .collect()
+}
+
+/// The centre of `points`' bounding box along `axis`.
+pub fn mid_plane(points: &[DVec3], axis: usize) -> f64 {
+    let (lo, hi) = crate::geometry::bounds_of(points);
+    (lo[axis] + hi[axis]) / 2.0
+}
+
+/// How much each handle follows an edit: 1 for the selection, and with soft
+/// selection a smooth falloff (smoothstep of 1 − d/r) with distance d to the
+/// nearest selected handle in `pose`, reaching 0 at `radius`.
+pub fn follow_weights(
+    pose: &[DVec3],
+    selection: &BTreeSet<usize>,
+    soft_radius: Option<f64>,
+) -> Vec<f64> {
+    pose.iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            if selection.contains(&i) {
+                return 1.0;
+            }
+            let Some(radius) = soft_radius.filter(|r| *r > 0.0) else {
+                return 0.0;
+            };
+            let nearest = selection
+                .iter()
+                .filter_map(|&s| pose.get(s))
+                .map(|&s| (s - p).length())
+                .fold(f64::INFINITY, f64::min);
+            let t = (1.0 - nearest / radius).clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
+        })
+        .collect()
+}
+
+/// `start` with `transform` applied about `pivot` to each handle in proportion
+/// to its weight, then, with symmetry, each moved handle's motion mirrored onto
+/// its partner. Of two partners that both move, the one that follows more (or,
+/// equally, the lower-numbered) leads; a handle on the plane keeps its
+/// coordinate across it.
+pub fn posed(
+    start: &[DVec3],
+    weights: &[f64],
+    transform: &Transform,
+    pivot: DVec3,
+    symmetry: Option<(usize, &[Option<usize>])>,
+) -> Vec<DVec3> {
+    let mut pose: Vec<DVec3> = start
+        .iter()
+        .zip(weights)
+        .map(|(&p, &w)| {
+            if w > 0.0 {
+                p + (transform.apply(p, pivot) - p) * w
+            } else {
+                p
+            }
+        })
+        .collect();
+    let Some((axis, partners)) = symmetry else {
+        return pose;
+    };
+    let weight = |i: usize| weights.get(i).copied().unwrap_or(0.0);
+    for i in 0..pose.len() {
+        if weight(i) <= 0.0 {
+            continue;
+        }
+        match partners.get(i).copied().flatten() {
+            Some(j) if j == i => pose[i][axis] = start[i][axis],
+            Some(j) => {
+                let leads = weight(i) > weight(j) || (weight(i) == weight(j) && i < j);
+                if leads {
+                    let mut motion = pose[i] - start[i];
+                    motion[axis] = -motion[axis];
+                    pose[j] = start[j] + motion;
+                }
+            }
+            None => {}
+        }
+    }
+    pose
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: DVec3, b: DVec3) -> bool {
+        (a - b).length() < 1e-12
+    }
+
+    #[test]
+    fn a_quarter_turn_about_z_takes_x_to_y_around_the_pivot() {
+        let pivot = DVec3::new(1.0, 1.0, 0.0);
+        let turn = Transform::Rotate {
+            axis: DVec3::Z,
+            angle: std::f64::consts::FRAC_PI_2,
+        };
+        assert!(close(turn.apply(pivot + DVec3::X, pivot), pivot + DVec3::Y));
+        assert!(close(turn.apply(pivot, pivot), pivot));
+        let stretch = Transform::Scale(DVec3::new(2.0, 1.0, 1.0));
+        assert!(close(
+            stretch.apply(DVec3::new(3.0, 5.0, 7.0), pivot),
+            DVec3::new(5.0, 5.0, 7.0)
+        ));
+    }
+
+    #[test]
+    fn partners_are_found_by_mirrored_rest_position() {
+        let rest = [
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(0.0, 2.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 3.0, 0.0),
+        ];
+        let centre = mid_plane(&rest, 0);
+        assert_eq!(centre, 0.0);
+        let partners = mirror_partners(&rest, 0, centre, 1e-9);
+        assert_eq!(partners, vec![Some(2), Some(1), Some(0), None]);
+    }
+
+    #[test]
+    fn soft_selection_falls_from_one_at_the_selection_to_zero_at_the_radius() {
+        let pose: Vec<DVec3> = (0..6).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let selection = BTreeSet::from([0]);
+        let weights = follow_weights(&pose, &selection, Some(4.0));
+        assert_eq!(weights[0], 1.0);
+        // smoothstep(1 - 2/4) = 0.5 half way.
+        assert!((weights[2] - 0.5).abs() < 1e-12);
+        assert!(weights.windows(2).all(|w| w[1] <= w[0]));
+        assert_eq!(weights[4], 0.0);
+        assert_eq!(weights[5], 0.0);
+        assert_eq!(
+            follow_weights(&pose, &selection, None),
+            vec![1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        );
+    }
+
+    #[test]
+    fn a_mirrored_edit_moves_the_partner_to_the_mirror_image() {
+        let start = [
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        let partners = mirror_partners(&start, 0, 0.0, 1e-9);
+        let weights = [1.0, 0.0, 1.0];
+        let moved = posed(
+            &start,
+            &weights,
+            &Transform::Translate(DVec3::new(-0.5, 0.25, 1.0)),
+            DVec3::ZERO,
+            Some((0, &partners)),
+        );
+        assert!(close(moved[0], DVec3::new(-1.5, 0.25, 1.0)));
+        assert!(close(moved[1], DVec3::new(1.5, 0.25, 1.0)));
+        // On the plane: it moves, but stays on the plane.
+        assert!(close(moved[2], DVec3::new(0.0, 1.25, 1.0)));
+    }
+
+    #[test]
+    fn a_half_weight_handle_moves_half_way() {
+        let start = [DVec3::ZERO, DVec3::X];
+        let moved = posed(
+            &start,
+            &[1.0, 0.5],
+            &Transform::Translate(DVec3::Y),
+            DVec3::ZERO,
+            None,
+        );
+        assert!(close(moved[0], DVec3::Y));
+        assert!(close(moved[1], DVec3::new(1.0, 0.5, 0.0)));
+    }
+}

@@ -1,0 +1,412 @@
+//! Blender's modal transforms: with handles selected, G moves, R rotates and S
+//! scales them, following the pointer from where the key was pressed. X, Y or Z
+//! constrain to a world axis (press again to free it), a typed number sets the
+//! amount (degrees, a factor, or a distance along the axis), a click or Enter
+//! confirms, Esc or a right click restores the pose. Each transform is one undo
+//! step. Soft selection and symmetry apply to every edit (`pose_tools`).
+
+use crate::app::editor::EditorApp;
+use crate::app::pose_tools::{
+    follow_weights, mid_plane, mirror_partners, posed, Pivot, Transform, AXIS_NAMES,
+};
+use egui::{Color32, Key, Pos2, Rect, Stroke};
+use glam::{DVec3, Vec2};
+
+/// Partners are matched within this fraction of the cage diagonal.
+const MIRROR_TOLERANCE: f64 = 1e-3;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransformKind {
+    Grab,
+    Rotate,
+    Scale,
+}
+
+impl TransformKind {
+    fn verb(self) -> &'static str {
+        match self {
+            TransformKind::Grab => "Move",
+            TransformKind::Rotate => "Rotate",
+            TransformKind::Scale => "Scale",
+        }
+    }
+}
+
+/// A transform under way.
+#[derive(Clone, Debug)]
+pub struct Modal {
+    kind: TransformKind,
+    pane: usize,
+    start_pose: Vec<DVec3>,
+    pivot: DVec3,
+    start_pointer: Pos2,
+    pointer: Pos2,
+    axis: Option<usize>,
+    typed: String,
+}
+
+impl EditorApp {
+    /// The pose `transform` gives `start` with the current selection, pivot,
+    /// soft selection and symmetry.
+    pub fn pose_transformed(&self, start: &[DVec3], transform: &Transform) -> Vec<DVec3> {
+        let rest = self.document.cage().positions();
+        let diagonal = self.document.cage().diagonal();
+        let tools = &self.pose_tools;
+        let soft = tools.soft_selection.then_some(tools.soft_radius * diagonal);
+        let weights = follow_weights(start, self.document.selection(), soft);
+        let partners = tools.symmetry.map(|axis| {
+            (
+                axis,
+                mirror_partners(
+                    rest,
+                    axis,
+                    mid_plane(rest, axis),
+                    MIRROR_TOLERANCE * diagonal,
+                ),
+            )
+        });
+        let symmetry = partners.as_ref().map(|(axis, p)| (*axis, p.as_slice()));
+        posed(start, &weights, transform, self.pivot_of(start), symmetry)
+    }
+
+    /// Per handle, for the cage shader: 0 idle, 1 selected, 2 hovered, and with
+    /// soft selection 3 + 255·w for a handle that follows with weight w.
+    pub(in crate::app) fn handle_states(&self) -> Vec<u32> {
+        let selection = self.document.selection();
+        let pose = self.document.pose();
+        let soft = self
+            .pose_tools
+            .soft_selection
+            .then(|| self.pose_tools.soft_radius * self.document.cage().diagonal());
+        let weights = follow_weights(pose, selection, soft);
+        (0..pose.len())
+            .map(|i| {
+                if selection.contains(&i) {
+                    1
+                } else if self.viewport.hovered == Some(i) {
+                    2
+                } else if weights[i] > 0.0 {
+                    3 + (weights[i] * 255.0).round() as u32
+                } else {
+                    0
+                }
+            })
+            .collect()
+    }
+
+    /// Apply `transform` to the selection as one undo step.
+    pub fn transform_selection(&mut self, transform: Transform) {
+        let start = self.document.pose().to_vec();
+        let pose = self.pose_transformed(&start, &transform);
+        self.document.edit_pose(pose);
+    }
+
+    fn pivot_of(&self, pose: &[DVec3]) -> DVec3 {
+        let selection = self.document.selection();
+        match self.pose_tools.pivot {
+            Pivot::Cursor => self.pose_tools.cursor,
+            Pivot::SelectionCentre if !selection.is_empty() => {
+                selection.iter().filter_map(|&i| pose.get(i)).sum::<DVec3>()
+                    / selection.len() as f64
+            }
+            Pivot::SelectionCentre => self.document.bounding_sphere().0,
+        }
+    }
+
+    /// Handles with no mirror partner under the symmetry in use.
+    pub fn handles_without_partner(&self) -> usize {
+        let Some(axis) = self.pose_tools.symmetry else {
+            return 0;
+        };
+        let rest = self.document.cage().positions();
+        let tolerance = MIRROR_TOLERANCE * self.document.cage().diagonal();
+        mirror_partners(rest, axis, mid_plane(rest, axis), tolerance)
+            .iter()
+            .filter(|p| p.is_none())
+            .count()
+    }
+
+    pub fn transform_under_way(&self) -> Option<TransformKind> {
+        self.viewport.modal.as_ref().map(|m| m.kind)
+    }
+
+    /// G, R or S in view `pane` with the pointer at `pointer`.
+    fn begin_transform(&mut self, kind: TransformKind, pane: usize, pointer: Pos2) {
+        if self.document.selection().is_empty() {
+            self.info("select handles first: G moves, R rotates and S scales the selection");
+            return;
+        }
+        let start_pose = self.document.pose().to_vec();
+        self.viewport.modal = Some(Modal {
+            kind,
+            pane,
+            pivot: self.pivot_of(&start_pose),
+            start_pose,
+            start_pointer: pointer,
+            pointer,
+            axis: None,
+            typed: String::new(),
+        });
+    }
+
+    /// The keys of a transform: begin one, or steer the one under way. True when
+    /// the keys were the transform's (the other shortcuts then wait).
+    pub(super) fn transform_keys(&mut self, ctx: &egui::Context) -> bool {
+        let Some(modal) = &mut self.viewport.modal else {
+            let pressed = |key| ctx.input(|i| i.key_pressed(key) && i.modifiers.is_none());
+            let kind = [
+                (Key::G, TransformKind::Grab),
+                (Key::R, TransformKind::Rotate),
+                (Key::S, TransformKind::Scale),
+            ]
+            .into_iter()
+            .find(|&(key, _)| pressed(key))
+            .map(|(_, kind)| kind);
+            let pointer = ctx.input(|i| i.pointer.hover_pos());
+            let pane = pointer.and_then(|p| self.viewport.pane_at(p));
+            if let (Some(kind), Some(pointer), Some(pane)) = (kind, pointer, pane) {
+                self.begin_transform(kind, pane, pointer);
+                return true;
+            }
+            return false;
+        };
+        let (escape, enter, backspace, events) = ctx.input(|i| {
+            (
+                i.key_pressed(Key::Escape),
+                i.key_pressed(Key::Enter),
+                i.key_pressed(Key::Backspace),
+                i.events.clone(),
+            )
+        });
+        for (key, axis) in [(Key::X, 0), (Key::Y, 1), (Key::Z, 2)] {
+            if ctx.input(|i| i.key_pressed(key)) {
+                modal.axis = if modal.axis == Some(axis) {
+                    None
+                } else {
+                    Some(axis)
+                };
+            }
+        }
+        for event in events {
+            if let egui::Event::Text(text) = event {
+                let accepted = text
+                    .chars()
+                    .all(|c| c.is_ascii_digit() || c == '.' || c == '-');
+                if accepted {
+                    modal.typed.push_str(&text);
+                }
+            }
+        }
+        if backspace {
+            modal.typed.pop();
+        }
+        if escape {
+            self.cancel_transform();
+        } else if enter {
+            self.confirm_transform();
+        } else {
+            self.preview_transform();
+        }
+        true
+    }
+
+    /// The pointer of a transform under way: follow it, confirm on a click,
+    /// cancel on a right click.
+    pub(super) fn transform_pointer(&mut self, response: &egui::Response) {
+        let Some(modal) = &mut self.viewport.modal else {
+            return;
+        };
+        if let Some(pointer) = response.ctx.input(|i| i.pointer.hover_pos()) {
+            modal.pointer = pointer;
+        }
+        if response.clicked_by(egui::PointerButton::Primary) {
+            self.confirm_transform();
+        } else if response.clicked_by(egui::PointerButton::Secondary) {
+            self.cancel_transform();
+        } else {
+            self.preview_transform();
+        }
+    }
+
+    fn preview_transform(&mut self) {
+        let Some(modal) = &self.viewport.modal else {
+            return;
+        };
+        let transform = self.modal_transform(modal);
+        let pose = self.pose_transformed(&modal.start_pose, &transform);
+        self.document.preview_pose(pose);
+    }
+
+    fn confirm_transform(&mut self) {
+        self.preview_transform();
+        if let Some(modal) = self.viewport.modal.take() {
+            let action = format!("{} handles", modal.kind.verb().to_lowercase());
+            self.document
+                .record_undo_point_as(modal.start_pose, &action);
+        }
+    }
+
+    fn cancel_transform(&mut self) {
+        if let Some(modal) = self.viewport.modal.take() {
+            self.document.preview_pose(modal.start_pose);
+        }
+    }
+
+    /// The transform the pointer (or the typed number) asks for.
+    fn modal_transform(&self, modal: &Modal) -> Transform {
+        let typed: Option<f64> = modal.typed.parse().ok();
+        let axis = modal.axis.map(|a| DVec3::AXES[a]);
+        let projection = self.viewport.pane(modal.pane).map(|(_, p)| p);
+        let pivot_screen = projection
+            .and_then(|p| p.project(modal.pivot.as_vec3()))
+            .map(|s| Pos2::new(s.x, s.y))
+            .unwrap_or(modal.start_pointer);
+        let from = modal.start_pointer - pivot_screen;
+        let to = modal.pointer - pivot_screen;
+        match modal.kind {
+            TransformKind::Grab => {
+                if let (Some(distance), Some(axis)) = (typed, axis) {
+                    return Transform::Translate(axis * distance);
+                }
+                let rect = self
+                    .viewport
+                    .pane_rects()
+                    .get(modal.pane)
+                    .map_or(Rect::NOTHING, |(_, r)| *r);
+                let motion = modal.pointer - modal.start_pointer;
+                Transform::Translate(self.drag_offset(modal.pane, modal.pivot, motion, axis, rect))
+            }
+            TransformKind::Rotate => {
+                // Screen y points down: a counter-clockwise turn on screen is a
+                // positive turn about the axis towards the viewer.
+                let on_screen = -(to.y.atan2(to.x) - from.y.atan2(from.x)) as f64;
+                let camera = self.camera_of(modal.pane);
+                let towards_viewer = (camera.eye() - camera.target)
+                    .normalize_or_zero()
+                    .as_dvec3();
+                let (axis, angle) = match axis {
+                    Some(axis) => {
+                        let sign = if axis.dot(towards_viewer) < 0.0 {
+                            -1.0
+                        } else {
+                            1.0
+                        };
+                        (axis, typed.map_or(on_screen * sign, f64::to_radians))
+                    }
+                    None => (towards_viewer, typed.map_or(on_screen, f64::to_radians)),
+                };
+                Transform::Rotate { axis, angle }
+            }
+            TransformKind::Scale => {
+                let factor = typed
+                    .unwrap_or_else(|| f64::from(to.length()) / f64::from(from.length().max(1.0)));
+                Transform::Scale(match modal.axis {
+                    Some(a) => {
+                        let mut factors = DVec3::ONE;
+                        factors[a] = factor;
+                        factors
+                    }
+                    None => DVec3::splat(factor),
+                })
+            }
+        }
+    }
+
+    /// The line from the pivot to the pointer, and what the transform does.
+    pub(super) fn draw_transform(&self, painter: &egui::Painter, pane: usize, rect: Rect) {
+        let Some(modal) = &self.viewport.modal else {
+            if self.pose_tools.pivot == Pivot::Cursor {
+                if let Some((_, projection)) = self.viewport.pane(pane) {
+                    if let Some(at) = projection.project(self.pose_tools.cursor.as_vec3()) {
+                        let at = Pos2::new(at.x, at.y);
+                        painter.circle_stroke(
+                            at,
+                            7.0,
+                            Stroke::new(2.0, Color32::from_rgb(230, 60, 60)),
+                        );
+                        painter.circle_stroke(at, 7.0, Stroke::new(1.0, Color32::WHITE));
+                    }
+                }
+            }
+            return;
+        };
+        if modal.pane != pane {
+            return;
+        }
+        if let Some((_, projection)) = self.viewport.pane(pane) {
+            if let Some(pivot) = projection.project(modal.pivot.as_vec3()) {
+                let pivot = Pos2::new(pivot.x, pivot.y);
+                painter.line_segment(
+                    [pivot, modal.pointer],
+                    Stroke::new(1.0, Color32::from_gray(220)),
+                );
+                painter.circle_filled(pivot, 3.0, Color32::WHITE);
+            }
+        }
+        let transform = self.modal_transform(modal);
+        let amount = match transform {
+            Transform::Translate(offset) => format!("by {:.4}", offset.length()),
+            Transform::Rotate { angle, .. } => format!("{:.1}°", angle.to_degrees()),
+            Transform::Scale(factors) => {
+                format!("× {:.3}", modal.axis.map_or(factors.x, |a| factors[a]))
+            }
+        };
+        let along = modal.axis.map_or(String::new(), |a| {
+            let relation = if modal.kind == TransformKind::Rotate {
+                "about"
+            } else {
+                "along"
+            };
+            format!(" {relation} {}", AXIS_NAMES[a])
+        });
+        let typed = if modal.typed.is_empty() {
+            String::new()
+        } else {
+            format!(" [{}]", modal.typed)
+        };
+        let text = format!(
+            "{}{along}: {amount}{typed}  ·  click or Enter confirms, Esc or right click cancels, X/Y/Z axis",
+            modal.kind.verb()
+        );
+        painter.text(
+            rect.left_bottom() + egui::vec2(10.0, -10.0),
+            egui::Align2::LEFT_BOTTOM,
+            text,
+            egui::FontId::proportional(14.0),
+            Color32::from_rgb(255, 200, 120),
+        );
+    }
+
+    fn mesh_point_under(&mut self, pane: usize, pointer: Pos2) -> Option<DVec3> {
+        let (kind, projection) = self.viewport.pane(pane)?;
+        let positions = self.deformed_on_cpu(kind.method())?;
+        let vertex = crate::app::compare::vertex_under_pointer(
+            &positions,
+            projection.view_projection,
+            projection.origin,
+            projection.size,
+            Vec2::new(pointer.x, pointer.y),
+            12.0,
+        )?;
+        positions.get(vertex).map(|p| p.as_dvec3())
+    }
+
+    /// Shift+right click: the 3D cursor goes to the handle or mesh vertex under
+    /// the pointer, and becomes the pivot.
+    pub(super) fn place_cursor(&mut self, pane: usize, pointer: Pos2) {
+        let handle = self
+            .pick(pointer)
+            .and_then(|h| self.document.pose().get(h).copied());
+        let target = match handle {
+            Some(at) => Some(at),
+            None => self.mesh_point_under(pane, pointer),
+        };
+        match target {
+            Some(at) => {
+                self.pose_tools.cursor = at;
+                self.pose_tools.pivot = Pivot::Cursor;
+            }
+            None => self.info("Shift+right click on a handle or the mesh places the 3D cursor"),
+        }
+    }
+}

@@ -1,0 +1,228 @@
+//! Posing tools through the editor, keys and pointer as a user gives them: G, R
+//! and S transforms with axis constraints and typed amounts, Esc restoring the
+//! pose exactly, one undo step per transform, symmetry mirroring an edit onto
+//! the partner handle, and soft selection pulling neighbours part of the way.
+
+mod common;
+
+use common::editor::*;
+use egui::{Event, Key, Modifiers, Pos2};
+use egui_kittest::Harness;
+use glam::{DMat3, DVec3};
+use pmvc::app::{EditorApp, TransformKind};
+
+/// Put the pointer in the first view, away from the handles.
+fn hover_view(harness: &mut Harness<'static, EditorApp>) -> Pos2 {
+    let (_, rect) = harness.state().pane_rects()[0];
+    let at = rect.left_top() + egui::vec2(60.0, 120.0);
+    harness.hover_at(at);
+    harness.run_steps(2);
+    at
+}
+
+fn press(harness: &mut Harness<'static, EditorApp>, key: Key) {
+    harness.key_press(key);
+    harness.run_steps(2);
+}
+
+fn type_number(harness: &mut Harness<'static, EditorApp>, text: &str) {
+    harness.event(Event::Text(text.into()));
+    harness.run_steps(2);
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-9
+}
+
+#[test]
+fn r_with_an_axis_and_a_typed_angle_rotates_the_selection_about_its_centre() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let start = harness.state().document().pose().to_vec();
+    harness.state_mut().select_only([10, 11, 12]);
+    hover_view(&mut harness);
+    press(&mut harness, Key::R);
+    assert_eq!(
+        harness.state().transform_under_way(),
+        Some(TransformKind::Rotate)
+    );
+    press(&mut harness, Key::Z);
+    type_number(&mut harness, "90");
+    press(&mut harness, Key::Enter);
+    assert_eq!(harness.state().transform_under_way(), None);
+
+    let centre = (start[10] + start[11] + start[12]) / 3.0;
+    let quarter = DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2);
+    let pose = harness.state().document().pose().to_vec();
+    for i in [10, 11, 12] {
+        let expected = centre + quarter * (start[i] - centre);
+        assert!(
+            close(pose[i], expected),
+            "handle {i}: {} vs {expected}",
+            pose[i]
+        );
+    }
+    assert_eq!(pose[0], start[0], "unselected handles stay");
+    // One Ctrl+Z undoes the whole transform.
+    assert_eq!(
+        harness.state().undo_label().as_deref(),
+        Some("rotate handles")
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run_steps(2);
+    assert_eq!(harness.state().document().pose(), start.as_slice());
+}
+
+#[test]
+fn s_along_an_axis_scales_that_coordinate_only_and_esc_restores_exactly() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let start = harness.state().document().pose().to_vec();
+    harness.state_mut().select_only([0, 1, 2, 3]);
+    let at = hover_view(&mut harness);
+    press(&mut harness, Key::S);
+    press(&mut harness, Key::X);
+    type_number(&mut harness, "2");
+    press(&mut harness, Key::Enter);
+    let centre = (start[0] + start[1] + start[2] + start[3]) / 4.0;
+    let pose = harness.state().document().pose().to_vec();
+    for i in 0..4 {
+        let expected = DVec3::new(
+            centre.x + 2.0 * (start[i].x - centre.x),
+            start[i].y,
+            start[i].z,
+        );
+        assert!(
+            close(pose[i], expected),
+            "handle {i}: {} vs {expected}",
+            pose[i]
+        );
+    }
+
+    // A pointer-driven move, then Esc: exactly the pose before, and no undo step.
+    let before = pose;
+    let edits = harness.state().document().edits();
+    press(&mut harness, Key::G);
+    for k in 1..=5 {
+        harness.hover_at(at + egui::vec2(12.0 * k as f32, -8.0 * k as f32));
+        harness.step();
+    }
+    harness.run_steps(2);
+    assert_ne!(
+        harness.state().document().pose(),
+        before.as_slice(),
+        "G follows the pointer"
+    );
+    press(&mut harness, Key::Escape);
+    assert_eq!(harness.state().document().pose(), before.as_slice());
+    assert_eq!(harness.state().document().edits(), edits);
+    assert_eq!(
+        harness.state().document().selection().len(),
+        4,
+        "Esc cancels, not deselects"
+    );
+}
+
+#[test]
+fn a_pointer_rotation_keeps_distances_to_the_pivot_and_a_click_confirms() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let start = harness.state().document().pose().to_vec();
+    harness.state_mut().select_only([4, 5, 8, 9]);
+    let at = hover_view(&mut harness);
+    press(&mut harness, Key::R);
+    for k in 1..=6 {
+        harness.hover_at(at + egui::vec2(0.0, 15.0 * k as f32));
+        harness.step();
+    }
+    click(&mut harness, at + egui::vec2(0.0, 90.0));
+    assert_eq!(harness.state().transform_under_way(), None);
+    let pose = harness.state().document().pose().to_vec();
+    let centre = (start[4] + start[5] + start[8] + start[9]) / 4.0;
+    assert!(pose[4] != start[4], "the selection turned");
+    for i in [4, 5, 8, 9] {
+        let before = (start[i] - centre).length();
+        let after = (pose[i] - centre).length();
+        assert!(
+            (before - after).abs() < 1e-6,
+            "handle {i}: {before} vs {after}"
+        );
+    }
+}
+
+#[test]
+fn symmetry_mirrors_a_move_onto_the_partner_handle() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let start = harness.state().document().pose().to_vec();
+    // The comb cage is an extrusion: every front handle has a back partner.
+    let back = 0;
+    let front = (0..start.len())
+        .find(|&j| {
+            j != back
+                && (start[j].x - start[back].x).abs() < 1e-9
+                && (start[j].y - start[back].y).abs() < 1e-9
+        })
+        .expect("a partner across z");
+    harness.run_steps(2);
+    // Turn symmetry on in the panel.
+    use egui_kittest::kittest::Queryable;
+    let z_buttons = harness.query_all_by_label("Z").count();
+    assert!(z_buttons >= 1);
+    harness.query_all_by_label("Z").last().unwrap().click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().handles_without_partner(), 0);
+
+    harness.state_mut().select_only([back]);
+    hover_view(&mut harness);
+    press(&mut harness, Key::G);
+    press(&mut harness, Key::Z);
+    type_number(&mut harness, "-0.25");
+    press(&mut harness, Key::Enter);
+    let pose = harness.state().document().pose().to_vec();
+    assert!(close(pose[back], start[back] + DVec3::new(0.0, 0.0, -0.25)));
+    assert!(
+        close(pose[front], start[front] + DVec3::new(0.0, 0.0, 0.25)),
+        "the partner moves the mirrored way: {} from {}",
+        pose[front],
+        start[front]
+    );
+}
+
+#[test]
+fn soft_selection_pulls_near_handles_part_of_the_way_and_far_ones_not_at_all() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let start = harness.state().document().pose().to_vec();
+    let diagonal = harness.state().document().cage().diagonal();
+    let selected = 10;
+    hover_view(&mut harness);
+    press(&mut harness, Key::O);
+    harness.state_mut().select_only([selected]);
+    harness.run_steps(2);
+    press(&mut harness, Key::G);
+    press(&mut harness, Key::Y);
+    type_number(&mut harness, "1");
+    press(&mut harness, Key::Enter);
+    let pose = harness.state().document().pose().to_vec();
+    let radius = 0.15 * diagonal;
+    let (mut partial, mut still) = (0, 0);
+    for i in 0..start.len() {
+        let distance = (start[i] - start[selected]).length();
+        let t = (1.0 - distance / radius).clamp(0.0, 1.0);
+        let expected = if i == selected {
+            1.0
+        } else {
+            t * t * (3.0 - 2.0 * t)
+        };
+        let moved = pose[i] - start[i];
+        assert!(
+            close(moved, DVec3::new(0.0, expected, 0.0)),
+            "handle {i} at {distance:.3} moved {moved}, expected {expected:.4} up"
+        );
+        partial += usize::from(expected > 0.0 && expected < 1.0);
+        still += usize::from(expected == 0.0);
+    }
+    assert!(partial >= 1, "some handles follow part of the way");
+    assert!(still >= 1, "far handles stay");
+}
