@@ -133,6 +133,10 @@ struct MeshVarying {
 
 @vertex
 fn vs_mesh(@builtin(vertex_index) vertex: u32) -> MeshVarying {
+    return mesh_vertex(vertex);
+}
+
+fn mesh_vertex(vertex: u32) -> MeshVarying {
     let world = deformed_position(vertex);
     var out: MeshVarying;
     out.clip = frame.view_projection * vec4<f32>(world, 1.0);
@@ -141,6 +145,20 @@ fn vs_mesh(@builtin(vertex_index) vertex: u32) -> MeshVarying {
     out.value = vertex_value(vertex, world);
     out.outside_cage = rest[vertex].w;
     return out;
+}
+
+// The wireframe overlay: the mesh's edges, deformed as the surface is, pulled a
+// little towards the camera so they win against the faces they bound.
+@vertex
+fn vs_wire(@builtin(vertex_index) vertex: u32) -> MeshVarying {
+    var out = mesh_vertex(vertex);
+    out.clip.z -= 5e-5 * out.clip.w;
+    return out;
+}
+
+@fragment
+fn fs_wire(in: MeshVarying) -> @location(0) vec4<f32> {
+    return vec4<f32>(0.12, 0.12, 0.14, 1.0);
 }
 
 @fragment

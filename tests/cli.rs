@@ -124,7 +124,7 @@ fn every_backend_binds_and_agrees() {
 }
 
 #[test]
-fn deform_keeps_faces_texture_coordinates_and_groups_and_drops_normals() {
+fn deform_keeps_faces_texture_coordinates_and_groups_and_recomputes_normals() {
     let dir = tempfile::tempdir().unwrap();
     let cage_text = cage_obj(&pmvc::geometry::procedural::cube_cage(1.0));
     let cage = write(dir.path(), "cage.obj", &cage_text);
@@ -165,16 +165,21 @@ fn deform_keeps_faces_texture_coordinates_and_groups_and_drops_normals() {
         "o tile",
         "vt 1 1",
         "usemtl stone",
-        "f 1/1 2/2 3/3",
+        "f 1/1/1 2/2/2 3/3/3",
         "g back",
-        "f 3 2 1",
+        "f 3//3 2//2 1//1",
+        "vn 0 0 1",
     ] {
         assert!(
             text.lines().any(|l| l == kept),
             "missing line '{kept}' in:\n{text}"
         );
     }
-    assert!(!text.contains("vn"), "stale normals kept:\n{text}");
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("vn ")).count(),
+        3,
+        "one recomputed normal per vertex, the stale one gone:\n{text}"
+    );
     let deformed = load_mesh(&out).unwrap();
     let expected = [[-1.0, -0.5, 0.0], [1.0, -0.5, 0.0], [1.0, 0.5, 0.0]];
     for (p, e) in deformed.mesh.positions.iter().zip(expected) {
@@ -556,4 +561,57 @@ fn bind_and_deform_say_what_they_wrote_on_a_terminal_and_nothing_on_a_pipe() {
         assert!(output.status.success());
         assert_eq!(stderr(&output), "", "{args:?}");
     }
+}
+
+#[test]
+fn deform_writes_normals_that_follow_the_deformation() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = pmvc::geometry::procedural::cube_cage(1.0);
+    let cage = write(dir.path(), "cage.obj", &cage_obj(&cube));
+    // A flat tile facing +z (front face counter-clockwise seen from +z).
+    let mesh = write(
+        dir.path(),
+        "tile.obj",
+        "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3\nf 1 3 4\n",
+    );
+    // Shear the cage, z' = z + x: an affine map, so the tile becomes the plane
+    // z = x, whose normal is (-1, 0, 1)/√2.
+    let sheared: Vec<glam::DVec3> = cube
+        .positions()
+        .iter()
+        .map(|p| glam::DVec3::new(p.x, p.y, p.z + p.x))
+        .collect();
+    let pose = write(
+        dir.path(),
+        "pose.obj",
+        &common::triangles_obj(&sheared, cube.triangles()),
+    );
+    let out = dir.path().join("out.obj");
+    let output = pmvc(&[
+        "deform",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage),
+        "--deformed-cage",
+        path_str(&pose),
+        "--out",
+        path_str(&out),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let expected = glam::DVec3::new(-1.0, 0.0, 1.0).normalize();
+    let normals: Vec<glam::DVec3> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("vn "))
+        .map(|rest| {
+            let c: Vec<f64> = rest.split(' ').map(|t| t.parse().unwrap()).collect();
+            glam::DVec3::new(c[0], c[1], c[2])
+        })
+        .collect();
+    assert_eq!(normals.len(), 4, "{text}");
+    for n in normals {
+        assert!((n - expected).length() < 1e-6, "{n} vs {expected}");
+    }
+    assert!(text.lines().any(|l| l == "f 1//1 2//2 3//3"), "{text}");
 }

@@ -399,3 +399,42 @@ fn the_cage_can_be_hidden_handles_resized_and_the_selection_framed() {
     assert_eq!(harness.state().camera().target, framed.target);
     assert_eq!(harness.state().camera().distance, framed.distance);
 }
+
+#[test]
+fn the_wireframe_draws_the_mesh_edges_over_the_surface_and_goes_away_again() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.run_steps(2);
+    let (_, rect) = harness.state().pane_rects()[0];
+    let scale = harness.ctx.pixels_per_point();
+    let plain = harness.render().unwrap();
+    harness.state_mut().view_mut().wireframe = true;
+    harness.run_steps(2);
+    let wired = harness.render().unwrap();
+    let luminance = |p: &image::Rgba<u8>| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
+    let (mut darker, mut brighter, mut inside) = (0, 0, 0);
+    for y in (rect.top() * scale) as u32..(rect.bottom() * scale) as u32 {
+        for x in (rect.left() * scale) as u32..(rect.right() * scale) as u32 {
+            let (before, after) = (plain.get_pixel(x, y), wired.get_pixel(x, y));
+            inside += 1;
+            if luminance(after) + 90 < luminance(before) {
+                darker += 1;
+            } else if luminance(after) > luminance(before) + 90 {
+                brighter += 1;
+            }
+        }
+    }
+    // The comb has thousands of triangles: dark lines over a good part of it.
+    assert!(darker > inside / 100, "{darker} darker pixels of {inside}");
+    assert!(
+        brighter < darker / 20,
+        "{brighter} brighter, {darker} darker"
+    );
+    harness.state_mut().view_mut().wireframe = false;
+    harness.run_steps(2);
+    assert_eq!(
+        harness.render().unwrap(),
+        plain,
+        "off again draws as before"
+    );
+}

@@ -154,6 +154,8 @@ pub struct ViewSettings {
     pub show_cage: bool,
     /// Handle radius in points (`HANDLE_SIZES`).
     pub handle_size: f32,
+    /// Draw the mesh's edges over its surface.
+    pub wireframe: bool,
 }
 
 /// The handle radii the View menu offers, in points; the default is 4.
@@ -187,6 +189,7 @@ impl Default for ViewSettings {
             hover_in_shaded: false,
             show_cage: true,
             handle_size: 4.0,
+            wireframe: false,
         }
     }
 }

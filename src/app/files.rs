@@ -8,7 +8,8 @@ use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
 use super::ui::file_dialog::FileAction;
 use crate::geometry::{
-    load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_obj, TriMesh,
+    load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_mesh_with_normals,
+    write_obj, TriMesh,
 };
 use std::path::Path;
 
@@ -319,13 +320,7 @@ impl EditorApp {
         let positions = self.document.deformed_positions(self.active_method());
         let result = match self.document.mesh_file() {
             Some(file) => write_deformed_mesh(file, &positions, path),
-            None => write_obj(
-                path,
-                &TriMesh {
-                    positions,
-                    ..(**self.document.mesh()).clone()
-                },
-            ),
+            None => write_mesh_with_normals(path, &positions, &self.document.mesh().triangles),
         };
         self.report_export(result, path)
     }

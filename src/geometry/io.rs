@@ -2,6 +2,7 @@
 //! [`super::output`].
 
 use super::error::{CageLoadError, WriteError};
+use super::normals::vertex_normals;
 use super::output::write_atomically;
 use super::{obj, off, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
@@ -106,8 +107,9 @@ pub fn write_obj_to(
 ///
 /// An OBJ source keeps everything but its vertex positions and normals: faces,
 /// texture coordinates, groups, materials and comments are copied. Normals are
-/// dropped (both `vn` lines and the normal part of face corners) because they
-/// would be stale after the deformation; viewers recompute them.
+/// recomputed from the deformed positions ([`vertex_normals`], one `vn` per
+/// vertex, written before the first face), and every face corner refers to its
+/// vertex's normal.
 pub fn write_deformed_mesh(
     file: &MeshFile,
     positions: &[DVec3],
@@ -120,25 +122,41 @@ pub fn write_deformed_mesh(
     );
     match (&file.format, &file.obj_text) {
         (MeshFormat::Obj, Some(text)) => write_atomically(path, |out| {
+            let normals = vertex_normals(positions, &file.mesh.triangles);
             let mut next_vertex = positions.iter();
+            // `v` lines so far: a negative index counts back from there.
+            let mut vertices_so_far: i64 = 0;
+            let mut normals_written = false;
             for line in text.lines() {
                 let mut tokens = line.split_whitespace();
                 match tokens.next() {
-                    Some("v") => write_vertex(
-                        out,
-                        *next_vertex.next().expect("vertex count checked on load"),
-                    )?,
+                    Some("v") => {
+                        vertices_so_far += 1;
+                        write_vertex(
+                            out,
+                            *next_vertex.next().expect("vertex count checked on load"),
+                        )?
+                    }
+                    // Stale after the deformation: recomputed below.
                     Some("vn") => {}
                     Some("f") => {
+                        if !normals_written {
+                            write_normals(out, &normals)?;
+                            normals_written = true;
+                        }
                         write!(out, "f")?;
                         for corner in tokens {
                             let mut parts = corner.split('/');
                             let vertex = parts.next().unwrap_or("");
-                            match parts.next() {
-                                Some(texcoord) if !texcoord.is_empty() => {
-                                    write!(out, " {vertex}/{texcoord}")?
-                                }
-                                _ => write!(out, " {vertex}")?,
+                            let texcoord = parts.next().filter(|t| !t.is_empty());
+                            // The normal of a corner is its vertex's: same index.
+                            let normal = match vertex.parse::<i64>() {
+                                Ok(index) if index < 0 => (vertices_so_far + 1 + index).to_string(),
+                                _ => vertex.to_owned(),
+                            };
+                            match texcoord {
+                                Some(texcoord) => write!(out, " {vertex}/{texcoord}/{normal}")?,
+                                None => write!(out, " {vertex}//{normal}")?,
                             }
                         }
                         writeln!(out)?;
@@ -148,14 +166,45 @@ pub fn write_deformed_mesh(
             }
             Ok(())
         }),
-        _ => write_obj(
-            path,
-            &TriMesh {
-                positions: positions.to_vec(),
-                ..file.mesh.clone()
-            },
-        ),
+        _ => write_mesh_with_normals(path, positions, &file.mesh.triangles),
     }
+}
+
+/// Write an OBJ of `positions` and `triangles` with recomputed vertex normals
+/// (a mesh that came from no OBJ file, such as an OFF file or a bundled scene).
+pub fn write_mesh_with_normals(
+    path: &Path,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> Result<(), WriteError> {
+    write_atomically(path, |out| {
+        writeln!(out, "# written by pmvc")?;
+        for p in positions {
+            write_vertex(out, *p)?;
+        }
+        if !triangles.is_empty() {
+            write_normals(out, &vertex_normals(positions, triangles))?;
+        }
+        for [a, b, c] in triangles {
+            let [a, b, c] = [a + 1, b + 1, c + 1];
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        }
+        Ok(())
+    })
+}
+
+/// `vn` lines, one per vertex, in vertex order.
+fn write_normals(out: &mut dyn Write, normals: &[DVec3]) -> std::io::Result<()> {
+    for n in normals {
+        writeln!(
+            out,
+            "vn {} {} {}",
+            RoundTrip(n.x),
+            RoundTrip(n.y),
+            RoundTrip(n.z)
+        )?;
+    }
+    Ok(())
 }
 
 fn write_vertex(out: &mut dyn Write, p: DVec3) -> std::io::Result<()> {

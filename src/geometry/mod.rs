@@ -8,6 +8,7 @@ mod classify;
 mod error;
 mod intersect;
 mod io;
+mod normals;
 mod obj;
 mod off;
 mod output;
@@ -22,8 +23,10 @@ pub use classify::{
 };
 pub use error::{CageError, CageLoadError, LoadError, WriteError};
 pub use io::{
-    cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_obj, write_obj_to,
+    cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_mesh_with_normals,
+    write_obj, write_obj_to,
 };
+pub use normals::vertex_normals;
 pub use output::{
     extension_warning, human_bytes, refuse_same_file, remove_unfinished_outputs, resolve_output,
     write_atomically, OutputTarget, PendingOutput,

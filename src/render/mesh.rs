@@ -35,6 +35,8 @@ pub(super) fn shader_module(device: &wgpu::Device, chunk_slots: u32) -> wgpu::Sh
 
 pub struct MeshRenderer {
     pipeline: wgpu::RenderPipeline,
+    /// The mesh's edges over it (View > Wireframe).
+    wire_pipeline: wgpu::RenderPipeline,
 }
 
 impl MeshRenderer {
@@ -54,41 +56,58 @@ impl MeshRenderer {
             bind_group_layouts: &[Some(scene_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("mesh"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_mesh"),
-                compilation_options: constants.clone(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: sample_count,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_mesh"),
-                compilation_options: constants,
-                targets: &[Some(OFFSCREEN_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Self { pipeline }
+        let pipeline_for = |label, entries: [&str; 2], topology, depth_write, depth_compare| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(entries[0]),
+                    compilation_options: constants.clone(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(depth_write),
+                    depth_compare: Some(depth_compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: sample_count,
+                    ..Default::default()
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entries[1]),
+                    compilation_options: constants.clone(),
+                    targets: &[Some(OFFSCREEN_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        Self {
+            pipeline: pipeline_for(
+                "mesh",
+                ["vs_mesh", "fs_mesh"],
+                wgpu::PrimitiveTopology::TriangleList,
+                true,
+                wgpu::CompareFunction::Less,
+            ),
+            wire_pipeline: pipeline_for(
+                "mesh wireframe",
+                ["vs_wire", "fs_wire"],
+                wgpu::PrimitiveTopology::LineList,
+                false,
+                wgpu::CompareFunction::LessEqual,
+            ),
+        }
     }
 
     /// Draw with `bind_group` (which picks the method's weights), whose frame
@@ -107,5 +126,22 @@ impl MeshRenderer {
         pass.set_bind_group(0, bind_group, &[frame_offset]);
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..scene.index_count, 0, 0..1);
+    }
+
+    /// The mesh's edges, after [`Self::draw`] in the same pass.
+    pub fn draw_wireframe(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &SceneGpu,
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+    ) {
+        if scene.mesh_edge_index_count == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.wire_pipeline);
+        pass.set_bind_group(0, bind_group, &[frame_offset]);
+        pass.set_index_buffer(scene.mesh_edges.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..scene.mesh_edge_index_count, 0, 0..1);
     }
 }

@@ -129,6 +129,9 @@ pub struct WeightSlot {
 pub struct SceneGpu {
     pub indices: wgpu::Buffer,
     pub index_count: u32,
+    /// Each mesh edge once, as line-list indices, for the wireframe overlay.
+    pub mesh_edges: wgpu::Buffer,
+    pub mesh_edge_index_count: u32,
     pub vertex_count: u32,
     pub cage_edges: wgpu::Buffer,
     pub cage_edge_index_count: u32,
@@ -166,11 +169,14 @@ impl SceneGpu {
             .map(|p| [p.x, p.y, p.z, 0.0])
             .collect();
         let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
+        let edges = unique_edges(triangles);
         let pose = rest_cage.positions().to_vec();
         let states = vec![0u32; pose.len().max(1)];
         Self {
             indices: buffer_with(device, "mesh indices", &indices, wgpu::BufferUsages::INDEX),
             index_count: indices.len() as u32,
+            mesh_edges: buffer_with(device, "mesh edges", &edges, wgpu::BufferUsages::INDEX),
+            mesh_edge_index_count: edges.len() as u32 * 2,
             vertex_count: rest_positions.len() as u32,
             cage_edges: buffer_with(device, "cage edges", cage_edges, wgpu::BufferUsages::INDEX),
             cage_edge_index_count: cage_edges.len() as u32 * 2,
@@ -291,4 +297,28 @@ pub struct ReadBack {
     pub values: Vec<f32>,
     /// The unshaded colour of each value.
     pub colours: Vec<[f32; 3]>,
+}
+
+/// Every edge of `triangles` once (as its two vertices, smaller first), in a
+/// fixed order so that frames are deterministic.
+pub fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
+        .map(|[u, v]| [u.min(v), u.max(v)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_triangles_sharing_a_side_have_five_edges() {
+        let edges = unique_edges(&[[0, 1, 2], [2, 1, 3]]);
+        assert_eq!(edges, vec![[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]);
+    }
 }

@@ -142,6 +142,8 @@ pub struct FrameParams {
     pub highlight_outside: bool,
     /// Draw the cage's edges and handles over the mesh.
     pub show_cage: bool,
+    /// Draw the mesh's edges over it.
+    pub wireframe: bool,
 }
 
 /// What the viewport draws, uploaded when the scene changes.
@@ -390,6 +392,7 @@ impl ViewportRenderer {
             handle_radius_px: 0.0,
             highlight_outside: false,
             show_cage: false,
+            wireframe: false,
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
@@ -475,6 +478,10 @@ impl ViewportRenderer {
         if let (Some(scene), Some(bind_group)) = (&self.scene, bind_group) {
             let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
             self.mesh.draw(&mut pass, scene, &bind_group, offset);
+            if params.wireframe {
+                self.mesh
+                    .draw_wireframe(&mut pass, scene, &bind_group, offset);
+            }
             if params.show_cage {
                 self.cage.draw(&mut pass, scene, &bind_group, offset);
             }

@@ -154,6 +154,8 @@ impl EditorApp {
         ui.separator();
         ui.checkbox(&mut self.view.show_cage, "Cage and handles (H)")
             .on_hover_text("Hidden handles cannot be picked or box-selected");
+        ui.checkbox(&mut self.view.wireframe, "Wireframe")
+            .on_hover_text("The mesh's edges over its surface, deformed with it");
         let label = ui.label("Handle size");
         ui.add(
             egui::Slider::new(&mut self.view.handle_size, HANDLE_SIZES)

@@ -224,6 +224,7 @@ impl EditorApp {
                 handle_radius_px: self.view.handle_size * pixels_per_point,
                 highlight_outside: self.highlight_outside,
                 show_cage: self.view.show_cage,
+                wireframe: self.view.wireframe,
             };
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
