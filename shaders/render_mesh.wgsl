@@ -5,8 +5,9 @@
 // the device) and each weights column's displacement d_k
 // (`Method::column_displacements`, uploaded per pose change), so the CPU never
 // touches mesh positions per frame. The displacement form is exact at rest for any
-// weights and keeps its precision far from the origin. Normals come from screen-space derivatives of the deformed
-// position, so shading always follows the deformation.
+// weights and keeps its precision far from the origin. Smooth shading reads each
+// vertex's normal of the deformed mesh, recomputed per pose change; faceted
+// shading takes screen-space derivatives of the deformed position.
 //
 // Besides plain shading the mesh can be coloured by a scalar per vertex: the
 // weight of one cage vertex, the vertex's most negative weight, or the distance
@@ -20,6 +21,8 @@
 @group(0) @binding(1) var<storage, read> rest: array<vec4<f32>>;
 // xyz: how far each weights column's vector moved from rest, for the method shown.
 @group(0) @binding(2) var<storage, read> displacements: array<vec4<f32>>;
+// After them, smooth shading's vertex normals of the deformed mesh, recomputed
+// per pose change (shaders/render_normals.wgsl).
 // The same for the compared method (the difference view).
 @group(0) @binding(5) var<storage, read> other_displacements: array<vec4<f32>>;
 
@@ -129,6 +132,8 @@ struct MeshVarying {
     @location(2) value: f32,
     // 1 for a vertex outside the cage, whether or not it is highlighted.
     @location(3) outside_cage: f32,
+    // The deformed mesh's normal (smooth shading; zero when not computed).
+    @location(4) normal: vec3<f32>,
 }
 
 @vertex
@@ -144,6 +149,9 @@ fn mesh_vertex(vertex: u32) -> MeshVarying {
     out.outside = rest[vertex].w * f32(frame.highlight_outside);
     out.value = vertex_value(vertex, world);
     out.outside_cage = rest[vertex].w;
+    if frame.smooth_shading == 1u && frame.weights_bound == 1u {
+        out.normal = displacements[frame.columns + vertex].xyz;
+    }
     return out;
 }
 
@@ -164,6 +172,9 @@ fn fs_wire(in: MeshVarying) -> @location(0) vec4<f32> {
 @fragment
 fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
     var normal = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    if frame.smooth_shading == 1u && length(in.normal) > 0.5 {
+        normal = normalize(in.normal);
+    }
     let to_eye = normalize(frame.eye - in.world);
     // Two-sided: light whichever side faces the camera.
     if dot(normal, to_eye) < 0.0 {
@@ -200,4 +211,14 @@ fn cs_deform(@builtin(global_invocation_id) id: vec3<u32>) {
     let value = vertex_value(id.x, position);
     output[id.x] = vec4<f32>(position, value);
     output[frame.vertex_count + id.x] = vec4<f32>(value_colour(value, rest[id.x].w > 0.5), 1.0);
+}
+
+// Smooth shading's first pass: the deformed positions of the method shown, as
+// the vertex shader computes them, for shaders/render_normals.wgsl.
+@compute @workgroup_size(64)
+fn cs_positions(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.vertex_count {
+        return;
+    }
+    output[id.x] = vec4<f32>(deformed_position(id.x), 0.0);
 }

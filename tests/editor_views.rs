@@ -438,3 +438,49 @@ fn the_wireframe_draws_the_mesh_edges_over_the_surface_and_goes_away_again() {
         "off again draws as before"
     );
 }
+
+#[test]
+fn smooth_shading_normals_follow_the_pose_as_the_cpu_twin_computes_them() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let rest = harness.state().document().cage().positions().to_vec();
+    // Bend the middle finger: its normals must turn with it.
+    for handle in [10, 11, 30, 31] {
+        harness
+            .state_mut()
+            .set_handle_position(handle, rest[handle] + glam::DVec3::new(1.5, 0.5, 0.0));
+    }
+    harness.run_steps(3);
+    // Drawing a frame computes the normals of the pose shown.
+    harness.render().unwrap();
+    let app = harness.state();
+    let method = app.active_method();
+    let gpu = app.read_back_normals(method).expect("normals drawn");
+    let deformed = app.document().deformed_positions(method);
+    let cpu = pmvc::geometry::vertex_normals(&deformed, &app.document().mesh().triangles);
+    let rest_normals = pmvc::geometry::vertex_normals(
+        &app.document().mesh().positions,
+        &app.document().mesh().triangles,
+    );
+    let mut worst = 0.0f64;
+    let mut turned = 0;
+    for ((g, c), r) in gpu.iter().zip(&cpu).zip(&rest_normals) {
+        let angle = g.as_dvec3().angle_between(*c);
+        worst = worst.max(angle);
+        turned += usize::from(c.angle_between(*r) > 0.05);
+    }
+    assert!(
+        worst < 2e-3,
+        "largest angle between GPU and CPU normals: {worst} rad"
+    );
+    assert!(
+        turned > 100,
+        "the pose turns the normals of {turned} vertices"
+    );
+
+    // Faceted shading draws differently, and the option comes back.
+    let smooth = harness.render().unwrap();
+    harness.state_mut().view_mut().smooth_shading = false;
+    harness.run_steps(2);
+    assert_ne!(harness.render().unwrap(), smooth);
+}

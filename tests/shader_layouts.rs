@@ -58,7 +58,7 @@ fn frame_uniform_matches_the_wgsl_frame() {
             rows_per_chunk,
             other_rows_per_chunk,
             other_first_chunk,
-            padding,
+            smooth_shading,
         ]
     );
     for source in [

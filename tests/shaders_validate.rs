@@ -17,6 +17,10 @@ fn composed_shaders() -> Vec<(String, String)> {
         pmvc::render::cage::shader_source(),
     ));
     shaders.push((
+        "render_normals.wgsl".into(),
+        pmvc::render::normals::shader_source(),
+    ));
+    shaders.push((
         "render_composite.wgsl".into(),
         include_str!("../shaders/render_composite.wgsl").into(),
     ));

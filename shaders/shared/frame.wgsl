@@ -28,8 +28,8 @@ struct Frame {
     other_rows_per_chunk: u32,
     // The pool slot of the compared method's first chunk.
     other_first_chunk: u32,
-    // Makes the size a multiple of 16, as in Rust.
-    padding: u32,
+    // 1: light with the per-vertex normals (smooth shading); 0: per face.
+    smooth_shading: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

@@ -156,6 +156,8 @@ pub struct ViewSettings {
     pub handle_size: f32,
     /// Draw the mesh's edges over its surface.
     pub wireframe: bool,
+    /// Light the mesh with per-vertex normals of the deformed mesh; else per face.
+    pub smooth_shading: bool,
 }
 
 /// The handle radii the View menu offers, in points; the default is 4.
@@ -190,6 +192,7 @@ impl Default for ViewSettings {
             show_cage: true,
             handle_size: 4.0,
             wireframe: false,
+            smooth_shading: true,
         }
     }
 }

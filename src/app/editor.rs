@@ -506,6 +506,16 @@ impl EditorApp {
             .map(|result| result.map(|read_back| read_back.positions))
     }
 
+    /// Smooth shading's vertex normals of `method`'s deformation as the GPU last
+    /// computed them; `None` before a smooth-shaded view of it was drawn.
+    pub fn read_back_normals(&self, method: crate::coords::Method) -> Option<Vec<Vec3>> {
+        self.with_renderer(|renderer, device, queue| {
+            renderer.read_back_normals(device, queue, method)
+        })
+        .flatten()
+        .and_then(Result::ok)
+    }
+
     /// Positions, colouring values and colours as the shaders compute them.
     pub fn read_back(&self, shading: &Shading) -> Option<Result<ReadBack, RenderError>> {
         self.with_renderer(|renderer, device, queue| renderer.read_back(device, queue, shading))

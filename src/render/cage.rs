@@ -3,6 +3,7 @@
 
 use super::scene_gpu::{SceneGpu, DEPTH_FORMAT, OFFSCREEN_FORMAT};
 use crate::gpu::shader_source::compose;
+use glam::Vec3;
 
 const SHADER: &str = include_str!("../../shaders/render_cage.wgsl");
 
@@ -110,4 +111,31 @@ impl CageRenderer {
             pass.draw(0..6, 0..scene.cage_vertex_count);
         }
     }
+}
+
+/// Cage edges worth drawing: those between faces that are not coplanar. The
+/// diagonals that split flat quads and ear-clipped caps only clutter the view.
+pub(super) fn feature_edges(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let normal = |[a, b, c]: [u32; 3]| {
+        let p = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+        (p(b) - p(a)).cross(p(c) - p(a)).normalize_or_zero()
+    };
+    let mut faces_of_edge: std::collections::BTreeMap<[u32; 2], Vec<Vec3>> = Default::default();
+    for &triangle in triangles {
+        let [a, b, c] = triangle;
+        for [u, v] in [[a, b], [b, c], [c, a]] {
+            faces_of_edge
+                .entry([u.min(v), u.max(v)])
+                .or_default()
+                .push(normal(triangle));
+        }
+    }
+    faces_of_edge
+        .into_iter()
+        .filter(|(_, normals)| match normals.as_slice() {
+            [n, m] => n.dot(*m) < 0.9995,
+            _ => true,
+        })
+        .map(|(edge, _)| edge)
+        .collect()
 }

@@ -19,6 +19,7 @@ pub mod camera;
 pub mod colormap;
 pub mod composite;
 pub mod mesh;
+pub mod normals;
 pub mod readback;
 pub mod scene_gpu;
 pub mod viewport;

@@ -43,13 +43,15 @@ pub struct FrameUniform {
     pub other_rows_per_chunk: u32,
     /// The pool slot of the compared family's first chunk.
     pub other_first_chunk: u32,
-    /// Rounds the size up to WGSL's 16-byte struct alignment.
-    pub padding: u32,
+    /// 1 for smooth shading (per-vertex normals), 0 for faceted; also rounds the
+    /// size up to WGSL's 16-byte struct alignment.
+    pub smooth_shading: u32,
 }
 
 /// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family
-/// shown, 3 cage pose, 4 handle states, 5 column displacements of the compared
-/// family; from [`FIRST_CHUNK_BINDING`] the pool of weight chunks.
+/// shown (followed by its vertex normals), 3 cage pose, 4 handle states, 5 column
+/// displacements of the compared family; from [`FIRST_CHUNK_BINDING`] the pool of
+/// weight chunks.
 const SCENE_STORAGE_BINDINGS: [u32; OTHER_STORAGE_BUFFERS as usize] = [1, 2, 3, 4, 5];
 
 /// Storage buffers the drawing shaders read in one stage, with the smallest pool
@@ -120,8 +122,13 @@ pub fn buffer_with<T: bytemuck::Pod>(
 pub struct WeightSlot {
     pub chunks: Vec<wgpu::Buffer>,
     pub split: ChunkSplit,
+    /// One `vec4` per column, then (smooth shading) one normal per mesh vertex:
+    /// the normals share the buffer so that drawing needs no storage binding
+    /// more than devices with the default 8 per stage have.
     pub displacements: wgpu::Buffer,
     pub columns: u32,
+    /// The pose revision the normals were computed for; `None` before the first.
+    pub normals_pose: Option<u64>,
 }
 
 /// The scene's GPU buffers: one mesh and cage, and the weights of every family
@@ -129,6 +136,13 @@ pub struct WeightSlot {
 pub struct SceneGpu {
     pub indices: wgpu::Buffer,
     pub index_count: u32,
+    /// Bumped by every pose upload, so normals know when they are stale.
+    pub pose_revision: u64,
+    /// Smooth shading: each vertex's triangles ([`super::normals::Adjacency`]),
+    /// and room for one family's deformed positions.
+    pub adjacency_offsets: wgpu::Buffer,
+    pub adjacency_corners: wgpu::Buffer,
+    pub deformed_scratch: wgpu::Buffer,
     /// Each mesh edge once, as line-list indices, for the wireframe overlay.
     pub mesh_edges: wgpu::Buffer,
     pub mesh_edge_index_count: u32,
@@ -170,11 +184,24 @@ impl SceneGpu {
             .collect();
         let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
         let edges = unique_edges(triangles);
+        let adjacency = super::normals::Adjacency::of(rest_positions.len(), triangles);
+        let [adjacency_offsets, adjacency_corners] =
+            super::normals::adjacency_buffers(device, &adjacency);
+        let deformed_scratch = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("deformed positions"),
+            size: (rest_positions.len() as u64 * 16).max(16),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let pose = rest_cage.positions().to_vec();
         let states = vec![0u32; pose.len().max(1)];
         Self {
             indices: buffer_with(device, "mesh indices", &indices, wgpu::BufferUsages::INDEX),
             index_count: indices.len() as u32,
+            pose_revision: 0,
+            adjacency_offsets,
+            adjacency_corners,
+            deformed_scratch,
             mesh_edges: buffer_with(device, "mesh edges", &edges, wgpu::BufferUsages::INDEX),
             mesh_edge_index_count: edges.len() as u32 * 2,
             vertex_count: rest_positions.len() as u32,

@@ -12,6 +12,7 @@ use super::cage::CageRenderer;
 use super::colormap::Scale;
 use super::composite::{Compositor, OffscreenTarget};
 use super::mesh::MeshRenderer;
+use super::normals::NormalsPass;
 use super::readback::Readback;
 use super::scene_gpu::{
     buffer_with, points_f32, scene_layout, FrameUniform, ReadBack, SceneGpu, WeightSlot,
@@ -144,6 +145,8 @@ pub struct FrameParams {
     pub show_cage: bool,
     /// Draw the mesh's edges over it.
     pub wireframe: bool,
+    /// Light with per-vertex normals of the deformed mesh (else per face).
+    pub smooth_shading: bool,
 }
 
 /// What the viewport draws, uploaded when the scene changes.
@@ -164,6 +167,8 @@ pub struct ViewportRenderer {
     compositor: Compositor,
     /// Made on the first readback.
     readback: Option<Readback>,
+    /// Made when smooth shading first needs normals.
+    normals: Option<NormalsPass>,
     targets: [Option<OffscreenTarget>; MAX_VIEWS],
     scene: Option<SceneGpu>,
     chunk_limits: ChunkLimits,
@@ -191,6 +196,7 @@ impl ViewportRenderer {
             cage: CageRenderer::new(device, &scene_layout, sample_count),
             compositor: Compositor::new(device, target_format),
             readback: None,
+            normals: None,
             sample_count,
             scene_layout,
             frame,
@@ -223,7 +229,7 @@ impl ViewportRenderer {
     /// Replace the scene. Weights start unbound: the mesh shows at rest.
     pub fn upload_scene(&mut self, device: &wgpu::Device, scene: &SceneUpload<'_>) {
         let cage_rest: Vec<Vec3> = scene.cage.positions().iter().map(|p| p.as_vec3()).collect();
-        let edges = feature_edges(&cage_rest, scene.cage.triangles());
+        let edges = super::cage::feature_edges(&cage_rest, scene.cage.triangles());
         self.scene = Some(SceneGpu::new(
             device,
             scene.rest_positions,
@@ -267,11 +273,16 @@ impl ViewportRenderer {
                 .map(|values| buffer_with(device, "weights", values, wgpu::BufferUsages::STORAGE))
                 .collect(),
         };
+        // The columns' displacements, then room for the vertex normals.
+        let mut displacements = scene.displacements_of(method);
+        displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
             device,
-            "column displacements",
-            &scene.displacements_of(method),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            "column displacements and vertex normals",
+            &displacements,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
         );
         scene.set_slot(
             method,
@@ -280,6 +291,7 @@ impl ViewportRenderer {
                 split,
                 displacements,
                 columns: weights.cols as u32,
+                normals_pose: None,
             }),
         );
         Ok(())
@@ -312,6 +324,7 @@ impl ViewportRenderer {
             return;
         }
         scene.pose = pose.to_vec();
+        scene.pose_revision += 1;
         queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&points_f32(pose, 1.0)));
         for (&method, slot) in &scene.slots {
             let displacements = scene.displacements_of(method);
@@ -363,7 +376,7 @@ impl ViewportRenderer {
             other_rows_per_chunk: rows_per_chunk(against),
             // The pool holds the shown family's chunks first (SceneGpu::bind_group).
             other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
-            padding: 0,
+            smooth_shading: u32::from(params.smooth_shading),
         }
     }
 
@@ -393,6 +406,7 @@ impl ViewportRenderer {
             highlight_outside: false,
             show_cage: false,
             wireframe: false,
+            smooth_shading: false,
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
@@ -443,6 +457,12 @@ impl ViewportRenderer {
                 )
                 .clone()
         });
+        if params.smooth_shading {
+            if let Some(bind_group) = &bind_group {
+                let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
+                self.update_normals(device, encoder, params.shading.method, bind_group, offset);
+            }
+        }
         let Some(target) = &self.targets[view] else {
             return;
         };
@@ -488,6 +508,49 @@ impl ViewportRenderer {
         }
     }
 
+    /// Recompute `method`'s vertex normals if the pose changed since they were.
+    fn update_normals(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        method: Method,
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+    ) {
+        let Some(scene) = &self.scene else { return };
+        let Some(slot) = scene.slots.get(&method) else {
+            return;
+        };
+        if slot.normals_pose == Some(scene.pose_revision) {
+            return;
+        }
+        let pass = self.normals.get_or_insert_with(|| {
+            NormalsPass::new(device, &self.scene_layout, self.chunk_limits.slots)
+        });
+        pass.encode(
+            device,
+            encoder,
+            scene,
+            bind_group,
+            frame_offset,
+            &slot.displacements,
+        );
+        let revision = scene.pose_revision;
+        if let Some(slot) = self.scene.as_mut().and_then(|s| s.slots.get_mut(&method)) {
+            slot.normals_pose = Some(revision);
+        }
+    }
+
+    /// `method`'s smooth-shading normals as last computed (for tests).
+    pub fn read_back_normals(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        method: Method,
+    ) -> Option<Result<Vec<Vec3>, wgpu::BufferAsyncError>> {
+        super::normals::read_back(device, queue, self.scene.as_ref()?, method)
+    }
+
     /// Composite view `view`'s image into egui's pass.
     fn composite(&self, pass: &mut wgpu::RenderPass<'static>, view: usize) {
         let Some(target) = &self.targets[view.min(MAX_VIEWS - 1)] else {
@@ -497,33 +560,6 @@ impl ViewportRenderer {
         pass.set_bind_group(0, &target.composite_group, &[]);
         pass.draw(0..3, 0..1);
     }
-}
-
-/// Cage edges worth drawing: those between faces that are not coplanar. The
-/// diagonals that split flat quads and ear-clipped caps only clutter the view.
-fn feature_edges(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let normal = |[a, b, c]: [u32; 3]| {
-        let p = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-        (p(b) - p(a)).cross(p(c) - p(a)).normalize_or_zero()
-    };
-    let mut faces_of_edge: std::collections::BTreeMap<[u32; 2], Vec<Vec3>> = Default::default();
-    for &triangle in triangles {
-        let [a, b, c] = triangle;
-        for [u, v] in [[a, b], [b, c], [c, a]] {
-            faces_of_edge
-                .entry([u.min(v), u.max(v)])
-                .or_default()
-                .push(normal(triangle));
-        }
-    }
-    faces_of_edge
-        .into_iter()
-        .filter(|(_, normals)| match normals.as_slice() {
-            [n, m] => n.dot(*m) < 0.9995,
-            _ => true,
-        })
-        .map(|(edge, _)| edge)
-        .collect()
 }
 
 /// The paint callback for one frame of the viewport.

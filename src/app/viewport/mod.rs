@@ -225,6 +225,7 @@ impl EditorApp {
                 highlight_outside: self.highlight_outside,
                 show_cage: self.view.show_cage,
                 wireframe: self.view.wireframe,
+                smooth_shading: self.view.smooth_shading,
             };
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
