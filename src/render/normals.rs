@@ -240,23 +240,12 @@ pub fn read_normals(
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
     queue.submit([encoder.finish()]);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    staging.map_async(wgpu::MapMode::Read, .., move |result| {
-        let _ = sender.send(result);
-    });
-    let _ = device.poll(wgpu::PollType::wait_indefinitely());
-    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
-    let normals = {
-        let view = staging
-            .get_mapped_range(..)
-            .map_err(|_| wgpu::BufferAsyncError)?;
-        let floats: &[[f32; 4]] = bytemuck::cast_slice(&view);
-        floats[..vertex_count]
-            .iter()
-            .map(|n| Vec3::new(n[0], n[1], n[2]))
-            .collect()
-    };
-    staging.unmap();
+    let floats = super::readback::map_vec4s(device, &staging)?;
+    let normals = floats
+        .iter()
+        .take(vertex_count)
+        .map(|n| Vec3::new(n[0], n[1], n[2]))
+        .collect();
     Ok(normals)
 }
 

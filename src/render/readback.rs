@@ -88,34 +88,44 @@ impl Readback {
         }
         encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, 2 * size);
         queue.submit([encoder.finish()]);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = sender.send(result);
-        });
-        let _ = device.poll(wgpu::PollType::wait_indefinitely());
-        receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
-        let read_back = {
-            let view = staging
-                .get_mapped_range(..)
-                .map_err(|_| wgpu::BufferAsyncError)?;
-            let floats: &[[f32; 4]] = bytemuck::cast_slice(&view);
-            let vertices = scene.vertex_count as usize;
-            let (deformed, colours) = floats.split_at(vertices.max(1));
-            ReadBack {
-                positions: deformed[..vertices]
-                    .iter()
-                    .map(|p| Vec3::new(p[0], p[1], p[2]))
-                    .collect(),
-                values: deformed[..vertices].iter().map(|p| p[3]).collect(),
-                colours: colours[..vertices]
-                    .iter()
-                    .map(|c| [c[0], c[1], c[2]])
-                    .collect(),
-            }
+        let floats = map_vec4s(device, &staging)?;
+        let vertices = scene.vertex_count as usize;
+        let (deformed, colours) = floats.split_at(vertices.max(1).min(floats.len()));
+        let read_back = ReadBack {
+            positions: deformed[..vertices]
+                .iter()
+                .map(|p| Vec3::new(p[0], p[1], p[2]))
+                .collect(),
+            values: deformed[..vertices].iter().map(|p| p[3]).collect(),
+            colours: colours[..vertices]
+                .iter()
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
         };
-        staging.unmap();
         Ok(read_back)
     }
+}
+
+/// Map `staging` (filled by commands already submitted), wait for the GPU, and
+/// copy it out as `vec4<f32>`s.
+pub(super) fn map_vec4s(
+    device: &wgpu::Device,
+    staging: &wgpu::Buffer,
+) -> Result<Vec<[f32; 4]>, wgpu::BufferAsyncError> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    staging.map_async(wgpu::MapMode::Read, .., move |result| {
+        let _ = sender.send(result);
+    });
+    let _ = device.poll(wgpu::PollType::wait_indefinitely());
+    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
+    let values = {
+        let view = staging
+            .get_mapped_range(..)
+            .map_err(|_| wgpu::BufferAsyncError)?;
+        bytemuck::cast_slice::<u8, [f32; 4]>(&view).to_vec()
+    };
+    staging.unmap();
+    Ok(values)
 }
 
 /// A compute-only writable buffer: writable storage in other stages needs features
