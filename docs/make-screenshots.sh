@@ -28,6 +28,9 @@ shoot compare-negativity --pose "$finger" --view side-by-side --negativity
 shoot compare-difference --pose "$finger" --view difference
 shoot compare-three-families --pose "$finger" --compare mvc,pmvc,harmonic
 shoot compare-three-heatmap --pose "$finger" --compare mvc,pmvc,harmonic --heatmap 7 --log-scale
+bar=$(mktemp -d)
+"$PMVC_EDITOR" generate twisted-bar --mesh "$bar/bar.obj" --cage "$bar/bar_cage.obj"
+shoot compare-twisted-bar "$bar/bar.obj" "$bar/bar_cage.obj" --pose docs/poses/twisted-bar.obj --compare pmvc,green
 elephant=(assets/scan_mesh.obj assets/scan_cage.obj --pose docs/poses/elephant-head-sideways.obj)
 shoot compare-elephant-side-by-side "${elephant[@]}" --view side-by-side
 shoot compare-elephant-heatmap "${elephant[@]}" --view side-by-side --heatmap 56 --log-scale

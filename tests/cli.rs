@@ -8,27 +8,7 @@ use pmvc::geometry::{classify_points, load_mesh};
 use std::path::Path;
 
 fn read_npy_f32(path: &Path) -> (Vec<usize>, Vec<f32>, String) {
-    let bytes = std::fs::read(path).unwrap();
-    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00", "npy format version 1.0");
-    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
-    let shape_text = header
-        .split("'shape': (")
-        .nth(1)
-        .unwrap()
-        .split(')')
-        .next()
-        .unwrap();
-    let shape: Vec<usize> = shape_text
-        .split(',')
-        .filter(|s| !s.trim().is_empty())
-        .map(|s| s.trim().parse().unwrap())
-        .collect();
-    let values = bytes[10 + header_len..]
-        .chunks(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    (shape, values, header)
+    parse_npy_f32(&std::fs::read(path).unwrap())
 }
 
 #[test]

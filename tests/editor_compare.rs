@@ -79,6 +79,16 @@ fn the_method_toggle_switches_instantly_without_rebinding() {
             >= -1e-6
     );
 
+    // Green coordinates come next, bound on demand too; the vertex shader applies
+    // their face columns as the CPU does.
+    press(&mut harness, Key::M);
+    assert_eq!(harness.state().active_method(), Method::Green);
+    run_until_bound(&mut harness);
+    harness.run_steps(2);
+    let app = harness.state();
+    let green = app.read_back_deformed().unwrap().unwrap();
+    assert!(max_distance(&green, &cpu_deformed(app, Method::Green)) < 1e-3);
+
     // Switching between bound families binds nothing.
     let binds = app.bind_count();
     press(&mut harness, Key::M);
@@ -451,7 +461,7 @@ fn snapshots_of_each_view() {
             Method::Pmvc,
         ),
         (
-            "compare_three_families",
+            "compare_every_family",
             ViewSettings {
                 layout: Layout::SideBySide,
                 compared: MethodSet::of(&Method::ALL),
@@ -497,7 +507,7 @@ fn snapshots_of_each_view() {
 }
 
 #[test]
-fn three_panes_show_every_family_each_as_its_weights_say() {
+fn one_pane_per_family_each_as_its_weights_say() {
     let Some(mut harness) = posed_editor(ViewSettings {
         layout: Layout::SideBySide,
         compared: MethodSet::of(&Method::ALL),

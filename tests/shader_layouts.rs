@@ -59,6 +59,7 @@ fn frame_uniform_matches_the_wgsl_frame() {
             other_rows_per_chunk,
             other_first_chunk,
             smooth_shading,
+            vertex_columns,
         ]
     );
     for source in [

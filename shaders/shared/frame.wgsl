@@ -30,6 +30,9 @@ struct Frame {
     other_first_chunk: u32,
     // 1: light with the per-vertex normals (smooth shading); 0: per face.
     smooth_shading: u32,
+    // The weights columns of the cage vertices; Green coordinates' triangle
+    // columns follow them. The negativity view's minimum runs over these.
+    vertex_columns: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

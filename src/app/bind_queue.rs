@@ -359,10 +359,11 @@ fn run(
                 method: options.method,
                 source: BindError::NothingKept,
             })?;
-            let quality = WeightQuality::measure(
+            let quality = WeightQuality::measure_columns(
                 &weights,
                 &prepared.points,
-                prepared.cage.positions(),
+                &options.method.rest_columns(&prepared.cage),
+                options.method.vertex_columns(&prepared.cage),
                 &outside,
             );
             Ok(BindOutcome {

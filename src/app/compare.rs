@@ -128,6 +128,9 @@ pub struct ViewSettings {
     pub overlay: Overlay,
     /// The cage vertex whose coordinate function the heatmap shows.
     pub heat_vertex: usize,
+    /// When set, the heatmap shows ψ of this cage triangle instead (Green
+    /// coordinates' per-triangle functions; other families have none).
+    pub heat_triangle: Option<usize>,
     /// The scale of the heatmap and the difference view.
     pub scale: Scale,
     /// The scale of the negativity view: logarithmic by default, because on real
@@ -181,6 +184,7 @@ impl Default for ViewSettings {
             layout: Layout::Single,
             overlay: Overlay::Shaded,
             heat_vertex: 0,
+            heat_triangle: None,
             scale: Scale::Linear,
             negativity_scale: Scale::LogMagnitude,
             compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
@@ -231,9 +235,10 @@ impl ViewSettings {
         match (pane, self.overlay) {
             (Pane::Difference { .. }, _) => Colouring::MethodDistance,
             (Pane::Method(_), Overlay::Shaded) => Colouring::Shaded,
-            (Pane::Method(_), Overlay::Heatmap) => {
-                Colouring::CageVertexWeight(self.heat_vertex as u32)
-            }
+            (Pane::Method(_), Overlay::Heatmap) => match self.heat_triangle {
+                Some(triangle) => Colouring::TriangleWeight(triangle as u32),
+                None => Colouring::CageVertexWeight(self.heat_vertex as u32),
+            },
             (Pane::Method(_), Overlay::Negativity) => Colouring::MostNegativeWeight,
         }
     }
@@ -300,12 +305,17 @@ pub fn column_range(weights: &Weights, column: usize) -> Option<ValueRange> {
     )
 }
 
-/// Range over the mesh of each vertex's most negative (smallest) weight.
-/// Range of the rows' smallest weights, leaving out the rows in `outside`
-/// (ascending): their weights follow the outside policy, not the family, and the
-/// negativity view paints them apart.
-pub fn row_minimum_range(weights: &Weights, outside: &[u32]) -> Option<ValueRange> {
-    if weights.cols == 0 {
+/// Range over the mesh of each vertex's most negative (smallest) weight among its
+/// first `vertex_columns` (the cage vertices' columns), leaving out the rows in
+/// `outside` (ascending): their weights follow the outside policy, not the
+/// family, and the negativity view paints them apart.
+pub fn row_minimum_range(
+    weights: &Weights,
+    vertex_columns: usize,
+    outside: &[u32],
+) -> Option<ValueRange> {
+    let columns = vertex_columns.min(weights.cols);
+    if columns == 0 {
         return None;
     }
     ValueRange::of(
@@ -314,7 +324,7 @@ pub fn row_minimum_range(weights: &Weights, outside: &[u32]) -> Option<ValueRang
             .chunks_exact(weights.cols)
             .enumerate()
             .filter(|(row, _)| outside.binary_search(&(*row as u32)).is_err())
-            .map(|(_, row)| row.iter().copied().fold(f32::INFINITY, f32::min)),
+            .map(|(_, row)| row[..columns].iter().copied().fold(f32::INFINITY, f32::min)),
     )
 }
 
@@ -352,8 +362,16 @@ pub struct HoverReadout {
 }
 
 impl HoverReadout {
-    pub fn new(weights: &Weights, method: Method, vertex: usize) -> Option<Self> {
+    /// The read-out of mesh vertex `vertex` over its first `vertex_columns`
+    /// weights, those of the cage vertices.
+    pub fn new(
+        weights: &Weights,
+        method: Method,
+        vertex: usize,
+        vertex_columns: usize,
+    ) -> Option<Self> {
         let row = weights.values.chunks_exact(weights.cols).nth(vertex)?;
+        let row = &row[..vertex_columns.min(row.len())];
         Some(Self {
             vertex,
             method,
@@ -442,7 +460,7 @@ mod tests {
         );
         assert_eq!(column_range(&weights, 3), None);
         assert_eq!(
-            row_minimum_range(&weights, &[]),
+            row_minimum_range(&weights, weights.cols, &[]),
             Some(ValueRange {
                 min: -0.1,
                 max: 0.2
@@ -450,7 +468,7 @@ mod tests {
         );
         // An outside row is left out.
         assert_eq!(
-            row_minimum_range(&weights, &[0]),
+            row_minimum_range(&weights, weights.cols, &[0]),
             Some(ValueRange { min: 0.2, max: 0.2 })
         );
         assert_eq!(

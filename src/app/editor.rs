@@ -337,6 +337,9 @@ impl EditorApp {
         self.viewport.reset_interaction();
         let cage_vertices = self.document.pose().len();
         self.view.heat_vertex = self.view.heat_vertex.min(cage_vertices.saturating_sub(1));
+        let cage_triangles = self.document.cage().triangle_count();
+        self.view.heat_triangle = (self.view.heat_triangle)
+            .map(|triangle| triangle.min(cage_triangles.saturating_sub(1)));
         self.binding_paused = false;
         if frame {
             self.frame_scene();

@@ -124,6 +124,12 @@ impl EditorApp {
                      the difference first"
                         .to_owned()
                 }
+                Colouring::TriangleWeight(_) if self.document.weights(pane.method()).is_some() => {
+                    format!(
+                        "{} has no per-triangle functions ψ; only Green coordinates do",
+                        pane.method()
+                    )
+                }
                 _ => format!("{} is not bound yet", pane.method()),
             });
             return false;
@@ -165,11 +171,23 @@ impl EditorApp {
                 let column = (column as usize).min(weights.cols.saturating_sub(1));
                 Some((0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
+            Colouring::TriangleWeight(triangle) => {
+                let weights = self.document.weights(pane.method())?;
+                let column = self.document.cage().vertex_count() + triangle as usize;
+                (column < weights.cols)
+                    .then(|| (0..weights.rows).map(|r| weights.row(r)[column]).collect())
+            }
             Colouring::MostNegativeWeight => {
                 let weights = self.document.weights(pane.method())?;
+                let columns = self.document.cage().vertex_count().min(weights.cols);
                 Some(
                     (0..weights.rows)
-                        .map(|r| weights.row(r).iter().copied().fold(f32::INFINITY, f32::min))
+                        .map(|r| {
+                            weights.row(r)[..columns]
+                                .iter()
+                                .copied()
+                                .fold(f32::INFINITY, f32::min)
+                        })
                         .collect(),
                 )
             }
@@ -200,6 +218,9 @@ impl EditorApp {
         let what = match (colouring, pane) {
             (Colouring::CageVertexWeight(vertex), _) => {
                 format!("{} coordinate of cage vertex {vertex}", pane.method())
+            }
+            (Colouring::TriangleWeight(triangle), _) => {
+                format!("{} psi of cage triangle {triangle}", pane.method())
             }
             (Colouring::MostNegativeWeight, _) => {
                 format!("{} most negative weight per vertex", pane.method())

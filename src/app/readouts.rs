@@ -106,9 +106,14 @@ impl EditorApp {
             Colouring::CageVertexWeight(vertex) => {
                 compare::column_range(self.document.weights(method)?, vertex as usize)
             }
+            Colouring::TriangleWeight(triangle) => {
+                let column = self.document.cage().vertex_count() + triangle as usize;
+                compare::column_range(self.document.weights(method)?, column)
+            }
             Colouring::MostNegativeWeight => {
                 let weights = self.document.weights(method)?;
-                compare::row_minimum_range(weights, self.document.outside())
+                let cage_vertices = self.document.cage().vertex_count();
+                compare::row_minimum_range(weights, cage_vertices, self.document.outside())
             }
             Colouring::MethodDistance => {
                 let Pane::Difference { against, shown } = pane else {

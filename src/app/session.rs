@@ -436,6 +436,9 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
     if view.heat_vertex >= cage.vertex_count() {
         view.heat_vertex = 0;
     }
+    if view.heat_triangle >= Some(cage.triangle_count()) {
+        view.heat_triangle = None;
+    }
     let cameras = session
         .cameras
         .iter()

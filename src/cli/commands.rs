@@ -1,7 +1,9 @@
 //! The work behind each subcommand.
 
+use super::weights_format::{check_weights_format, read_weights_for, writes_npz};
 use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
-use crate::coords::npy::{npy_file_bytes, npy_preamble, read_npy, write_f32_values, write_npy_to};
+use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values, write_npy_to};
+use crate::coords::npz::{npz_payload_bytes, write_npz_to};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{
     self, classify_points, extension_warning, human_bytes, refuse_same_file, Cage, MeshFile,
@@ -52,11 +54,15 @@ pub(super) fn load_input(
                 input.cage.display()
             );
         }
+        let policy = if choice.method == Method::Green {
+            "they get Green's exterior extension through the nearest cage triangle, exact at rest and continuous across it".to_owned()
+        } else {
+            format!("they get MVC weights (beyond {} cage diagonals, MVC's affine extension), which sum to one, reproduce their points at any distance and meet the inside coordinates continuously on the cage", crate::coords::mvc::FAR_FIELD_DIAGONALS)
+        };
         warn_line!(
-            "pmvc: {}: warning: {summary} of {}; they get MVC weights (beyond {} cage diagonals, MVC's affine extension), which sum to one, reproduce their points at any distance and meet the inside coordinates continuously on the cage",
+            "pmvc: {}: warning: {summary} of {}; {policy}",
             input.mesh.display(),
             input.cage.display(),
-            crate::coords::mvc::FAR_FIELD_DIAGONALS
         );
     }
     Ok(BoundInput {
@@ -163,9 +169,10 @@ fn outside_note(input: &BoundInput) -> String {
 const BLOCK_BYTES: usize = 256 << 20;
 
 /// Rows held at once by `pmvc bind`: everything for a family that solves for the
-/// whole cage, a block for one whose rows are independent.
+/// whole cage or is written as a `.npz` (array after array), a block for one whose
+/// rows are independent.
 fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
-    if args.method.method.spec().rows_independent {
+    if args.method.method.spec().rows_independent && !writes_npz(args.method.method) {
         let block = args
             .block_rows
             .map_or(BLOCK_BYTES / (4 * columns.max(1)), |rows| {
@@ -242,12 +249,13 @@ fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result
 
 pub(super) fn bind(args: &BindArgs) -> Result<()> {
     let inputs = [args.input.mesh.as_path(), args.input.cage.as_path()];
-    check_output(
-        &args.out,
-        &inputs,
-        &["npy"],
-        "float32 weights in .npy format",
-    )?;
+    check_weights_format(args)?;
+    let (extensions, what): (&[&str], _) = if writes_npz(args.method.method) {
+        (&["npz"], "phi and psi float32 arrays in .npz format")
+    } else {
+        (&["npy"], "float32 weights in .npy format")
+    };
+    check_output(&args.out, &inputs, extensions, what)?;
     // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
     // on the driver: do it while the inputs load and are classified.
     let choice = args.method.backend;
@@ -263,11 +271,24 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     // Opened before the work, so that a full disk or an unwritable folder is
     // reported now, and a signal during the bind removes the temporary file.
     let output = PendingOutput::create(&args.out)?;
-    output.check_space(npy_file_bytes(rows, columns))?;
+    output.check_space(if writes_npz(args.method.method) {
+        npz_payload_bytes(rows, columns)
+    } else {
+        npy_file_bytes(rows, columns)
+    })?;
     let started = std::time::Instant::now();
     let device = bind_to(args, &input, backend, output, rows, columns)?;
+    let shape = if writes_npz(args.method.method) {
+        let vertices = input.cage.vertex_count();
+        format!(
+            "phi {rows} × {vertices} and psi {rows} × {} float32",
+            columns - vertices
+        )
+    } else {
+        format!("{rows} × {columns} float32 weights")
+    };
     summary(format_args!(
-        "wrote {}: {rows} × {columns} float32 weights ({}, {device}) in {:.2} s; {}",
+        "wrote {}: {shape} ({}, {device}) in {:.2} s; {}",
         args.out.display(),
         method_label(&args.method),
         started.elapsed().as_secs_f64(),
@@ -291,7 +312,12 @@ fn bind_to(
     if block >= rows {
         let (weights, device) = bind_rows(input, 0..rows, &args.method, &backend, &bar)?;
         bar.finish_and_clear();
-        write_npy_to(output, &args.out, &weights)?;
+        if writes_npz(args.method.method) {
+            let vertices = args.method.method.vertex_columns(&input.cage);
+            write_npz_to(output, &args.out, &weights, vertices)?;
+        } else {
+            write_npy_to(output, &args.out, &weights)?;
+        }
         return Ok(device);
     }
     // In blocks of rows, each written as soon as it is bound: memory stays at one
@@ -349,28 +375,13 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             args.input.cage.display()
         );
     }
-    let weights = match &args.weights {
-        Some(path) => {
-            let weights = read_npy(path)?;
-            let rows = input.mesh.mesh.positions.len();
-            if (weights.rows, weights.cols) != (rows, expected) {
-                bail!(
-                    "{}: weights have shape ({}, {}), but the mesh has {rows} vertices and the cage {expected}",
-                    path.display(),
-                    weights.rows,
-                    weights.cols
-                );
-            }
-            weights
-        }
-        None => compute_weights(&input, &args.method)?,
+    let (weights, method) = match &args.weights {
+        Some(path) => read_weights_for(path, &input, args.method.method)?,
+        None => (compute_weights(&input, &args.method)?, args.method.method),
     };
     // Displacement form: exact at rest for any weights, and no cancellation of
     // large absolute positions far from the origin.
-    let moves = args
-        .method
-        .method
-        .column_displacements(&input.cage, &pose.mesh.positions);
+    let moves = method.column_displacements(&input.cage, &pose.mesh.positions);
     let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
     geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     let source = match &args.weights {
@@ -491,6 +502,9 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
     check_output(&args.cage, &[], &["obj"], "an OBJ cage")?;
     let (mesh, cage) = if args.scene == SCULPT_SIZE {
         sculpt_size_scene()
+    } else if args.scene == geometry::twisted_bar::TWISTED_BAR {
+        let bar = geometry::twisted_bar::twisted_bar();
+        (bar.mesh, bar.cage)
     } else {
         let scene = table1_scene(&args.scene).context("unknown scene")?;
         let points = geometry::TriMesh {

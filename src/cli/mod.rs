@@ -25,6 +25,7 @@ macro_rules! warn_line {
 mod bench;
 mod commands;
 mod environment;
+mod weights_format;
 
 /// Standard output could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -131,8 +132,8 @@ pub struct BindArgs {
     pub input: CageInput,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order.
-    #[arg(long, value_name = "W.npy")]
+    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated).
+    #[arg(long, value_name = "W.npy|W.npz")]
     pub out: PathBuf,
     /// Bind and write this many rows at a time, so that memory holds one block
     /// (MVC and PMVC; default: 256 MiB of weights). Harmonic coordinates solve for
@@ -150,10 +151,10 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored).
-    #[arg(long, value_name = "W.npy")]
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi).
+    #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
-    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are dropped.
+    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh.
     #[arg(long, value_name = "M2.obj")]
     pub out: PathBuf,
 }
@@ -328,8 +329,9 @@ impl EditArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct GenerateArgs {
-    /// Scene name: the paper's Table 1 sizes (point sets), or sculpt-size (a
-    /// million-vertex triangle mesh).
+    /// Scene name: the paper's Table 1 sizes (point sets), sculpt-size (a
+    /// million-vertex triangle mesh), or twisted-bar (a round bar in a box cage,
+    /// for docs/poses/twisted-bar.obj).
     #[arg(value_parser = clap::builder::PossibleValuesParser::new(generate_scene_names()))]
     pub scene: String,
     /// Output mesh as OBJ.
@@ -343,6 +345,7 @@ pub struct GenerateArgs {
 fn generate_scene_names() -> Vec<&'static str> {
     let mut names = crate::geometry::procedural::table1_scene_names().to_vec();
     names.push(crate::geometry::procedural::SCULPT_SIZE);
+    names.push(crate::geometry::twisted_bar::TWISTED_BAR);
     names
 }
 
@@ -466,7 +469,7 @@ mod tests {
             options.view.scale,
             crate::render::colormap::Scale::LogMagnitude
         );
-        let options = edit_options(&["--compare", "mvc,pmvc,harmonic"]);
+        let options = edit_options(&["--compare", "mvc,pmvc,harmonic,green"]);
         assert_eq!(options.view.layout, Layout::SideBySide);
         assert_eq!(
             options.view.compared.iter().collect::<Vec<_>>(),

@@ -20,6 +20,9 @@ pub enum Method {
     Pmvc,
     /// Harmonic coordinates (Joshi et al. 2007), by a grid solve of Laplace's equation.
     Harmonic,
+    /// Green coordinates (Lipman, Levin, Cohen-Or 2008), closed form: one column per
+    /// cage vertex (φ) and one per cage triangle (ψ).
+    Green,
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -64,6 +67,9 @@ impl Parameter {
 pub enum ColumnLayout {
     /// One weight per cage vertex.
     CageVertices,
+    /// One per cage vertex, then one per cage triangle in [`Cage::triangles`] order
+    /// (Green coordinates' φ, then ψ).
+    CageVerticesThenTriangles,
 }
 
 /// Everything the product needs to know about a family to offer it.
@@ -142,15 +148,28 @@ const HARMONIC: FamilySpec = FamilySpec {
     rows_independent: false,
 };
 
+const GREEN: FamilySpec = FamilySpec {
+    id: "green",
+    name: "Green",
+    summary: "Green coordinates: shape-preserving, one weight per cage vertex and per triangle; not positive",
+    parameter: None,
+    columns: ColumnLayout::CageVerticesThenTriangles,
+    positive_inside: false,
+    outside_policy: "vertices outside the cage get Green's exterior extension: the inside \
+         coordinates continued through the nearest cage triangle, exact at rest and continuous across it",
+    rows_independent: true,
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 3] = [Method::Mvc, Method::Pmvc, Method::Harmonic];
+    pub const ALL: [Method; 4] = [Method::Mvc, Method::Pmvc, Method::Harmonic, Method::Green];
 
     pub fn spec(self) -> &'static FamilySpec {
         match self {
             Method::Mvc => &MVC,
             Method::Pmvc => &PMVC,
             Method::Harmonic => &HARMONIC,
+            Method::Green => &GREEN,
         }
     }
 
@@ -179,21 +198,59 @@ impl Method {
     pub fn columns(self, cage: &Cage) -> usize {
         match self.spec().columns {
             ColumnLayout::CageVertices => cage.vertex_count(),
+            ColumnLayout::CageVerticesThenTriangles => cage.vertex_count() + cage.triangle_count(),
         }
+    }
+
+    /// The vector each weights column multiplies at rest: the cage positions, then
+    /// for Green coordinates each triangle's unit outward normal. A row reproduces
+    /// its point when Σₖ wₖ cₖ equals it (linear precision).
+    pub fn rest_columns(self, rest: &Cage) -> Vec<DVec3> {
+        let mut columns = rest.positions().to_vec();
+        if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
+            columns.extend(rest_normals(rest));
+        }
+        columns
     }
 
     /// Per weights column, how far its vector moved from `rest` to `pose`; a mesh
     /// vertex then moves by Σₖ wₖ dₖ (the displacement form, exact at rest for any
-    /// weights). For one column per cage vertex this is `pose − rest`.
+    /// weights). For a cage vertex's column this is `pose − rest`; for a triangle's
+    /// (Green coordinates) it is `sⱼ nⱼ' − nⱼ`, the stretched deformed normal less
+    /// the rest normal. A pose of the wrong length moves nothing.
     pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
-        match self.spec().columns {
-            ColumnLayout::CageVertices => pose
-                .iter()
-                .zip(rest.positions())
-                .map(|(posed, rested)| *posed - *rested)
-                .collect(),
+        let mut moves: Vec<DVec3> = pose
+            .iter()
+            .zip(rest.positions())
+            .map(|(posed, rested)| *posed - *rested)
+            .collect();
+        if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
+            match super::green::face_vectors(rest, pose) {
+                Ok(faces) => moves.extend(
+                    faces
+                        .into_iter()
+                        .zip(rest_normals(rest))
+                        .map(|(posed, rested)| posed - rested),
+                ),
+                Err(_) => moves.resize(self.columns(rest), DVec3::ZERO),
+            }
         }
+        moves
     }
+
+    /// Columns that belong to cage vertices: where partition of unity and
+    /// positivity are measured (Green coordinates' ψ columns are neither).
+    pub fn vertex_columns(self, cage: &Cage) -> usize {
+        cage.vertex_count()
+    }
+}
+
+/// Each cage triangle's unit outward normal (zero for a degenerate one).
+fn rest_normals(cage: &Cage) -> impl Iterator<Item = DVec3> + '_ {
+    cage.triangles().iter().map(|&corners| {
+        let [a, b, c] = corners.map(|i| cage.positions()[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    })
 }
 
 /// Saved files name a family by its identifier ("pmvc"), so adding or reordering

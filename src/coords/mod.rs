@@ -14,6 +14,10 @@
 //!   there. Beyond [`mvc::FAR_FIELD_DIAGONALS`] cage diagonals, where the closed
 //!   form loses digits, MVC are extended affinely (see [`mvc`]), which keeps
 //!   those properties exactly at every distance.
+//!
+//! Green coordinates are the exception: they have their own surface and exterior
+//! policies ([`green`]), which keep the deformation continuous across the cage for
+//! their extra triangle columns, so their rows ignore the point's class.
 
 pub mod cubemap;
 pub mod family;
@@ -21,6 +25,7 @@ pub mod green;
 pub mod harmonic;
 pub mod mvc;
 pub mod npy;
+pub mod npz;
 pub mod pmvc;
 pub mod quality;
 
@@ -91,7 +96,8 @@ impl Default for BindOptions {
     }
 }
 
-/// Dense weights: one row per mesh vertex, one column per cage vertex, row-major f32.
+/// Dense weights: one row per mesh vertex, one column per cage vertex (then, for
+/// Green coordinates, per cage triangle), row-major f32.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Weights {
     pub rows: usize,
@@ -261,7 +267,7 @@ pub fn bind_cpu(
             harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
         return Ok(weights);
     }
-    let mut weights = Weights::zeros(points.len(), cage.vertex_count());
+    let mut weights = Weights::zeros(points.len(), options.method.columns(cage));
     let rows: Vec<usize> = (0..points.len()).collect();
     bind_rows(
         points,
@@ -275,8 +281,8 @@ pub fn bind_cpu(
     Ok(weights)
 }
 
-/// The one row loop of every CPU bind: fill `out` (`rows.len()` × cage vertices,
-/// row-major) with the weights of `points[rows[k]]`, in parallel, advancing
+/// The one row loop of every CPU bind: fill `out` (`rows.len()` × the method's
+/// columns, row-major) with the weights of `points[rows[k]]`, in parallel, advancing
 /// `progress` and stopping early when it is cancelled.
 pub fn bind_rows(
     points: &[DVec3],
@@ -288,7 +294,7 @@ pub fn bind_rows(
     progress: &BindProgress,
 ) -> Result<(), Cancelled> {
     assert_eq!(points.len(), classes.len(), "one class per point");
-    let cols = cage.vertex_count();
+    let cols = options.method.columns(cage);
     assert_eq!(
         out.len(),
         rows.len() * cols,
@@ -298,6 +304,7 @@ pub fn bind_rows(
         return Ok(());
     }
     let table = cubemap::TexelTable::new(options.resolution.max(1));
+    let green_cage = (options.method == Method::Green).then(|| green::GreenCage::new(cage));
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
@@ -313,16 +320,20 @@ pub fn bind_rows(
                     return Err(Cancelled);
                 }
                 for (row, &i) in block.chunks_mut(cols).zip(block_rows) {
-                    weights_at(
-                        points[i],
-                        classes[i],
-                        cage,
-                        options.method,
-                        &table,
-                        row_f64,
-                        mvc_scratch,
-                        pmvc_scratch,
-                    );
+                    if let Some(green_cage) = &green_cage {
+                        green_row(green_cage, points[i], row_f64);
+                    } else {
+                        weights_at(
+                            points[i],
+                            classes[i],
+                            cage,
+                            options.method,
+                            &table,
+                            row_f64,
+                            mvc_scratch,
+                            pmvc_scratch,
+                        );
+                    }
                     for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
                         *out = value as f32;
                     }
@@ -333,7 +344,17 @@ pub fn bind_rows(
         )
 }
 
-/// Coordinates of one point, following the policy of the module doc.
+/// Green coordinates of `x` into one row (φ, then ψ); NaN for a point they cannot
+/// take (not finite), which the bind's validation rejects beforehand.
+fn green_row(green_cage: &green::GreenCage, x: DVec3, out: &mut [f64]) {
+    let (phi, psi) = out.split_at_mut(green_cage.vertex_count());
+    if green_cage.coordinates(x, phi, psi).is_err() {
+        out.fill(f64::NAN);
+    }
+}
+
+/// Coordinates of one point, following the policy of the module doc. `out` holds
+/// the method's columns ([`Method::columns`]).
 #[allow(clippy::too_many_arguments)]
 pub fn weights_at(
     x: DVec3,
@@ -345,6 +366,12 @@ pub fn weights_at(
     mvc_scratch: &mut mvc::MvcScratch,
     pmvc_scratch: &mut pmvc::PmvcScratch,
 ) {
+    if method == Method::Green {
+        // Its own policies for every class; prepared per call here, once per bind
+        // in `bind_rows`.
+        green_row(&green::GreenCage::new(cage), x, out);
+        return;
+    }
     match class {
         PointClass::OnSurface {
             triangle,
@@ -360,7 +387,9 @@ pub fn weights_at(
         PointClass::Inside => match method {
             // Harmonic coordinates have no per-point form; bind_cpu solves them
             // whole. Asked for one row, MVC is the outside policy's answer.
-            Method::Mvc | Method::Harmonic => mvc::mvc_weights(x, cage, out, mvc_scratch),
+            Method::Mvc | Method::Harmonic | Method::Green => {
+                mvc::mvc_weights(x, cage, out, mvc_scratch)
+            }
             Method::Pmvc => {
                 if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the

@@ -27,6 +27,23 @@ pub enum NpyError {
     FortranOrder { path: PathBuf },
     #[error("{path}: expected float32 weights, found dtype {dtype}", path = path.display())]
     Dtype { path: PathBuf, dtype: String },
+    #[error("{path}: not a .npz archive: {source}", path = path.display())]
+    NotNpz {
+        path: PathBuf,
+        source: zip::result::ZipError,
+    },
+    #[error("{path}: has no array '{name}' (it holds: {found})", path = path.display())]
+    MissingArray {
+        path: PathBuf,
+        name: &'static str,
+        found: String,
+    },
+    #[error("{path}: 'phi' has {phi_rows} rows but 'psi' has {psi_rows}; both need one row per mesh vertex", path = path.display())]
+    RowMismatch {
+        path: PathBuf,
+        phi_rows: usize,
+        psi_rows: usize,
+    },
     #[error("{path}: shape ({rows}, {cols}) is too long for a .npy header", path = path.display())]
     HeaderTooLong {
         path: PathBuf,
@@ -98,11 +115,15 @@ pub fn read_npy(path: &Path) -> Result<Weights, NpyError> {
         path: path.to_owned(),
         source,
     })?;
-    let npy =
-        npyz::NpyFile::new(std::io::BufReader::new(file)).map_err(|source| NpyError::NotNpy {
-            path: path.to_owned(),
-            source,
-        })?;
+    read_npy_from(std::io::BufReader::new(file), path)
+}
+
+/// [`read_npy`] from any reader (an archive's entry); `path` names it in errors.
+pub(super) fn read_npy_from(reader: impl std::io::Read, path: &Path) -> Result<Weights, NpyError> {
+    let npy = npyz::NpyFile::new(reader).map_err(|source| NpyError::NotNpy {
+        path: path.to_owned(),
+        source,
+    })?;
     let shape = npy.shape().to_vec();
     let [rows, cols] = shape[..] else {
         return Err(NpyError::Shape {

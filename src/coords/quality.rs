@@ -47,12 +47,27 @@ impl WeightQuality {
     /// tolerance, which only decides what is counted. A degenerate cage (zero
     /// diagonal) gives the linear precision error unscaled.
     pub fn measure(weights: &Weights, points: &[DVec3], cage: &[DVec3], outside: &[u32]) -> Self {
+        Self::measure_columns(weights, points, cage, cage.len(), outside)
+    }
+
+    /// [`Self::measure`] for a family whose columns are not all cage vertices:
+    /// `columns` holds each column's rest vector ([`super::Method::rest_columns`]),
+    /// the first `vertex_columns` of them the cage positions. Partition of unity
+    /// and negativity are measured over those; linear precision over all.
+    pub fn measure_columns(
+        weights: &Weights,
+        points: &[DVec3],
+        columns: &[DVec3],
+        vertex_columns: usize,
+        outside: &[u32],
+    ) -> Self {
         assert_eq!(points.len(), weights.rows, "one point per weights row");
         assert_eq!(
-            cage.len(),
+            columns.len(),
             weights.cols,
-            "one cage position per weights column"
+            "one rest vector per weights column"
         );
+        let cage = &columns[..vertex_columns.min(columns.len())];
         let diagonal = {
             let (lo, hi) = crate::geometry::bounds_of(cage);
             (hi - lo).length()
@@ -62,7 +77,7 @@ impl WeightQuality {
         let (inside, beyond) = (0..weights.rows)
             .into_par_iter()
             .map(|i| {
-                let row = RowQuality::of(i, weights.row(i), points[i], cage);
+                let row = RowQuality::of(i, weights.row(i), points[i], columns, cage.len());
                 if is_outside(i) {
                     (RowQuality::default(), row)
                 } else {
@@ -121,14 +136,17 @@ impl Default for RowQuality {
 }
 
 impl RowQuality {
-    fn of(i: usize, row: &[f32], x: DVec3, cage: &[DVec3]) -> Self {
+    fn of(i: usize, row: &[f32], x: DVec3, columns: &[DVec3], vertex_columns: usize) -> Self {
         let mut quality = Self::default();
         let mut sum = 0.0;
         let mut position = DVec3::ZERO;
-        for (j, (&w, &c)) in row.iter().zip(cage).enumerate() {
+        for (j, (&w, &c)) in row.iter().zip(columns).enumerate() {
             let w = f64::from(w);
-            sum += w;
             position += w * c;
+            if j >= vertex_columns {
+                continue;
+            }
+            sum += w;
             if w < quality.min {
                 quality.min = w;
                 quality.min_at = Some((i, j));

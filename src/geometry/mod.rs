@@ -15,6 +15,7 @@ mod output;
 mod ply;
 pub mod procedural;
 pub mod subdivide;
+pub mod twisted_bar;
 
 pub use cage::{Cage, CageReport};
 pub use classify::{

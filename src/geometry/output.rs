@@ -280,6 +280,23 @@ impl PendingOutput {
         self,
         write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
     ) -> Result<(), WriteError> {
+        self.finish_into(false, |out| write(out))
+    }
+
+    /// [`Self::finish`] for formats that seek back (zip archives): a file is
+    /// written in place; a device or pipe gets the bytes built in memory first.
+    pub fn finish_seekable(
+        self,
+        write: impl FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
+        self.finish_into(true, write)
+    }
+
+    fn finish_into(
+        self,
+        seeks: bool,
+        write: impl FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
         let path = self.path;
         let wrap = |source| WriteError {
             path: path.clone(),
@@ -292,7 +309,14 @@ impl PendingOutput {
                     .open(&device)
                     .map_err(wrap)?;
                 let mut buffered = std::io::BufWriter::new(file);
-                write(&mut buffered).map_err(wrap)?;
+                if seeks {
+                    // A pipe cannot seek: build the bytes first.
+                    let mut bytes = std::io::Cursor::new(Vec::new());
+                    write(&mut bytes).map_err(wrap)?;
+                    buffered.write_all(bytes.get_ref()).map_err(wrap)?;
+                } else {
+                    write(&mut buffered).map_err(wrap)?;
+                }
                 buffered.flush().map_err(wrap)
             }
             Pending::File {
@@ -305,14 +329,21 @@ impl PendingOutput {
                     write(&mut buffered).map_err(wrap)?;
                     buffered.flush().map_err(wrap)?;
                 }
-                temporary.as_file().sync_all().map_err(wrap)?;
-                temporary
-                    .persist(&target)
-                    .map_err(|error| wrap(error.error))?;
-                Ok(())
+                persist(temporary, &target).map_err(wrap)
             }
         }
     }
+}
+
+/// A writer that can also seek (an archive's central directory needs it).
+pub trait WriteSeek: Write + std::io::Seek {}
+impl<T: Write + std::io::Seek> WriteSeek for T {}
+
+/// Make a finished temporary file durable and rename it over `target`.
+fn persist(temporary: tempfile::NamedTempFile, target: &Path) -> std::io::Result<()> {
+    temporary.as_file().sync_all()?;
+    temporary.persist(target).map_err(|error| error.error)?;
+    Ok(())
 }
 
 /// Write an output by the rules in the module documentation.

@@ -43,9 +43,13 @@ pub struct FrameUniform {
     pub other_rows_per_chunk: u32,
     /// The pool slot of the compared family's first chunk.
     pub other_first_chunk: u32,
-    /// 1 for smooth shading (per-vertex normals), 0 for faceted; also rounds the
-    /// size up to WGSL's 16-byte struct alignment.
+    /// 1 for smooth shading (per-vertex normals), 0 for faceted.
     pub smooth_shading: u32,
+    /// The weights columns of the cage vertices (the negativity view's minimum
+    /// runs over these; Green coordinates' triangle columns follow them).
+    pub vertex_columns: u32,
+    /// Rounds the size up to WGSL's 16-byte struct alignment.
+    pub _padding: [u32; 3],
 }
 
 /// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family

@@ -28,7 +28,7 @@ use glam::{DVec3, Mat4, Vec3};
 /// costs about 16 ms a frame on lavapipe, so software adapters default to 1.
 pub const MSAA_SAMPLES: u32 = 4;
 /// Views drawn in one frame.
-pub const MAX_VIEWS: usize = 3;
+pub const MAX_VIEWS: usize = 4;
 /// The frame-uniform slot of readbacks, after the views'.
 const READBACK_SLOT: usize = MAX_VIEWS;
 const BACKGROUND: wgpu::Color = wgpu::Color {
@@ -83,6 +83,9 @@ pub enum Colouring {
     Shaded,
     /// The weight of one column: λᵢ of cage vertex i.
     CageVertexWeight(u32),
+    /// Green coordinates' ψⱼ of cage triangle j: the column after the cage
+    /// vertices'; a family without it shows the mesh shaded.
+    TriangleWeight(u32),
     /// minⱼ λⱼ per mesh vertex: where the coordinates go negative.
     MostNegativeWeight,
     /// |p′ − p′_against| between two families' deformations, over the cage size.
@@ -90,11 +93,16 @@ pub enum Colouring {
 }
 
 impl Colouring {
-    /// The shader's `COLOURING_*` constant and the column it shows.
-    fn code(self) -> [u32; 2] {
+    /// The shader's `COLOURING_*` constant and the column it shows, for weights
+    /// of `columns` columns whose first `vertex_columns` are the cage vertices'.
+    fn code(self, vertex_columns: u32, columns: u32) -> [u32; 2] {
         match self {
             Colouring::Shaded => [0, 0],
             Colouring::CageVertexWeight(vertex) => [1, vertex],
+            Colouring::TriangleWeight(triangle) => match vertex_columns.checked_add(triangle) {
+                Some(column) if column < columns => [1, column],
+                _ => [0, 0],
+            },
             Colouring::MostNegativeWeight => [2, 0],
             Colouring::MethodDistance => [3, 0],
         }
@@ -356,7 +364,11 @@ impl ViewportRenderer {
         let (shown, against) = (slot_of(Some(shading.method)), slot_of(shading.against));
         let columns = shown.map_or(0, |slot| slot.columns);
         let rows_per_chunk = |slot: Option<&WeightSlot>| slot.map_or(1, |s| s.split.rows_per_chunk);
-        let [colouring, colouring_column] = shading.colouring.code();
+        let cage_vertices = self
+            .scene
+            .as_ref()
+            .map_or(0, |scene| scene.cage_vertex_count);
+        let [colouring, colouring_column] = shading.colouring.code(cage_vertices, columns);
         FrameUniform {
             view_projection: params.view_projection.to_cols_array_2d(),
             eye: params.eye.to_array(),
@@ -377,6 +389,8 @@ impl ViewportRenderer {
             // The pool holds the shown family's chunks first (SceneGpu::bind_group).
             other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
             smooth_shading: u32::from(params.smooth_shading),
+            vertex_columns: cage_vertices,
+            _padding: [0; 3],
         }
     }
 

@@ -83,3 +83,28 @@ pub fn assert_clean_failure(output: &Output, file: &str, what: &str) {
         "error should say '{what}': {text}"
     );
 }
+
+/// A version 1.0 `.npy` of little-endian float32, parsed by hand (independent of
+/// the library's reader): its shape, values and header text.
+pub fn parse_npy_f32(bytes: &[u8]) -> (Vec<usize>, Vec<f32>, String) {
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00", "npy format version 1.0");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
+    let shape_text = header
+        .split("'shape': (")
+        .nth(1)
+        .unwrap()
+        .split(')')
+        .next()
+        .unwrap();
+    let shape: Vec<usize> = shape_text
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    let values = bytes[10 + header_len..]
+        .chunks(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    (shape, values, header)
+}

@@ -50,11 +50,7 @@ impl EditorApp {
             ui.selectable_value(overlay, Overlay::Heatmap, "Heatmap λi");
             ui.selectable_value(overlay, Overlay::Negativity, "Negativity");
             if self.view.overlay == Overlay::Heatmap {
-                let last = self.document.pose().len().saturating_sub(1);
-                let label = ui.label("i =");
-                ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
-                    .labelled_by(label.id)
-                    .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+                self.heatmap_controls(ui);
             }
             if self.view.overlay != Overlay::Shaded || self.view.layout != Layout::Single {
                 let scale = self.view.overlay_scale_mut();
@@ -62,6 +58,43 @@ impl EditorApp {
                 ui.selectable_value(scale, Scale::LogMagnitude, "Log");
             }
         });
+    }
+
+    /// Which coordinate function the heatmap shows: a cage vertex's, or (Green
+    /// coordinates) a cage triangle's ψ.
+    fn heatmap_controls(&mut self, ui: &mut egui::Ui) {
+        let triangles = self.document.cage().triangle_count();
+        let mut of_triangle = self.view.heat_triangle.is_some();
+        let label = ui.label("of");
+        egui::ComboBox::from_id_salt("heatmap of")
+            .selected_text(if of_triangle {
+                "ψj of triangle"
+            } else {
+                "λi of vertex"
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut of_triangle, false, "λi of vertex")
+                    .on_hover_text("Every family: the coordinate of cage vertex i (φi for Green)");
+                ui.selectable_value(&mut of_triangle, true, "ψj of triangle")
+                    .on_hover_text("Green coordinates only: the function of cage triangle j");
+            })
+            .response
+            .labelled_by(label.id);
+        if of_triangle {
+            let mut triangle = self.view.heat_triangle.unwrap_or(0);
+            let label = ui.label("j =");
+            ui.add(egui::DragValue::new(&mut triangle).range(0..=triangles.saturating_sub(1)))
+                .labelled_by(label.id)
+                .on_hover_text("Cage triangle, in the order the cage's faces are triangulated");
+            self.view.heat_triangle = Some(triangle);
+        } else {
+            self.view.heat_triangle = None;
+            let last = self.document.pose().len().saturating_sub(1);
+            let label = ui.label("i =");
+            ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
+                .labelled_by(label.id)
+                .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+        }
     }
 
     /// Which methods the side-by-side layout shows.

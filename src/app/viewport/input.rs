@@ -95,6 +95,7 @@ impl EditorApp {
             // In heatmap mode a click on a handle shows that vertex's coordinate.
             if let (Some(handle), Overlay::Heatmap) = (picked, self.view.overlay) {
                 self.view.heat_vertex = handle;
+                self.view.heat_triangle = None;
             }
             match (picked, modifiers.shift) {
                 (Some(handle), true) => self.document.toggle_selected(handle),

@@ -11,6 +11,7 @@ pub use modal::TransformKind;
 use super::compare::{HoverReadout, Pane};
 use super::editor::EditorApp;
 use super::widgets::draw_colour_bar;
+use crate::coords::Method;
 use crate::render::{
     Colouring, FrameParams, OrbitCamera, ScreenProjection, ViewportCallback, MAX_VIEWS,
 };
@@ -269,7 +270,7 @@ impl EditorApp {
         self.draw_transform(&painter, index, rect);
         if shading.colouring != Colouring::Shaded {
             if let Some(range) = self.value_range(shading.colouring, kind) {
-                let note = self.colour_bar_note(shading.colouring);
+                let note = self.colour_bar_note(shading.colouring, kind);
                 let title = self.colour_bar_title(kind);
                 draw_colour_bar(&painter, rect, &shading, range, title, note);
             }
@@ -301,18 +302,43 @@ impl EditorApp {
         }
     }
 
-    /// The negativity view's legend for the vertices outside the cage, when
-    /// there are any: grey, and why.
-    fn colour_bar_note(&self, colouring: Colouring) -> Option<String> {
+    /// What the colour bar must also say: in the negativity view, that a family
+    /// is not positive by design and how many vertices are outside the cage (grey,
+    /// and why); for ψ, that it is signed or missing.
+    fn colour_bar_note(&self, colouring: Colouring, kind: Pane) -> Option<String> {
         let outside = self.document.outside().len();
-        (colouring == Colouring::MostNegativeWeight && outside > 0)
-            .then(|| format!("{outside} outside the cage (MVC by policy), not counted"))
+        let method = kind.method();
+        let mut notes = Vec::new();
+        if colouring == Colouring::MostNegativeWeight && !method.spec().positive_inside {
+            notes.push(format!("{method} weights are not positive by design"));
+        }
+        if colouring == Colouring::MostNegativeWeight && outside > 0 {
+            let policy = if method == Method::Green {
+                "exterior extension"
+            } else {
+                "MVC"
+            };
+            notes.push(format!(
+                "{outside} outside the cage ({policy} by policy), not counted"
+            ));
+        }
+        if let Colouring::TriangleWeight(_) = colouring {
+            let has_triangle_columns =
+                method.columns(self.document.cage()) > method.vertex_columns(self.document.cage());
+            notes.push(if has_triangle_columns {
+                "ψ is signed: blue below 0, red above".to_owned()
+            } else {
+                format!("{method} has no ψ: shaded")
+            });
+        }
+        (!notes.is_empty()).then(|| notes.join("; "))
     }
 
     fn colour_bar_title(&self, kind: Pane) -> String {
         let method = kind.method().name();
         match (self.view.colouring(kind), kind) {
             (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
+            (Colouring::TriangleWeight(triangle), _) => format!("ψ{triangle} ({method})"),
             (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
             (Colouring::MethodDistance, Pane::Difference { .. }) => {
                 // The pane's title names the methods; the bar says how it scales.

@@ -93,7 +93,9 @@ impl EditorApp {
                 Vec2::new(pointer.x, pointer.y),
                 HOVER_RADIUS,
             )?;
-            let readout = HoverReadout::new(self.document.weights(method)?, method, vertex)?;
+            let cage_vertices = self.document.cage().vertex_count();
+            let weights = self.document.weights(method)?;
+            let readout = HoverReadout::new(weights, method, vertex, cage_vertices)?;
             Some((pane, pointer, readout))
         });
         self.viewport.hover_readout = readout.as_ref().map(|(pane, _, r)| (*pane, r.clone()));

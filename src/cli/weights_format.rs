@@ -1,0 +1,88 @@
+//! Which file format a family's weights take: one `.npy` matrix, or Green
+//! coordinates' two arrays in a `.npz`; checked before any work, and applied when
+//! `pmvc deform --weights` reads a file.
+
+use super::commands::BoundInput;
+use super::BindArgs;
+use crate::coords::family::ColumnLayout;
+use crate::coords::npy::read_npy;
+use crate::coords::npz::read_npz;
+use crate::coords::{Method, Weights};
+use anyhow::{bail, Result};
+
+/// Whether `method`'s weights are written as two arrays in a `.npz` (φ and ψ)
+/// rather than one `.npy`.
+pub(super) fn writes_npz(method: Method) -> bool {
+    method.spec().columns == ColumnLayout::CageVerticesThenTriangles
+}
+
+/// The output's extension decides its format, so one that does not fit the
+/// family is an error before any work.
+pub(super) fn check_weights_format(args: &BindArgs) -> Result<()> {
+    let extension = args
+        .out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let method = args.method.method;
+    match (writes_npz(method), extension.as_deref()) {
+        (true, Some("npy")) => bail!(
+            "{}: {} coordinates are two arrays (phi: mesh vertices × cage vertices, psi: mesh vertices × cage triangles) and are written as .npz; use --out {}",
+            args.out.display(),
+            method.name(),
+            args.out.with_extension("npz").display()
+        ),
+        (false, Some("npz")) => bail!(
+            "{}: {} weights are one array, written as .npy; use --out {} (only Green coordinates, --method green, are written as .npz)",
+            args.out.display(),
+            method.name(),
+            args.out.with_extension("npy").display()
+        ),
+        _ => Ok(()),
+    }
+}
+
+/// Weights from a file and the family they apply as: a `.npz` holds Green
+/// coordinates (φ and ψ), a `.npy` one weight per cage vertex, whatever `--method`
+/// says, except that Green coordinates cannot come from a `.npy`.
+pub(super) fn read_weights_for(
+    path: &std::path::Path,
+    input: &BoundInput,
+    asked: Method,
+) -> Result<(Weights, Method)> {
+    let rows = input.mesh.mesh.positions.len();
+    let (vertices, triangles) = (input.cage.vertex_count(), input.cage.triangle_count());
+    let is_npz = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
+    if is_npz {
+        let (weights, phi_columns) = read_npz(path)?;
+        let psi_columns = weights.cols - phi_columns;
+        if (weights.rows, phi_columns, psi_columns) != (rows, vertices, triangles) {
+            bail!(
+                "{}: phi has shape ({}, {phi_columns}) and psi ({}, {psi_columns}), but the mesh has {rows} vertices and the cage {vertices} vertices and {triangles} triangles",
+                path.display(),
+                weights.rows,
+                weights.rows
+            );
+        }
+        return Ok((weights, Method::Green));
+    }
+    if writes_npz(asked) {
+        bail!(
+            "{}: {} coordinates are read from a .npz with arrays phi and psi (what `pmvc bind --method {}` writes), not from a .npy",
+            path.display(),
+            asked.name(),
+            asked.id()
+        );
+    }
+    let weights = read_npy(path)?;
+    if (weights.rows, weights.cols) != (rows, vertices) {
+        bail!(
+            "{}: weights have shape ({}, {}), but the mesh has {rows} vertices and the cage {vertices}",
+            path.display(),
+            weights.rows,
+            weights.cols
+        );
+    }
+    Ok((weights, asked))
+}

@@ -1,0 +1,88 @@
+//! Green coordinates in the editor: bound on demand like the other families, the
+//! vertex shader's blend of their face columns keeping a similarity of the cage a
+//! similarity of the mesh, ψ of a chosen triangle as a heatmap, and the negativity
+//! view over φ only (ψ is not a weight of a cage vertex).
+
+mod common;
+
+use common::editor::*;
+use glam::{DMat3, DVec3};
+use pmvc::app::compare::{Overlay, Pane};
+use pmvc::coords::Method;
+use pmvc::render::Colouring;
+
+#[test]
+fn green_binds_follows_a_similarity_and_shows_psi_and_phi_negativity() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_active_method(Method::Green);
+    run_until_bound(&mut harness);
+    let app = harness.state();
+    let cage = app.document().cage().clone();
+    let (vertices, triangles) = (cage.vertex_count(), cage.triangle_count());
+    let weights = app
+        .document()
+        .weights(Method::Green)
+        .expect("bound")
+        .clone();
+    assert_eq!(weights.cols, vertices + triangles);
+    let quality = app.document().bound(Method::Green).unwrap().quality;
+    assert!(quality.max_partition_error < 1e-5, "{quality:?}");
+    assert!(quality.max_linear_precision_error < 1e-5, "{quality:?}");
+
+    // A rotation and uniform scale of the whole cage, loaded as a pose: the drawn
+    // mesh is the rest mesh under the same map (to f32 blending).
+    let rotation = DMat3::from_axis_angle(DVec3::new(0.3, 1.0, 0.2).normalize(), 0.6);
+    let centre = cage.positions().iter().sum::<DVec3>() / vertices as f64;
+    let moved = |p: DVec3| centre + 1.5 * (rotation * (p - centre)) + DVec3::X * 0.4;
+    let pose: Vec<DVec3> = cage.positions().iter().map(|&p| moved(p)).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let pose_path = common::write(
+        dir.path(),
+        "pose.obj",
+        &common::triangles_obj(&pose, cage.triangles()),
+    );
+    assert!(harness.state_mut().load_pose(&pose_path));
+    harness.run_steps(2);
+    let app = harness.state();
+    let drawn = app.read_back_deformed().unwrap().unwrap();
+    let rest = rest_positions(app);
+    let expected: Vec<glam::Vec3> = rest.iter().map(|p| moved(p.as_dvec3()).as_vec3()).collect();
+    let worst = max_distance(&drawn, &expected);
+    assert!(
+        worst < 2e-4 * cage.diagonal() as f32,
+        "worst {worst} of diagonal {}",
+        cage.diagonal()
+    );
+
+    // ψ of triangle 5 as a heatmap: the drawn values are that column, signed.
+    harness.state_mut().view_mut().overlay = Overlay::Heatmap;
+    harness.state_mut().view_mut().heat_triangle = Some(5);
+    harness.run_steps(2);
+    let shading = harness.state_mut().shading_of(Pane::Method(Method::Green));
+    assert_eq!(shading.colouring, Colouring::TriangleWeight(5));
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    let column: Vec<f32> = (0..weights.rows)
+        .map(|r| weights.row(r)[vertices + 5])
+        .collect();
+    for (drawn, stored) in read.values.iter().zip(&column) {
+        assert!((drawn - stored).abs() < 1e-6, "{drawn} vs {stored}");
+    }
+    let largest = column.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    assert_eq!(shading.colour_limit, largest);
+    // MVC has no ψ: its pane shows the mesh shaded, with no value.
+    let shading = harness.state_mut().shading_of(Pane::Method(Method::Mvc));
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    assert!(read.values.iter().all(|&v| v == 0.0));
+
+    // The negativity view takes each row's smallest φ, never a ψ.
+    harness.state_mut().view_mut().overlay = Overlay::Negativity;
+    harness.run_steps(2);
+    let shading = harness.state_mut().shading_of(Pane::Method(Method::Green));
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    for (row, drawn) in read.values.iter().enumerate() {
+        let phi = &weights.row(row)[..vertices];
+        let phi_min = phi.iter().copied().fold(f32::INFINITY, f32::min);
+        assert_eq!(*drawn, phi_min, "row {row}");
+    }
+}
