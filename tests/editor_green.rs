@@ -86,3 +86,30 @@ fn green_binds_follows_a_similarity_and_shows_psi_and_phi_negativity() {
         assert_eq!(*drawn, phi_min, "row {row}");
     }
 }
+
+/// `--heatmap-triangle` beyond the cage's triangles is an error (a scripted run
+/// then exits non-zero), and the view falls back to a triangle that exists.
+#[test]
+fn a_triangle_out_of_range_is_reported_and_clamped() {
+    use pmvc::app::compare::ViewSettings;
+    use pmvc::app::EditorOptions;
+    let Some(harness) = editor_with(EditorOptions {
+        view: ViewSettings {
+            overlay: Overlay::Heatmap,
+            heat_triangle: Some(100_000),
+            ..Default::default()
+        },
+        ..Default::default()
+    }) else {
+        return;
+    };
+    let app = harness.state();
+    let triangles = app.document().cage().triangle_count();
+    let error = app.last_error().expect("an error");
+    assert!(
+        error.contains("--heatmap-triangle 100000")
+            && error.contains(&format!("{triangles} triangles")),
+        "{error}"
+    );
+    assert_eq!(app.view().heat_triangle, Some(triangles - 1));
+}

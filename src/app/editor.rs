@@ -202,6 +202,14 @@ impl EditorApp {
                 app.view.heat_vertex
             ));
         }
+        let cage_triangles = app.document.cage().triangle_count();
+        if let Some(asked) = options.view.heat_triangle.filter(|&t| t >= cage_triangles) {
+            app.error(format!(
+                "--heatmap-triangle {asked}: the cage has {cage_triangles} triangles (0 to {}); showing triangle {}",
+                cage_triangles.saturating_sub(1),
+                app.view.heat_triangle.unwrap_or(0)
+            ));
+        }
         // Opening the files asked for is where editing starts, not an undo step.
         app.scene_history.clear();
         // A session opened above has started its binds; starting again would

@@ -12,6 +12,13 @@ fn colour32([r, g, b]: [f32; 3]) -> Color32 {
     Color32::from_rgb(byte(r), byte(g), byte(b))
 }
 
+/// A line above a colour bar; `grey_swatch` when it starts with what the grey
+/// vertices mean.
+pub struct BarNote {
+    pub text: String,
+    pub grey_swatch: bool,
+}
+
 /// A horizontal colour bar at the bottom of `rect`: the map from −limit to +limit
 /// (0 to +limit for distances), with the values' min and max marked.
 pub fn draw_colour_bar(
@@ -20,7 +27,7 @@ pub fn draw_colour_bar(
     shading: &Shading,
     range: ValueRange,
     title: String,
-    note: Option<String>,
+    note: Option<BarNote>,
 ) {
     let signed = shading.colouring != Colouring::MethodDistance;
     let limit = shading.colour_limit;
@@ -85,14 +92,12 @@ pub fn draw_colour_bar(
             bar.left_top() - egui::vec2(0.0, 36.0),
             egui::vec2(12.0, 12.0),
         );
-        painter.rect_filled(swatch, 2.0, colour32(colormap::OUTSIDE));
-        painter.text(
-            swatch.right_center() + egui::vec2(6.0, 0.0),
-            egui::Align2::LEFT_CENTER,
-            note,
-            font.clone(),
-            text,
-        );
+        let mut at = swatch.left_center();
+        if note.grey_swatch {
+            painter.rect_filled(swatch, 2.0, colour32(colormap::OUTSIDE));
+            at = swatch.right_center() + egui::vec2(6.0, 0.0);
+        }
+        painter.text(at, egui::Align2::LEFT_CENTER, note.text, font.clone(), text);
     }
     // Distances read as a share of the cage diagonal; the log scale's left end
     // is where it stops resolving, not zero.

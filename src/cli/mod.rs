@@ -212,6 +212,10 @@ pub struct EditArgs {
     /// Colour the mesh by the coordinate function of this cage vertex (0-based).
     #[arg(long, value_name = "CAGE_VERTEX", conflicts_with = "negativity")]
     pub heatmap: Option<usize>,
+    /// Colour the mesh by Green coordinates' ψ of this cage triangle (0-based, in
+    /// the order the cage's faces are triangulated); other families show shaded.
+    #[arg(long, value_name = "CAGE_TRIANGLE", conflicts_with_all = ["negativity", "heatmap"])]
+    pub heatmap_triangle: Option<usize>,
     /// Colour the mesh by each vertex's most negative weight.
     #[arg(long)]
     pub negativity: bool,
@@ -295,6 +299,10 @@ impl EditArgs {
         if let Some(vertex) = self.heatmap {
             view.overlay = Overlay::Heatmap;
             view.heat_vertex = vertex;
+        }
+        if let Some(triangle) = self.heatmap_triangle {
+            view.overlay = Overlay::Heatmap;
+            view.heat_triangle = Some(triangle);
         }
         if self.negativity {
             view.overlay = Overlay::Negativity;

@@ -10,7 +10,7 @@ pub use modal::TransformKind;
 
 use super::compare::{HoverReadout, Pane};
 use super::editor::EditorApp;
-use super::widgets::draw_colour_bar;
+use super::widgets::{draw_colour_bar, BarNote};
 use crate::coords::Method;
 use crate::render::{
     Colouring, FrameParams, OrbitCamera, ScreenProjection, ViewportCallback, MAX_VIEWS,
@@ -303,16 +303,15 @@ impl EditorApp {
     }
 
     /// What the colour bar must also say: in the negativity view, that a family
-    /// is not positive by design and how many vertices are outside the cage (grey,
+    /// does not promise positive weights and how many vertices are outside the cage (grey,
     /// and why); for ψ, that it is signed or missing.
-    fn colour_bar_note(&self, colouring: Colouring, kind: Pane) -> Option<String> {
+    fn colour_bar_note(&self, colouring: Colouring, kind: Pane) -> Option<BarNote> {
         let outside = self.document.outside().len();
         let method = kind.method();
         let mut notes = Vec::new();
-        if colouring == Colouring::MostNegativeWeight && !method.spec().positive_inside {
-            notes.push(format!("{method} weights are not positive by design"));
-        }
-        if colouring == Colouring::MostNegativeWeight && outside > 0 {
+        // The grey swatch goes with the first line, so the outside count leads.
+        let grey_swatch = colouring == Colouring::MostNegativeWeight && outside > 0;
+        if grey_swatch {
             let policy = if method == Method::Green {
                 "exterior extension"
             } else {
@@ -321,6 +320,9 @@ impl EditorApp {
             notes.push(format!(
                 "{outside} outside the cage ({policy} by policy), not counted"
             ));
+        }
+        if colouring == Colouring::MostNegativeWeight && !method.spec().positive_inside {
+            notes.push(format!("{method} does not promise positive weights"));
         }
         if let Colouring::TriangleWeight(_) = colouring {
             let has_triangle_columns =
@@ -331,7 +333,10 @@ impl EditorApp {
                 format!("{method} has no ψ: shaded")
             });
         }
-        (!notes.is_empty()).then(|| notes.join("; "))
+        (!notes.is_empty()).then(|| BarNote {
+            text: notes.join("; "),
+            grey_swatch,
+        })
     }
 
     fn colour_bar_title(&self, kind: Pane) -> String {
