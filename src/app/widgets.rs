@@ -32,11 +32,37 @@ pub fn draw_colour_bar(
     let signed = shading.colouring != Colouring::MethodDistance;
     let limit = shading.colour_limit;
     let low = if signed { -limit } else { 0.0 };
+    let font = egui::FontId::proportional(12.0);
+    let text = Color32::from_gray(235);
+    // Distances read as a share of the cage diagonal; the log scale's left end
+    // is where it stops resolving, not zero.
+    let number = |value: f32| if signed { short(value) } else { percent(value) };
+    let left = match (signed, shading.scale) {
+        (_, Scale::Linear) => number(low),
+        (true, Scale::LogMagnitude) => format!("−{}", short(limit)),
+        (false, Scale::LogMagnitude) => {
+            format!("≤ {}", number(limit * 10f32.powf(-colormap::LOG_DECADES)))
+        }
+    };
+    let middle = format!("min {} · max {}", number(range.min), number(range.max));
+    let width_of = |label: &str| {
+        painter
+            .layout_no_wrap(label.to_owned(), font.clone(), text)
+            .size()
+            .x
+    };
+    let bar_width = (rect.width() - 32.0).clamp(60.0, 320.0);
+    // In a narrow view the min/max line gets a row of its own rather than
+    // running into the end labels.
+    let end_width = width_of(&left).max(width_of(&number(limit)));
+    let own_row = width_of(&middle) / 2.0 + end_width + 6.0 > bar_width / 2.0;
+    let raise = if own_row { 15.0 } else { 0.0 };
     let bar = Rect::from_min_size(
-        Pos2::new(rect.left() + 16.0, rect.bottom() - 42.0),
-        egui::vec2((rect.width() - 32.0).clamp(60.0, 320.0), 14.0),
+        Pos2::new(rect.left() + 16.0, rect.bottom() - 42.0 - raise),
+        egui::vec2(bar_width, 14.0),
     );
     let mut backdrop = bar.expand2(egui::vec2(8.0, 22.0));
+    backdrop.max.y += raise;
     if note.is_some() {
         backdrop.min.y -= 18.0;
     }
@@ -73,8 +99,6 @@ pub fn draw_colour_bar(
             Stroke::new(2.0, Color32::BLACK),
         );
     }
-    let font = egui::FontId::proportional(12.0);
-    let text = Color32::from_gray(235);
     let log = if shading.scale == Scale::LogMagnitude {
         format!(" · log scale, {} decades", colormap::LOG_DECADES)
     } else {
@@ -99,20 +123,10 @@ pub fn draw_colour_bar(
         }
         painter.text(at, egui::Align2::LEFT_CENTER, note.text, font.clone(), text);
     }
-    // Distances read as a share of the cage diagonal; the log scale's left end
-    // is where it stops resolving, not zero.
-    let number = |value: f32| if signed { short(value) } else { percent(value) };
-    let left = match (signed, shading.scale) {
-        (_, Scale::Linear) => number(low),
-        (true, Scale::LogMagnitude) => format!("−{}", short(limit)),
-        (false, Scale::LogMagnitude) => {
-            format!("≤ {}", number(limit * 10f32.powf(-colormap::LOG_DECADES)))
-        }
-    };
     painter.text(
-        bar.center_bottom() + egui::vec2(0.0, 2.0),
+        bar.center_bottom() + egui::vec2(0.0, 2.0 + raise),
         egui::Align2::CENTER_TOP,
-        format!("min {} · max {}", number(range.min), number(range.max)),
+        middle,
         font.clone(),
         text,
     );
