@@ -12,8 +12,8 @@
 
 #import bind_params
 #import bind_constants
+#import angles
 
-const PI: f32 = 3.14159265358979;
 // Below this |sin| of a spherical angle the 0/0 cancellation (error about 1e-8/|sin|
 // in a coordinate) could exceed the accuracy budget. Measured: 1e-3 sent 26% of the
 // comb's points to the CPU, 1e-4 sends 2% with max |Δ| 3e-6; 1e-5 gives max |Δ| 1e-5.
@@ -25,30 +25,6 @@ const MIN_SINE: f32 = 1e-4;
 @group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> weights: array<f32>;
 @group(0) @binding(7) var<storage, read_write> status: array<u32>;
-
-// atan on [-1, 1] to about 1 ulp (Cephes atanf).
-fn atan_unit(x: f32) -> f32 {
-    var offset = 0.0;
-    var y = x;
-    if abs(x) > 0.41421356 {
-        offset = sign(x) * (0.25 * PI);
-        y = (abs(x) - 1.0) / (abs(x) + 1.0) * sign(x);
-    }
-    let z = y * y;
-    return offset + ((((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z
-        - 3.33329491539e-1) * z * y + y);
-}
-
-// The angle in [0, π] with this sine (≥ 0) and cosine.
-fn angle(sine: f32, cosine: f32) -> f32 {
-    if sine <= cosine {
-        return atan_unit(sine / cosine);
-    }
-    if sine <= -cosine {
-        return PI - atan_unit(sine / -cosine);
-    }
-    return 0.5 * PI - atan_unit(cosine / sine);
-}
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -445,3 +445,53 @@ fn the_adapters_report_names_the_choice_and_the_limits() {
         None => assert!(report.contains("chosen: none"), "{report}"),
     }
 }
+
+/// Green coordinates on the GPU: every φ and ψ within 1e-5 of the CPU's f64 values,
+/// on a convex and two non-convex cages, for points inside (some 1e-4 of the
+/// diagonal from the surface), on the surface and outside. Rows the kernel cannot
+/// trust are redone on the CPU; most inside rows must stay on the GPU, or the
+/// agreement would say nothing about the kernel.
+#[test]
+fn green_coordinates_agree_with_the_cpu_to_1e_5() {
+    let Some(context) = test_context("green") else {
+        return;
+    };
+    for (name, cage) in [("cube", cube_cage(1.0)), ("comb", comb()), ("star", star())] {
+        let mut points = mixed_points(&cage, 600, 6);
+        points.extend(points_inside(&cage, 400, 7, 1e-4));
+        let input = input(&cage, points, Method::Green);
+        let expected = cpu(&input);
+        let output = Binder::new(Backend::Gpu(Arc::clone(&context)))
+            .bind_blocking(&input, &BindProgress::default())
+            .expect("GPU bind");
+        let actual = output.weights.expect("CPU weights requested");
+        assert_eq!(actual.cols, cage.vertex_count() + cage.triangle_count());
+        let worst = actual
+            .values
+            .iter()
+            .zip(&expected.values)
+            .map(|(&g, &c)| {
+                let delta = (f64::from(g) - f64::from(c)).abs();
+                if delta.is_nan() {
+                    f64::INFINITY
+                } else {
+                    delta
+                }
+            })
+            .fold(0.0, f64::max);
+        let inside = input
+            .classes
+            .iter()
+            .filter(|class| matches!(class, PointClass::Inside))
+            .count();
+        let flagged = output.stats.cpu_rows - (input.points.len() - inside);
+        eprintln!(
+            "  green {name}: max |Δ| = {worst:.2e}; {flagged} of {inside} inside rows redone on the CPU"
+        );
+        assert!(worst <= 1e-5, "green {name}: max |Δ| = {worst:e}");
+        assert!(
+            flagged * 20 <= inside,
+            "green {name}: {flagged} of {inside} inside rows flagged"
+        );
+    }
+}

@@ -11,6 +11,7 @@ use crate::coords::Method;
 pub enum Kernel {
     Mvc,
     Pmvc,
+    Green,
 }
 
 impl Kernel {
@@ -18,6 +19,7 @@ impl Kernel {
         match method {
             Method::Mvc => Some(Kernel::Mvc),
             Method::Pmvc => Some(Kernel::Pmvc),
+            Method::Green => Some(Kernel::Green),
             _ => None,
         }
     }
@@ -25,14 +27,16 @@ impl Kernel {
 
 const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
 const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");
+const GREEN_SOURCE: &str = include_str!("../../shaders/bind_green.wgsl");
 
 /// The binding kernels' WGSL with imports resolved, by file name.
-pub fn kernel_sources() -> [(&'static str, String); 2] {
+pub fn kernel_sources() -> [(&'static str, String); 3] {
     // The shared files are compiled in, so only a broken build can fail here.
     let composed = |name, source| compose(name, source).unwrap_or_else(|error| panic!("{error}"));
     [
         ("bind_pmvc.wgsl", composed("bind_pmvc.wgsl", PMVC_SOURCE)),
         ("bind_mvc.wgsl", composed("bind_mvc.wgsl", MVC_SOURCE)),
+        ("bind_green.wgsl", composed("bind_green.wgsl", GREEN_SOURCE)),
     ]
 }
 
@@ -63,6 +67,7 @@ pub(crate) struct Kernels {
     pub layout: wgpu::BindGroupLayout,
     pub pmvc: wgpu::ComputePipeline,
     pub mvc: wgpu::ComputePipeline,
+    pub green: wgpu::ComputePipeline,
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -109,7 +114,7 @@ impl Kernels {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let [(_, pmvc_source), (_, mvc_source)] = kernel_sources();
+        let [(_, pmvc_source), (_, mvc_source), (_, green_source)] = kernel_sources();
         let pipeline = |label: &str, source: String| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(label),
@@ -126,12 +131,18 @@ impl Kernels {
         };
         let pmvc = pipeline("bind_pmvc", pmvc_source);
         let mvc = pipeline("bind_mvc", mvc_source);
+        let green = pipeline("bind_green", green_source);
         if let Some(error) = pollster::block_on(memory.pop()) {
             return Err(error.into());
         }
         if let Some(error) = pollster::block_on(validation.pop()) {
             return Err(error.into());
         }
-        Ok(Self { layout, pmvc, mvc })
+        Ok(Self {
+            layout,
+            pmvc,
+            mvc,
+            green,
+        })
     }
 }

@@ -17,7 +17,7 @@ enum Shared {
 }
 
 /// Every importable name and its text.
-const SHARED: [(&str, Shared); 4] = [
+const SHARED: [(&str, Shared); 5] = [
     (
         "frame",
         Shared::File(include_str!("../../shaders/shared/frame.wgsl")),
@@ -25,6 +25,10 @@ const SHARED: [(&str, Shared); 4] = [
     (
         "bind_params",
         Shared::File(include_str!("../../shaders/shared/bind_params.wgsl")),
+    ),
+    (
+        "angles",
+        Shared::File(include_str!("../../shaders/shared/angles.wgsl")),
     ),
     ("cube_faces", Shared::Generated(cube_faces_wgsl)),
     ("bind_constants", Shared::Generated(bind_constants_wgsl)),

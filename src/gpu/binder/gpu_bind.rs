@@ -16,7 +16,7 @@ const MAX_BATCH_BUFFER_BYTES: u64 = 64 << 20;
 /// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
 /// the same row loop as a CPU bind.
 fn cpu_rows(input: &BindInput, rows: &[usize]) -> Vec<f32> {
-    let mut out = vec![0.0f32; rows.len() * input.cage.vertex_count()];
+    let mut out = vec![0.0f32; rows.len() * input.options.method.columns(&input.cage)];
     // A batch's own progress: the bind advances once per batch.
     let batch_progress = BindProgress::default();
     let finished = coords::bind_rows(
@@ -95,7 +95,9 @@ impl<'a> GpuBind<'a> {
             return Err(failure.into());
         }
         let rows = input.points.len();
-        let cols = input.cage.vertex_count();
+        // A weights row: one column per cage vertex, then for Green coordinates
+        // one per cage triangle.
+        let cols = input.options.method.columns(&input.cage);
         let triangles = input.cage.triangle_count();
         let method = input.options.method;
         let kernel = Kernel::of(method).ok_or(BindError::NoGpuKernel { method })?;
@@ -304,7 +306,7 @@ impl<'a> GpuBind<'a> {
                 let triangles = self.input.cage.triangle_count().max(1);
                 match self.kernel {
                     Kernel::Pmvc => 2048 / triangles,
-                    Kernel::Mvc => 65536 / triangles,
+                    Kernel::Mvc | Kernel::Green => 65536 / triangles,
                 }
             }
         }
@@ -431,6 +433,10 @@ impl<'a> GpuBind<'a> {
                         }
                         Kernel::Mvc => {
                             pass.set_pipeline(&kernels.mvc);
+                            (inside.len() as u32).div_ceil(WORKGROUP_SIZE)
+                        }
+                        Kernel::Green => {
+                            pass.set_pipeline(&kernels.green);
                             (inside.len() as u32).div_ceil(WORKGROUP_SIZE)
                         }
                     };

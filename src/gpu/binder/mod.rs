@@ -10,7 +10,8 @@
 //! The GPU computes the rows of `Inside` points. The CPU (f64, [`coords::weights_at`])
 //! fills the rows of points on the surface or outside, and redoes the rows the
 //! kernels flag: PMVC points whose rays escape, MVC points too close to a cage
-//! vertex, triangle or triangle plane for f32.
+//! vertex, triangle or triangle plane for f32, Green rows that miss their
+//! identities (Σφ = 1, the rest pose) by more than f32 rounding.
 
 mod gpu_bind;
 
