@@ -13,18 +13,12 @@
 #import bind_params
 #import bind_constants
 #import angles
+#import closed_form_bindings
 
 // How far the identities may miss, relative to the point's distance to the
 // farthest cage vertex (Σφ is dimensionless). Measured on the test cages: rows
 // that pass agree with the CPU to about 1e-6; see docs/gpu-binding.md.
 const IDENTITY_TOLERANCE: f32 = 4e-6;
-
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> cage_positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> topology: array<u32>;
-@group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read_write> weights: array<f32>;
-@group(0) @binding(7) var<storage, read_write> status: array<u32>;
 
 // ∫ 1/r ds along the edge from a to b (relative to the point): ln of
 // (ra + rb + ℓ) / (ra + rb − ℓ), the denominator rewritten without cancellation

@@ -13,18 +13,12 @@
 #import bind_params
 #import bind_constants
 #import angles
+#import closed_form_bindings
 
 // Below this |sin| of a spherical angle the 0/0 cancellation (error about 1e-8/|sin|
 // in a coordinate) could exceed the accuracy budget. Measured: 1e-3 sent 26% of the
 // comb's points to the CPU, 1e-4 sends 2% with max |Δ| 3e-6; 1e-5 gives max |Δ| 1e-5.
 const MIN_SINE: f32 = 1e-4;
-
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> cage_positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> topology: array<u32>;
-@group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read_write> weights: array<f32>;
-@group(0) @binding(7) var<storage, read_write> status: array<u32>;
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -17,7 +17,7 @@ enum Shared {
 }
 
 /// Every importable name and its text.
-const SHARED: [(&str, Shared); 5] = [
+const SHARED: [(&str, Shared); 6] = [
     (
         "frame",
         Shared::File(include_str!("../../shaders/shared/frame.wgsl")),
@@ -29,6 +29,12 @@ const SHARED: [(&str, Shared); 5] = [
     (
         "angles",
         Shared::File(include_str!("../../shaders/shared/angles.wgsl")),
+    ),
+    (
+        "closed_form_bindings",
+        Shared::File(include_str!(
+            "../../shaders/shared/closed_form_bindings.wgsl"
+        )),
     ),
     ("cube_faces", Shared::Generated(cube_faces_wgsl)),
     ("bind_constants", Shared::Generated(bind_constants_wgsl)),
