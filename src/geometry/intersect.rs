@@ -66,7 +66,7 @@ pub fn find_crossing(
 
 /// Whether two triangles of the mesh cross: an edge of one passes through the
 /// other's interior, or, sharing an edge, one is folded flat onto the other.
-fn triangles_cross(
+pub(crate) fn triangles_cross(
     first: [u32; 3],
     second: [u32; 3],
     positions: &[DVec3],

@@ -3,6 +3,7 @@
 //! Vertex order is always the file's order: row *i* of any weights matrix is the
 //! *i*-th `v` line of the mesh file, column *j* the *j*-th `v` line of the cage file.
 
+pub mod autocage;
 mod cage;
 mod classify;
 mod error;

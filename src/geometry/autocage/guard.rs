@@ -1,0 +1,104 @@
+//! Spatial hashing of the simplified surface's triangles and vertices, for the
+//! checks that keep a collapse from making the cage cross itself or swallow
+//! another of its parts.
+
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Items (triangle or vertex indices) filed under every cell their box touches.
+/// Entries go stale as the surface changes; callers check what they get back.
+pub(super) struct SpatialHash {
+    cell: f64,
+    cells: HashMap<[i32; 3], Vec<u32>>,
+}
+
+impl SpatialHash {
+    pub(super) fn new(cell: f64) -> SpatialHash {
+        SpatialHash {
+            cell,
+            cells: HashMap::new(),
+        }
+    }
+
+    pub(super) fn cell_size(&self) -> f64 {
+        self.cell
+    }
+
+    fn key(&self, p: DVec3) -> [i32; 3] {
+        (p / self.cell).floor().as_ivec3().to_array()
+    }
+
+    pub(super) fn insert(&mut self, item: u32, lo: DVec3, hi: DVec3) {
+        let (a, b) = (self.key(lo), self.key(hi));
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    self.cells.entry([x, y, z]).or_default().push(item);
+                }
+            }
+        }
+    }
+
+    /// Every item filed in a cell that the box touches, each once (using
+    /// `seen`, a per-item stamp array, and `stamp`, a value not used before).
+    pub(super) fn query(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        seen: &mut [u32],
+        stamp: u32,
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        let (a, b) = (self.key(lo), self.key(hi));
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    if let Some(items) = self.cells.get(&[x, y, z]) {
+                        for &item in items {
+                            if seen[item as usize] != stamp {
+                                seen[item as usize] = stamp;
+                                out.push(item);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Six times the signed volume of the tetrahedron (a, b, c, d).
+pub(super) fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    (b - a).cross(c - a).dot(d - a)
+}
+
+/// Whether `p` lies strictly inside the tetrahedron (apex, a, b, c), with
+/// `tolerance` on the six-fold volumes.
+pub(super) fn inside_tetrahedron(
+    p: DVec3,
+    apex: DVec3,
+    [a, b, c]: [DVec3; 3],
+    tolerance: f64,
+) -> bool {
+    let total = orient(apex, a, b, c);
+    if total.abs() <= tolerance {
+        return false;
+    }
+    let sign = total.signum();
+    [
+        orient(p, a, b, c),
+        orient(apex, p, b, c),
+        orient(apex, a, p, c),
+        orient(apex, a, b, p),
+    ]
+    .iter()
+    .all(|&v| v * sign > tolerance)
+}
+
+/// Smallest interior angle of a triangle, in radians.
+pub(super) fn min_angle([a, b, c]: [DVec3; 3]) -> f64 {
+    let angle = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p);
+    let (x, y) = (angle(a, b, c), angle(b, c, a));
+    x.min(y).min(std::f64::consts::PI - x - y)
+}

@@ -1,0 +1,478 @@
+//! Outward-only simplification (progressive hulls, Sander et al. 2000): edge
+//! collapses in order of quadric error (Garland and Heckbert 1997), where the
+//! new vertex must lie on or outside the plane of every face around the edge.
+//! Each new surface then encloses the one before, and so the voxels and the
+//! mesh. A collapse is refused when it would break the surface's link
+//! condition, flip or squash a face, make two faces cross, or sweep over
+//! another part of the surface.
+
+use super::guard::SpatialHash;
+use super::voxels::Envelope;
+use glam::{DMat3, DVec3};
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Plane quadric: vᵀAv + 2bᵀv + c, stored as A (symmetric), b and c.
+#[derive(Clone, Copy, Default)]
+struct Quadric {
+    a: DMat3,
+    b: DVec3,
+    c: f64,
+}
+
+impl Quadric {
+    fn plane(normal: DVec3, point: DVec3, weight: f64) -> Quadric {
+        let d = -normal.dot(point);
+        Quadric {
+            a: DMat3::from_cols(normal * normal.x, normal * normal.y, normal * normal.z) * weight,
+            b: normal * (d * weight),
+            c: d * d * weight,
+        }
+    }
+
+    fn add(self, other: Quadric) -> Quadric {
+        Quadric {
+            a: self.a + other.a,
+            b: self.b + other.b,
+            c: self.c + other.c,
+        }
+    }
+
+    fn error(&self, v: DVec3) -> f64 {
+        (v.dot(self.a * v) + 2.0 * self.b.dot(v) + self.c).max(0.0)
+    }
+
+    /// The point of least error, when the quadric pins one down.
+    fn optimum(&self) -> Option<DVec3> {
+        let scale = (self.a.x_axis.x + self.a.y_axis.y + self.a.z_axis.z) / 3.0;
+        let det = self.a.determinant();
+        (scale > 0.0 && det.abs() > 1e-6 * scale.powi(3)).then(|| -(self.a.inverse() * self.b))
+    }
+}
+
+#[derive(PartialEq)]
+struct Candidate {
+    cost: f64,
+    a: u32,
+    b: u32,
+    versions: (u32, u32),
+}
+
+impl Eq for Candidate {}
+
+impl Ord for Candidate {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // Least cost first in a max-heap; ties broken by vertex ids.
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then_with(|| (other.a, other.b).cmp(&(self.a, self.b)))
+    }
+}
+
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+pub(super) struct Simplified {
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+pub(super) struct State {
+    pub(super) positions: Vec<DVec3>,
+    pub(super) triangles: Vec<[u32; 3]>,
+    pub(super) triangle_alive: Vec<bool>,
+    pub(super) vertex_triangles: Vec<Vec<u32>>,
+    pub(super) vertex_alive: Vec<bool>,
+    quadrics: Vec<Quadric>,
+    pub(super) versions: Vec<u32>,
+    pub(super) alive_vertices: usize,
+    pub(super) alive_triangles: usize,
+    pub(super) triangle_hash: SpatialHash,
+    pub(super) vertex_hash: SpatialHash,
+    pub(super) triangles_at_rebuild: usize,
+    pub(super) seen_triangles: Vec<u32>,
+    pub(super) seen_vertices: Vec<u32>,
+    /// Points of the mesh (vertices and face centres) that must stay inside.
+    pub(super) mesh_points: Vec<DVec3>,
+    pub(super) mesh_hash: SpatialHash,
+    pub(super) seen_mesh_points: Vec<u32>,
+    pub(super) stamp: u32,
+    pub(super) tolerance: f64,
+    pub(super) volume_tolerance: f64,
+}
+
+/// What the simplification aims for and may not go past.
+pub(super) struct Goal {
+    pub target_vertices: usize,
+    /// The envelope's limit grows up to this many cells when stuck.
+    pub max_limit: u16,
+    /// Least distance from the mesh that tightening keeps.
+    pub clearance: f64,
+    pub diagonal: f64,
+}
+
+/// Collapse edges of the closed surface until it has the goal's vertices or no
+/// collapse is allowed, then tighten it. Returns `None` when `progress` asks
+/// to stop.
+pub(super) fn simplify(
+    mesh_points: Vec<DVec3>,
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    mut envelope: Envelope,
+    goal: &Goal,
+    progress: &dyn Fn(f32) -> bool,
+) -> Option<Simplified> {
+    let mut state = State::new(positions, triangles, envelope.cell, goal.diagonal);
+    state.set_mesh_points(mesh_points);
+    let start = state.alive_vertices;
+    let mut heap = state.all_candidates(&envelope);
+    let mut steps = 0usize;
+    let target = goal.target_vertices;
+    while state.alive_vertices > target {
+        let Some(entry) = heap.pop() else {
+            // Stuck: let the cage move further from the mesh, and go on.
+            if envelope.limit >= goal.max_limit {
+                break;
+            }
+            envelope.limit = (envelope.limit + 1 + envelope.limit / 4).min(goal.max_limit);
+            heap = state.all_candidates(&envelope);
+            continue;
+        };
+        let (a, b) = (entry.a as usize, entry.b as usize);
+        if !state.vertex_alive[a]
+            || !state.vertex_alive[b]
+            || entry.versions != (state.versions[a], state.versions[b])
+        {
+            continue;
+        }
+        // Faces nearby may have changed since this entry was made.
+        let Some(fresh) = state.candidate(entry.a, entry.b) else {
+            continue;
+        };
+        if fresh.cost > entry.cost * (1.0 + 1e-9) + 1e-300 {
+            heap.push(fresh);
+            continue;
+        }
+        let positions = state.positions(a, b);
+        if !positions
+            .iter()
+            .any(|&(_, p)| state.collapse(a, b, p, &envelope))
+        {
+            continue;
+        }
+        for n in state.neighbours(a) {
+            let (i, j) = (a.min(n) as u32, a.max(n) as u32);
+            if let Some(candidate) = state.candidate(i, j) {
+                heap.push(candidate);
+            }
+        }
+        steps += 1;
+        if steps.is_multiple_of(512) {
+            let done = (start - state.alive_vertices) as f32 / (start - target).max(1) as f32;
+            if !progress(0.9 * done.min(1.0)) {
+                return None;
+            }
+        }
+    }
+    if !progress(0.9) {
+        return None;
+    }
+    state.shrink(2.0 * envelope.cell, goal.clearance);
+    Some(state.finish())
+}
+
+impl State {
+    fn all_candidates(&self, envelope: &Envelope) -> BinaryHeap<Candidate> {
+        let _ = envelope;
+        let edges: Vec<(u32, u32)> = (0..self.triangles.len())
+            .filter(|&t| self.triangle_alive[t])
+            .flat_map(|t| {
+                let t = self.triangles[t];
+                [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
+            })
+            .filter(|(i, j)| i < j)
+            .collect();
+        edges
+            .par_iter()
+            .filter_map(|&(a, b)| self.candidate(a, b))
+            .collect::<Vec<_>>()
+            .into()
+    }
+
+    fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>, cell: f64, diagonal: f64) -> State {
+        let mut vertex_triangles = vec![Vec::new(); positions.len()];
+        let mut quadrics = vec![Quadric::default(); positions.len()];
+        for (t, tri) in triangles.iter().enumerate() {
+            let [p, q, r] = tri.map(|i| positions[i as usize]);
+            let vector = (q - p).cross(r - p);
+            let area = 0.5 * vector.length();
+            let plane = Quadric::plane(vector.normalize_or_zero(), p, area);
+            for &i in tri {
+                vertex_triangles[i as usize].push(t as u32);
+                quadrics[i as usize] = quadrics[i as usize].add(plane);
+            }
+        }
+        let count = positions.len();
+        let mut state = State {
+            triangle_alive: vec![true; triangles.len()],
+            vertex_alive: vec![true; count],
+            versions: vec![0; count],
+            alive_vertices: count,
+            alive_triangles: triangles.len(),
+            triangle_hash: SpatialHash::new(2.0 * cell),
+            vertex_hash: SpatialHash::new(2.0 * cell),
+            triangles_at_rebuild: triangles.len(),
+            seen_triangles: vec![0; triangles.len()],
+            seen_vertices: vec![0; count],
+            mesh_points: Vec::new(),
+            mesh_hash: SpatialHash::new(cell),
+            seen_mesh_points: Vec::new(),
+            stamp: 0,
+            tolerance: 1e-9 * diagonal,
+            volume_tolerance: 1e-12 * diagonal.powi(3),
+            positions,
+            triangles,
+            vertex_triangles,
+            quadrics,
+        };
+        state.rebuild_hashes(2.0 * cell);
+        state
+    }
+
+    fn set_mesh_points(&mut self, points: Vec<DVec3>) {
+        self.mesh_hash = SpatialHash::new(self.triangle_hash.cell_size());
+        for (i, p) in points.iter().enumerate() {
+            self.mesh_hash.insert(i as u32, *p, *p);
+        }
+        self.seen_mesh_points = vec![0; points.len()];
+        self.mesh_points = points;
+    }
+
+    pub(super) fn corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    pub(super) fn neighbours(&self, v: usize) -> Vec<usize> {
+        let mut out: Vec<usize> = self.vertex_triangles[v]
+            .iter()
+            .flat_map(|&t| self.triangles[t as usize])
+            .map(|i| i as usize)
+            .filter(|&i| i != v)
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Faces around a or b, each once.
+    pub(super) fn star(&self, a: usize, b: usize) -> Vec<u32> {
+        let mut star: Vec<u32> = self.vertex_triangles[a]
+            .iter()
+            .chain(&self.vertex_triangles[b])
+            .copied()
+            .collect();
+        star.sort_unstable();
+        star.dedup();
+        star
+    }
+
+    fn candidate(&self, a: u32, b: u32) -> Option<Candidate> {
+        let (cost, _) = *self.positions(a as usize, b as usize).first()?;
+        Some(Candidate {
+            cost,
+            a,
+            b,
+            versions: (self.versions[a as usize], self.versions[b as usize]),
+        })
+    }
+
+    /// Where the merged vertex may go, best first: the quadric's optimum (when
+    /// it is near the edge), points along the edge and its two ends, each
+    /// pushed out along the star's mean normal until it is on or outside every
+    /// face plane, ordered by error.
+    fn positions(&self, a: usize, b: usize) -> Vec<(f64, DVec3)> {
+        let star = self.star(a, b);
+        let planes: Vec<(DVec3, DVec3)> = star
+            .iter()
+            .filter_map(|&t| {
+                let [p, q, r] = self.corners(t as usize);
+                let normal = (q - p).cross(r - p).try_normalize()?;
+                Some((normal, p))
+            })
+            .collect();
+        let Some(mean) = planes
+            .iter()
+            .fold(DVec3::ZERO, |sum, (n, _)| sum + *n)
+            .try_normalize()
+        else {
+            return Vec::new();
+        };
+        let quadric = self.quadrics[a].add(self.quadrics[b]);
+        let (pa, pb) = (self.positions[a], self.positions[b]);
+        let middle = (pa + pb) * 0.5;
+        let reach = pa.distance(pb);
+        let optimum = quadric.optimum().filter(|p| p.distance(middle) <= reach);
+        let along = [0.5, 0.0, 1.0, 0.25, 0.75].map(|t| Some(pa.lerp(pb, t)));
+        let mut found: Vec<(f64, DVec3)> = std::iter::once(optimum)
+            .chain(along)
+            .flatten()
+            .filter_map(|start| {
+                // Outward along `mean` by the least that satisfies every plane.
+                let mut push: f64 = 0.0;
+                for (normal, point) in &planes {
+                    let distance = normal.dot(start - *point);
+                    if distance >= 0.0 {
+                        continue;
+                    }
+                    let rate = normal.dot(mean);
+                    if rate < 1e-3 {
+                        return None;
+                    }
+                    push = push.max(-distance / rate);
+                }
+                let position = start + mean * push;
+                Some((quadric.error(position), position))
+            })
+            .collect();
+        found.sort_by(|x, y| x.0.total_cmp(&y.0));
+        found
+    }
+
+    /// Collapse edge (a, b) into `a` at `position` if every check passes.
+    fn collapse(&mut self, a: usize, b: usize, position: DVec3, envelope: &Envelope) -> bool {
+        if !self.link_condition_holds(a, b) {
+            return false;
+        }
+        let star = self.star(a, b);
+        let replaced: Vec<(u32, [u32; 3])> = star
+            .iter()
+            .filter(|&&t| {
+                let tri = self.triangles[t as usize];
+                !(tri.contains(&(a as u32)) && tri.contains(&(b as u32)))
+            })
+            .map(|&t| {
+                let tri =
+                    self.triangles[t as usize].map(|i| if i == b as u32 { a as u32 } else { i });
+                (t, tri)
+            })
+            .collect();
+        let old_corners: Vec<[DVec3; 3]> = star.iter().map(|&t| self.corners(t as usize)).collect();
+        let (old_a, old_b) = (self.positions[a], self.positions[b]);
+        self.positions[a] = position;
+        let shapes = self.shapes_are_good(&replaced, (a, b), (old_a, old_b))
+            && replaced
+                .iter()
+                .all(|(_, tri)| envelope.allows_triangle(tri.map(|i| self.positions[i as usize])));
+        let crosses = shapes && self.crosses_anything(&replaced, &star);
+        let sweeps =
+            shapes && !crosses && self.sweeps_over_vertices(a, b, position, &star, &old_corners);
+        let new_corners: Vec<[DVec3; 3]> = replaced
+            .iter()
+            .map(|(_, tri)| tri.map(|i| self.positions[i as usize]))
+            .collect();
+        let uncovers =
+            shapes && !crosses && !sweeps && self.uncovers_mesh_points(&old_corners, &new_corners);
+        let accepted = shapes && !crosses && !sweeps && !uncovers;
+        if !accepted {
+            self.positions[a] = old_a;
+            return false;
+        }
+        // Commit: remove the star, add the replacements.
+        for &t in &star {
+            self.triangle_alive[t as usize] = false;
+            self.alive_triangles -= 1;
+        }
+        let mut touched = Vec::new();
+        for &t in &star {
+            touched.extend(self.triangles[t as usize]);
+        }
+        touched.sort_unstable();
+        touched.dedup();
+        for (_, tri) in &replaced {
+            let t = self.triangles.len() as u32;
+            self.triangles.push(*tri);
+            self.triangle_alive.push(true);
+            self.seen_triangles.push(0);
+            self.alive_triangles += 1;
+            let [p, q, r] = tri.map(|i| self.positions[i as usize]);
+            self.triangle_hash
+                .insert(t, p.min(q).min(r), p.max(q).max(r));
+        }
+        for v in touched {
+            let alive = &self.triangle_alive;
+            self.vertex_triangles[v as usize].retain(|&t| alive[t as usize]);
+        }
+        let first_new = self.triangles.len() - replaced.len();
+        for t in first_new..self.triangles.len() {
+            for i in self.triangles[t] {
+                self.vertex_triangles[i as usize].push(t as u32);
+            }
+        }
+        self.vertex_alive[b] = false;
+        self.vertex_triangles[b].clear();
+        self.alive_vertices -= 1;
+        self.quadrics[a] = self.quadrics[a].add(self.quadrics[b]);
+        self.versions[a] += 1;
+        self.versions[b] += 1;
+        self.vertex_hash.insert(a as u32, position, position);
+        if self.alive_triangles * 2 < self.triangles_at_rebuild {
+            let size = self.mean_edge_length().max(self.triangle_hash.cell_size());
+            self.rebuild_hashes(size);
+        }
+        true
+    }
+
+    fn mean_edge_length(&self) -> f64 {
+        let (sum, count) = (0..self.triangles.len())
+            .filter(|&t| self.triangle_alive[t])
+            .map(|t| {
+                let [p, q, r] = self.corners(t);
+                p.distance(q).max(q.distance(r)).max(r.distance(p))
+            })
+            .fold((0.0, 0usize), |(s, c), l| (s + l, c + 1));
+        sum / count.max(1) as f64
+    }
+
+    fn rebuild_hashes(&mut self, cell: f64) {
+        self.triangle_hash = SpatialHash::new(cell);
+        self.vertex_hash = SpatialHash::new(cell);
+        for t in 0..self.triangles.len() {
+            if self.triangle_alive[t] {
+                let [p, q, r] = self.corners(t);
+                self.triangle_hash
+                    .insert(t as u32, p.min(q).min(r), p.max(q).max(r));
+            }
+        }
+        for v in 0..self.positions.len() {
+            if self.vertex_alive[v] {
+                let p = self.positions[v];
+                self.vertex_hash.insert(v as u32, p, p);
+            }
+        }
+        self.triangles_at_rebuild = self.alive_triangles;
+    }
+
+    fn finish(self) -> Simplified {
+        let mut remap = vec![u32::MAX; self.positions.len()];
+        let mut positions = Vec::with_capacity(self.alive_vertices);
+        for (v, p) in self.positions.iter().enumerate() {
+            if self.vertex_alive[v] {
+                remap[v] = positions.len() as u32;
+                positions.push(*p);
+            }
+        }
+        let triangles = (0..self.triangles.len())
+            .filter(|&t| self.triangle_alive[t])
+            .map(|t| self.triangles[t].map(|i| remap[i as usize]))
+            .collect();
+        Simplified {
+            positions,
+            triangles,
+        }
+    }
+}

@@ -1,0 +1,374 @@
+//! The inside of the mesh as voxels: the cells its surface passes through, plus
+//! the cells whose centre has a winding number above one half; then dilated by
+//! the clearance, with cavities filled and made well-composed so that the
+//! boundary of the cell set is a 2-manifold.
+
+use super::winding::TriangleTree;
+use crate::geometry::TriMesh;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::collections::VecDeque;
+
+/// A box of cells of side `cell` starting at `origin`; `inside` holds one flag
+/// per cell, x fastest.
+pub(super) struct Voxels {
+    pub origin: DVec3,
+    pub cell: f64,
+    pub dims: [usize; 3],
+    pub inside: Vec<bool>,
+}
+
+impl Voxels {
+    fn index(&self, x: usize, y: usize, z: usize) -> usize {
+        x + self.dims[0] * (y + self.dims[1] * z)
+    }
+
+    fn coordinates(&self, index: usize) -> [usize; 3] {
+        let [nx, ny, _] = self.dims;
+        [index % nx, (index / nx) % ny, index / (nx * ny)]
+    }
+
+    pub(super) fn centre(&self, index: usize) -> DVec3 {
+        let [x, y, z] = self.coordinates(index);
+        self.origin + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell
+    }
+
+    pub(super) fn count(&self) -> usize {
+        self.inside.iter().filter(|&&b| b).count()
+    }
+
+    /// The 6 face neighbours of a cell that lie in the grid.
+    fn neighbours(&self, index: usize) -> impl Iterator<Item = usize> + '_ {
+        let [x, y, z] = self.coordinates(index);
+        let [nx, ny, nz] = self.dims;
+        let steps: [(bool, isize); 6] = [
+            (x > 0, -1),
+            (x + 1 < nx, 1),
+            (y > 0, -(nx as isize)),
+            (y + 1 < ny, nx as isize),
+            (z > 0, -((nx * ny) as isize)),
+            (z + 1 < nz, (nx * ny) as isize),
+        ];
+        steps
+            .into_iter()
+            .filter(|(ok, _)| *ok)
+            .map(move |(_, step)| (index as isize + step) as usize)
+    }
+
+    fn on_border(&self, index: usize) -> bool {
+        let [x, y, z] = self.coordinates(index);
+        let [nx, ny, nz] = self.dims;
+        x == 0 || y == 0 || z == 0 || x + 1 == nx || y + 1 == ny || z + 1 == nz
+    }
+}
+
+/// Voxelise the inside of `mesh` in a grid of `cell`-sized cells with `margin`
+/// empty cells around its bounds. `progress` gets fractions of this stage.
+pub(super) fn voxelise(
+    mesh: &TriMesh,
+    tree: &TriangleTree,
+    cell: f64,
+    margin: usize,
+    progress: &dyn Fn(f32) -> bool,
+) -> Option<Voxels> {
+    let (lo, hi) = mesh.bounds();
+    let origin = lo - DVec3::splat(margin as f64 * cell);
+    let dims = ((hi - lo) / cell)
+        .ceil()
+        .as_uvec3()
+        .to_array()
+        .map(|n| n.max(1) as usize + 2 * margin);
+    let mut voxels = Voxels {
+        origin,
+        cell,
+        dims,
+        inside: vec![false; dims[0] * dims[1] * dims[2]],
+    };
+    mark_surface(mesh, &mut voxels);
+    if !progress(0.3) {
+        return None;
+    }
+    classify_empty_cells(&mut voxels, tree);
+    progress(1.0).then_some(voxels)
+}
+
+/// Mark every cell the surface passes through, by sampling each triangle at a
+/// third of a cell. A cell missed at a corner is within a cell of a marked
+/// one, so the dilation that follows still covers it.
+fn mark_surface(mesh: &TriMesh, voxels: &mut Voxels) {
+    let step = voxels.cell / 3.0;
+    // Points no face uses are enclosed too.
+    for &p in &mesh.positions {
+        let index = cell_of(voxels, p);
+        voxels.inside[index] = true;
+    }
+    let cells: Vec<usize> = mesh
+        .triangles
+        .par_iter()
+        .flat_map_iter(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
+            let n = (longest / step).ceil().max(1.0) as usize;
+            let mut cells = Vec::with_capacity((n + 1) * (n + 2) / 2);
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let p = a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64);
+                    cells.push(cell_of(voxels, p));
+                }
+            }
+            cells.sort_unstable();
+            cells.dedup();
+            cells
+        })
+        .collect();
+    for index in cells {
+        voxels.inside[index] = true;
+    }
+}
+
+fn cell_of(voxels: &Voxels, p: DVec3) -> usize {
+    let c = ((p - voxels.origin) / voxels.cell).floor();
+    let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
+    voxels.index(
+        clamp(c.x, voxels.dims[0]),
+        clamp(c.y, voxels.dims[1]),
+        clamp(c.z, voxels.dims[2]),
+    )
+}
+
+/// Decide the cells the surface does not touch by winding number. Such cells
+/// form regions bounded by surface cells; in a closed mesh each region is all
+/// inside or all outside, so a few samples decide it. A region whose samples
+/// disagree (an open mesh's inside leaking through a hole) is decided cell by
+/// cell.
+fn classify_empty_cells(voxels: &mut Voxels, tree: &TriangleTree) {
+    const SAMPLES: usize = 24;
+    let mut region = vec![u32::MAX; voxels.inside.len()];
+    let mut regions: Vec<Vec<usize>> = Vec::new();
+    for start in 0..voxels.inside.len() {
+        if voxels.inside[start] || region[start] != u32::MAX {
+            continue;
+        }
+        let id = regions.len() as u32;
+        let mut cells = vec![start];
+        region[start] = id;
+        let mut next = 0;
+        while next < cells.len() {
+            let index = cells[next];
+            next += 1;
+            for n in voxels.neighbours(index) {
+                if !voxels.inside[n] && region[n] == u32::MAX {
+                    region[n] = id;
+                    cells.push(n);
+                }
+            }
+        }
+        regions.push(cells);
+    }
+    for cells in regions {
+        let stride = (cells.len() / SAMPLES).max(1);
+        let samples: Vec<f64> = cells
+            .par_iter()
+            .step_by(stride)
+            .map(|&i| tree.winding_number(voxels.centre(i)))
+            .collect();
+        let all_inside = samples.iter().all(|&w| w.abs() > 0.5);
+        let all_outside = samples.iter().all(|&w| w.abs() <= 0.5);
+        let inside: Vec<usize> = if all_inside {
+            cells
+        } else if all_outside {
+            Vec::new()
+        } else {
+            cells
+                .par_iter()
+                .copied()
+                .filter(|&i| tree.winding_number(voxels.centre(i)).abs() > 0.5)
+                .collect()
+        };
+        for index in inside {
+            voxels.inside[index] = true;
+        }
+    }
+}
+
+/// Grow the set by `radius` cells in every direction (a cube, so that every
+/// point outside is at least `radius` cells from the original set).
+pub(super) fn dilate(voxels: &mut Voxels, radius: usize) {
+    let dims = voxels.dims;
+    let strides = [1, dims[0], dims[0] * dims[1]];
+    for axis in 0..3 {
+        let length = dims[axis];
+        let stride = strides[axis];
+        let mut next = voxels.inside.clone();
+        for start in 0..voxels.inside.len() {
+            if voxels.coordinates(start)[axis] != 0 {
+                continue;
+            }
+            // Sliding count of set cells in the window [i - radius, i + radius].
+            let at = |i: usize| voxels.inside[start + i * stride] as usize;
+            let mut count: usize = (0..radius.min(length)).map(at).sum();
+            for i in 0..length {
+                if i + radius < length {
+                    count += at(i + radius);
+                }
+                if i > radius {
+                    count -= at(i - radius - 1);
+                }
+                next[start + i * stride] = count > 0;
+            }
+        }
+        voxels.inside = next;
+    }
+}
+
+/// Make cavities (empty regions that do not reach the grid's border) inside:
+/// the cage is a solid around the mesh.
+pub(super) fn fill_cavities(voxels: &mut Voxels) {
+    let mut outside = vec![false; voxels.inside.len()];
+    let mut queue: VecDeque<usize> = (0..voxels.inside.len())
+        .filter(|&i| voxels.on_border(i) && !voxels.inside[i])
+        .collect();
+    for &i in &queue {
+        outside[i] = true;
+    }
+    while let Some(index) = queue.pop_front() {
+        for n in voxels.neighbours(index) {
+            if !voxels.inside[n] && !outside[n] {
+                outside[n] = true;
+                queue.push_back(n);
+            }
+        }
+    }
+    for (inside, outside) in voxels.inside.iter_mut().zip(outside) {
+        *inside = !outside;
+    }
+}
+
+/// Add cells until no two cells of the same kind (inside or empty) meet only
+/// along an edge or at a corner with both cells of the other kind between them.
+/// Such a set is well-composed, and the faces between inside and empty cells
+/// form a 2-manifold. Only inside cells are added, so containment is kept.
+pub(super) fn make_well_composed(voxels: &mut Voxels) {
+    let [nx, ny, nz] = voxels.dims;
+    loop {
+        let mut changed = false;
+        for z in 0..nz.saturating_sub(1) {
+            for y in 0..ny.saturating_sub(1) {
+                for x in 0..nx.saturating_sub(1) {
+                    let block: [usize; 8] = std::array::from_fn(|k| {
+                        voxels.index(x + (k & 1), y + ((k >> 1) & 1), z + ((k >> 2) & 1))
+                    });
+                    if block_is_critical(&block.map(|i| voxels.inside[i])) {
+                        for i in block {
+                            voxels.inside[i] = true;
+                        }
+                        changed = true;
+                    }
+                }
+            }
+        }
+        if !changed {
+            return;
+        }
+    }
+}
+
+/// Whether a 2×2×2 block (corner k at offset (k&1, k>>1&1, k>>2&1)) holds an
+/// edge-only or corner-only contact.
+fn block_is_critical(cells: &[bool; 8]) -> bool {
+    // The six 2×2 faces of the block: a diagonal pair of one kind and the other
+    // pair of the other kind is an edge-only contact.
+    const FACES: [[usize; 4]; 6] = [
+        [0, 1, 2, 3],
+        [4, 5, 6, 7],
+        [0, 1, 4, 5],
+        [2, 3, 6, 7],
+        [0, 2, 4, 6],
+        [1, 3, 5, 7],
+    ];
+    for [a, b, c, d] in FACES {
+        // Corners a, b, c, d are laid out as a 2×2 square: a-d and b-c are the
+        // diagonals.
+        if cells[a] == cells[d] && cells[b] == cells[c] && cells[a] != cells[b] {
+            return true;
+        }
+    }
+    // Opposite corners of one kind with all six others of the other kind.
+    for k in 0..4 {
+        let opposite = 7 - k;
+        let kind = cells[k];
+        if cells[opposite] == kind
+            && (0..8)
+                .filter(|&j| j != k && j != opposite)
+                .all(|j| cells[j] != kind)
+        {
+            return true;
+        }
+    }
+    false
+}
+
+/// How far each cell is from the set, in cells (Chebyshev distance: a cube
+/// around the set), up to `u16::MAX`.
+pub(super) fn distance_from_set(voxels: &Voxels) -> Vec<u16> {
+    let [nx, ny, nz] = voxels.dims;
+    let mut distance = vec![u16::MAX; voxels.inside.len()];
+    let mut queue: VecDeque<usize> = VecDeque::new();
+    for (i, &inside) in voxels.inside.iter().enumerate() {
+        if inside {
+            distance[i] = 0;
+            queue.push_back(i);
+        }
+    }
+    while let Some(index) = queue.pop_front() {
+        let [x, y, z] = voxels.coordinates(index);
+        let next = distance[index].saturating_add(1);
+        for dz in z.saturating_sub(1)..=(z + 1).min(nz - 1) {
+            for dy in y.saturating_sub(1)..=(y + 1).min(ny - 1) {
+                for dx in x.saturating_sub(1)..=(x + 1).min(nx - 1) {
+                    let n = voxels.index(dx, dy, dz);
+                    if distance[n] == u16::MAX {
+                        distance[n] = next;
+                        queue.push_back(n);
+                    }
+                }
+            }
+        }
+    }
+    distance
+}
+
+/// Where the cage may go: cells within `limit` cells of the mesh's inside.
+/// Raising the limit trades tightness for fewer vertices; keeping it below half
+/// a gap keeps the parts on either side apart.
+pub(super) struct Envelope {
+    pub origin: DVec3,
+    pub cell: f64,
+    pub dims: [usize; 3],
+    pub distance: Vec<u16>,
+    pub limit: u16,
+}
+
+impl Envelope {
+    fn allows(&self, p: DVec3) -> bool {
+        let c = ((p - self.origin) / self.cell).floor();
+        if c.cmplt(DVec3::ZERO).any() {
+            return false;
+        }
+        let [x, y, z] = [c.x as usize, c.y as usize, c.z as usize];
+        let [nx, ny, nz] = self.dims;
+        x < nx && y < ny && z < nz && self.distance[x + nx * (y + ny * z)] <= self.limit
+    }
+
+    /// Every point of the triangle, sampled at half a cell, is allowed: a band
+    /// of forbidden cells is at least a cell wide, so no sample skips it.
+    pub(super) fn allows_triangle(&self, [a, b, c]: [DVec3; 3]) -> bool {
+        let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
+        let n = (2.0 * longest / self.cell).ceil().max(1.0) as usize;
+        (0..=n).all(|i| {
+            (0..=n - i).all(|j| {
+                self.allows(a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64))
+            })
+        })
+    }
+}
