@@ -5,6 +5,7 @@
 //! viewport in `viewport/`, and one file per panel in `ui/`.
 
 use super::bind_queue::BindQueue;
+use super::cage_generation::CageGeneration;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::exports::ImageRequest;
@@ -88,6 +89,8 @@ pub struct EditorApp {
     pub(super) scene_history: SceneHistory,
     /// A file dropped on the window, waiting for the user to say what it is.
     pub(super) dropped: Option<DroppedFile>,
+    /// File > Generate cage…: its window, job and proposal.
+    pub(super) cage_generation: CageGeneration,
 }
 
 impl EditorApp {
@@ -161,6 +164,7 @@ impl EditorApp {
             numeric_drag_start: None,
             scene_history: SceneHistory::default(),
             dropped: None,
+            cage_generation: CageGeneration::new(cc.egui_ctx.clone()),
         };
         if let Some(error) = unsupported {
             app.error(error.to_string());
@@ -176,8 +180,9 @@ impl EditorApp {
                 }
             }
             (Some(mesh), Some(cage), None) => opened = app.open_pair(mesh, cage),
+            (Some(mesh), None, None) => opened = app.open_mesh_alone(mesh),
             (None, None, None) => {}
-            _ => app.error("give both a mesh and a cage; showing the default scene"),
+            _ => app.error("give a mesh with the cage; showing the default scene"),
         }
         if !opened {
             app.install_document(app.document.clone());

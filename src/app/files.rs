@@ -1,6 +1,7 @@
 //! File actions: opening meshes, cages and bundled scenes, poses, export, and
 //! dropped files. A file that fails to load or validate changes nothing.
 
+use super::cage_generation::cage_reaches;
 use super::document::Document;
 use super::editor::{EditorApp, FileRole};
 use super::recent::RecentEntry;
@@ -13,7 +14,7 @@ use crate::geometry::{
 };
 use std::path::Path;
 
-fn file_title(path: &Path) -> String {
+pub(super) fn file_title(path: &Path) -> String {
     path.file_name()
         .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned())
 }
@@ -195,6 +196,16 @@ impl EditorApp {
     pub fn open_file(&mut self, role: FileRole, path: &Path) -> bool {
         let document = match role {
             FileRole::Mesh => match load_mesh(path) {
+                // A cage that holds none of the mesh is replaced by a box, and
+                // the Generate cage window offers a real one.
+                Ok(file) if !cage_reaches(self.document.cage(), &file.mesh) => {
+                    let opened = self.open_mesh_in_box(path, file);
+                    if opened {
+                        self.remember(RecentEntry::Mesh(path.to_owned()));
+                        self.start_bind();
+                    }
+                    return opened;
+                }
                 Ok(file) => Document::new(
                     file_title(path),
                     file.mesh.clone(),

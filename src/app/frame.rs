@@ -10,6 +10,7 @@ impl eframe::App for EditorApp {
         self.intercept_close(&ctx);
         self.ask_for_keyboard_focus(&ctx, frame);
         self.poll_bind();
+        self.poll_cage_generation();
         self.handle_dropped_files(&ctx);
         self.handle_shortcuts(&ctx);
         self.file_shortcuts(&ctx);
@@ -28,6 +29,7 @@ impl eframe::App for EditorApp {
         // The question first: its Save pose… opens the file dialog in this frame.
         self.quit_dialog(&ctx);
         self.file_dialog_window(&ctx);
+        self.generate_cage_window(&ctx);
         self.request_wanted_binds();
         if self.show_statistics {
             // Keep frames coming so the readout measures rendering, not idling.

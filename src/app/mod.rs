@@ -9,11 +9,14 @@
 //!   `files` and `readouts` add its actions.
 //! - `viewport`: panes, input and picking; `ui`: menu, toolbar, side panel,
 //!   quality table, notices and statistics.
+//! - [`cage_generation`]: File > Generate cage…, a cage generated in the
+//!   background and proposed over the mesh before it replaces the cage.
 //! - [`compare`]: what the views compare and how the mesh is coloured.
 //! - [`scenes`]: the bundled scenes; [`widgets`]: the colour bar and hover box.
 
 pub mod bind_queue;
 mod binding;
+pub mod cage_generation;
 pub mod compare;
 pub mod document;
 pub mod editor;
@@ -41,7 +44,8 @@ use std::path::PathBuf;
 /// How the editor starts (the `pmvc edit` arguments).
 #[derive(Clone, Debug, Default)]
 pub struct EditorOptions {
-    /// Mesh to open instead of the default scene (needs `cage` too).
+    /// Mesh to open instead of the default scene; without `cage` it opens in a
+    /// loose box and the Generate cage window offers a cage.
     pub mesh: Option<PathBuf>,
     pub cage: Option<PathBuf>,
     /// A session to open (instead of `mesh` and `cage`).

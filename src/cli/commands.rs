@@ -217,7 +217,7 @@ pub(super) fn progress_bar(total: u64, method: Method) -> indicatif::ProgressBar
 
 /// Refuse an output that is one of the inputs, and warn when its name says it
 /// holds something else.
-fn check_output(
+pub(super) fn check_output(
     out: &std::path::Path,
     inputs: &[&std::path::Path],
     extensions: &[&str],

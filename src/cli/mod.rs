@@ -1,5 +1,5 @@
-//! The `pmvc` command line: `edit` (the default), `bind`, `deform`, `check`, `bench`,
-//! `generate` and `info`.
+//! The `pmvc` command line: `edit` (the default), `bind`, `deform`, `check`, `cage`,
+//! `bench`, `generate` and `info`.
 //!
 //! Errors are reported as one line on stderr naming the file, with exit status 1.
 //! Outputs are written through a temporary file, so an existing output survives a
@@ -23,6 +23,7 @@ macro_rules! warn_line {
 }
 
 mod bench;
+mod cage;
 mod commands;
 mod environment;
 mod weights_format;
@@ -54,6 +55,8 @@ pub enum Command {
     Deform(DeformArgs),
     /// Validate a mesh and its cage and print statistics.
     Check(CheckArgs),
+    /// Generate a cage of about N vertices around a mesh, write it as OBJ and print what was measured on it.
+    Cage(cage::CageArgs),
     /// Time binding on scenes of the paper's sizes and on the shared evaluation data.
     Bench(bench::BenchArgs),
     /// Write one of the procedural benchmark scenes as OBJ files.
@@ -173,8 +176,8 @@ pub struct CheckArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct EditArgs {
-    /// Mesh to open instead of the bundled scene (.obj or .off).
-    #[arg(requires = "cage")]
+    /// Mesh to open instead of the bundled scene (.obj or .off). Without a cage
+    /// it opens in a box, with the Generate cage window offering a cage.
     pub mesh: Option<PathBuf>,
     /// Its cage.
     pub cage: Option<PathBuf>,
@@ -375,7 +378,13 @@ pub fn main() -> ExitCode {
     };
     if matches!(
         cli.command,
-        Some(Command::Bind(_) | Command::Deform(_) | Command::Generate(_) | Command::Bench(_))
+        Some(
+            Command::Bind(_)
+                | Command::Deform(_)
+                | Command::Cage(_)
+                | Command::Generate(_)
+                | Command::Bench(_)
+        )
     ) {
         environment::remove_unfinished_outputs_on_signals();
     }
@@ -388,6 +397,7 @@ pub fn main() -> ExitCode {
         Some(Command::Bind(args)) => commands::bind(&args),
         Some(Command::Deform(args)) => commands::deform(&args),
         Some(Command::Check(args)) => commands::check(&args),
+        Some(Command::Cage(args)) => cage::cage(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Generate(args)) => commands::generate(&args),
         Some(Command::Info) => commands::info(),
@@ -502,6 +512,16 @@ mod tests {
             let parsed = Cli::try_parse_from(["pmvc", "edit", "--difference-limit", bad]);
             assert!(parsed.is_err(), "--difference-limit {bad} was accepted");
         }
+    }
+
+    #[test]
+    fn a_mesh_opens_alone_or_with_its_cage_but_a_cage_needs_a_mesh() {
+        let alone = edit_options(&["m.obj"]);
+        assert_eq!(alone.mesh.as_deref(), Some(std::path::Path::new("m.obj")));
+        assert_eq!(alone.cage, None);
+        let pair = edit_options(&["m.obj", "c.obj"]);
+        assert_eq!(pair.cage.as_deref(), Some(std::path::Path::new("c.obj")));
+        assert!(Cli::try_parse_from(["pmvc", "edit", "--session", "s.json", "m.obj"]).is_err());
     }
 
     #[test]

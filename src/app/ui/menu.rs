@@ -30,6 +30,13 @@ impl EditorApp {
         if ui.button("Open cage…").clicked() {
             self.ask_for_file(FileAction::OpenCage);
         }
+        if ui
+            .button("Generate cage…")
+            .on_hover_text("A cage of about a chosen number of vertices around the mesh, shown before it replaces the current one")
+            .clicked()
+        {
+            self.open_cage_generation();
+        }
         ui.menu_button("Recent", |ui| {
             if self.recent.entries().is_empty() {
                 ui.label("(none)");

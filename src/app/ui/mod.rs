@@ -3,6 +3,7 @@
 
 pub mod drop_dialog;
 pub mod file_dialog;
+pub mod generate_cage;
 pub mod menu;
 pub mod named_poses;
 pub mod notices;

@@ -268,6 +268,7 @@ impl EditorApp {
             );
         }
         self.draw_transform(&painter, index, rect);
+        self.draw_proposed_cage(&painter, index);
         if shading.colouring != Colouring::Shaded {
             if let Some(range) = self.value_range(shading.colouring, kind) {
                 let note = self.colour_bar_note(shading.colouring, kind);

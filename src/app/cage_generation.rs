@@ -1,0 +1,445 @@
+//! Generating a cage in the editor: the job on a background thread with its
+//! progress and cancel, the proposal waiting for the user, and what using it
+//! does (one undo step, then a bind). The window is `ui/generate_cage.rs`.
+//!
+//! A proposal belongs to the mesh it was generated around: if the document's
+//! mesh changes meanwhile (undo, another file), the proposal is dropped.
+
+use super::document::Document;
+use super::editor::EditorApp;
+use crate::geometry::autocage::{
+    generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, MAX_TARGET_VERTICES,
+    MIN_TARGET_VERTICES,
+};
+use crate::geometry::{Cage, MeshFile, TriMesh};
+use crate::render::scene_gpu::unique_edges;
+use glam::DVec3;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::mpsc::{channel, Receiver, TryRecvError};
+use std::sync::Arc;
+
+/// The target a first generation offers when the cage says nothing better.
+pub const DEFAULT_TARGET_VERTICES: usize = 64;
+
+/// Clearance offered when the user asks for one: 1 % of the mesh's diagonal.
+const DEFAULT_CLEARANCE_PERCENT: f64 = 1.0;
+
+/// The loose box a mesh opened alone sits in, this fraction of its diagonal
+/// away from it on every side.
+const BOX_MARGIN: f64 = 0.05;
+
+/// The window's settings and whatever the job is doing.
+pub struct CageGeneration {
+    pub(super) open: bool,
+    /// About how many vertices to ask for.
+    pub target_vertices: usize,
+    /// The user set the target: opening the window keeps it.
+    pub(super) target_chosen: bool,
+    /// Whether to ask for a clearance (else the generator picks one voxel).
+    pub use_clearance: bool,
+    /// The clearance, in % of the mesh's bounding-box diagonal.
+    pub clearance_percent: f64,
+    state: State,
+    /// Asked to draw a frame as the job progresses and when it ends.
+    repaint: Option<egui::Context>,
+}
+
+impl Default for CageGeneration {
+    fn default() -> Self {
+        Self {
+            repaint: None,
+            open: false,
+            target_vertices: DEFAULT_TARGET_VERTICES,
+            target_chosen: false,
+            use_clearance: false,
+            clearance_percent: DEFAULT_CLEARANCE_PERCENT,
+            state: State::Idle { message: None },
+        }
+    }
+}
+
+enum State {
+    /// Nothing under way; the last job's failure or cancel, if any.
+    Idle {
+        message: Option<String>,
+    },
+    Running(Job),
+    /// A cage generated around `mesh`, not yet used.
+    Proposed(Proposal),
+}
+
+struct Job {
+    mesh: Arc<TriMesh>,
+    cancel: Arc<AtomicBool>,
+    /// The fraction done, as f32 bits.
+    progress: Arc<AtomicU32>,
+    result: Receiver<Result<GeneratedCage, AutoCageError>>,
+}
+
+/// A generated cage shown over the mesh until it is used or discarded.
+pub struct Proposal {
+    pub generated: GeneratedCage,
+    /// Its edges, each once, for the viewport's overlay.
+    pub edges: Vec<[u32; 2]>,
+    mesh: Arc<TriMesh>,
+}
+
+impl CageGeneration {
+    /// The window's state, with `repaint` woken by the job.
+    pub fn new(repaint: egui::Context) -> Self {
+        Self {
+            repaint: Some(repaint),
+            ..Self::default()
+        }
+    }
+
+    pub fn is_open(&self) -> bool {
+        self.open
+    }
+
+    pub fn is_running(&self) -> bool {
+        matches!(self.state, State::Running(_))
+    }
+
+    /// The running job's fraction done.
+    pub fn progress(&self) -> Option<f32> {
+        match &self.state {
+            State::Running(job) => Some(f32::from_bits(job.progress.load(Ordering::Relaxed))),
+            _ => None,
+        }
+    }
+
+    pub fn proposal(&self) -> Option<&Proposal> {
+        match &self.state {
+            State::Proposed(proposal) => Some(proposal),
+            _ => None,
+        }
+    }
+
+    /// Why the last job gave no cage ("cancelled", or the generator's error).
+    pub fn message(&self) -> Option<&str> {
+        match &self.state {
+            State::Idle { message } => message.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// The options the window's settings ask for.
+    pub fn options(&self) -> CageOptions {
+        CageOptions {
+            clearance: self.use_clearance.then_some(self.clearance_percent / 100.0),
+            ..CageOptions::new(self.target_vertices)
+        }
+    }
+
+    /// Start generating around `mesh`, waking the editor as progress is made
+    /// and when the job ends. Any job or proposal before it is dropped.
+    fn start(&mut self, mesh: Arc<TriMesh>) {
+        self.cancel();
+        let repaint = self.repaint.clone();
+        let wake = move || {
+            if let Some(ctx) = &repaint {
+                ctx.request_repaint();
+            }
+        };
+        let options = self.options();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let progress = Arc::new(AtomicU32::new(0f32.to_bits()));
+        let (send, result) = channel();
+        let job_mesh = Arc::clone(&mesh);
+        let (job_cancel, job_progress) = (Arc::clone(&cancel), Arc::clone(&progress));
+        std::thread::spawn(move || {
+            let report = |fraction: f32| {
+                job_progress.store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+                wake();
+                !job_cancel.load(Ordering::Relaxed)
+            };
+            let generated = generate_cage(&job_mesh, &options, &report);
+            // The editor may have gone; then nobody wants the cage.
+            let _ = send.send(generated);
+            wake();
+        });
+        self.state = State::Running(Job {
+            mesh,
+            cancel,
+            progress,
+            result,
+        });
+    }
+
+    /// Stop a running job (its thread ends at its next progress report) and
+    /// drop any proposal.
+    pub fn cancel(&mut self) {
+        let mut message = None;
+        if let State::Running(job) = &self.state {
+            job.cancel.store(true, Ordering::Relaxed);
+            message = Some("cancelled".to_owned());
+        }
+        self.state = State::Idle { message };
+    }
+
+    /// Take a finished job's result; drop a proposal made for another mesh.
+    fn poll(&mut self, current_mesh: &Arc<TriMesh>) {
+        match &self.state {
+            State::Running(job) => {
+                let finished = match job.result.try_recv() {
+                    Ok(result) => result.map_err(|error| match error {
+                        AutoCageError::Cancelled => "cancelled".to_owned(),
+                        error => error.to_string(),
+                    }),
+                    Err(TryRecvError::Empty) => return,
+                    Err(TryRecvError::Disconnected) => {
+                        Err("internal error: the cage generator stopped without a result".into())
+                    }
+                };
+                let mesh = Arc::clone(&job.mesh);
+                self.state = match finished {
+                    Ok(generated) if Arc::ptr_eq(&mesh, current_mesh) => {
+                        State::Proposed(Proposal {
+                            edges: unique_edges(generated.cage.triangles()),
+                            generated,
+                            mesh,
+                        })
+                    }
+                    Ok(_) => State::Idle {
+                        message: Some("the mesh changed while the cage was generated".into()),
+                    },
+                    Err(message) => State::Idle {
+                        message: Some(message),
+                    },
+                };
+            }
+            State::Proposed(proposal) if !Arc::ptr_eq(&proposal.mesh, current_mesh) => {
+                self.state = State::Idle { message: None };
+            }
+            _ => {}
+        }
+    }
+
+    fn take_proposal(&mut self) -> Option<Proposal> {
+        match std::mem::replace(&mut self.state, State::Idle { message: None }) {
+            State::Proposed(proposal) => Some(proposal),
+            other => {
+                self.state = other;
+                None
+            }
+        }
+    }
+}
+
+/// The measured properties of a generated cage, one line each: what the CLI
+/// prints and the window shows. `seconds` is left out when timings are hidden.
+pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
+    let mut lines = vec![format!(
+        "vertices: {} (target {}), {} triangles, {} shell{}",
+        stats.vertices,
+        stats.target_vertices,
+        stats.triangles,
+        stats.shells,
+        if stats.shells == 1 { "" } else { "s" }
+    )];
+    if !stats.target_reached() {
+        let (low, high) = target_range(stats.target_vertices);
+        lines.push(format!(
+            "target not reached: {} vertices is outside {} ± 15% ({low} to {high})",
+            stats.vertices, stats.target_vertices
+        ));
+    }
+    lines.push(format!(
+        "minimum clearance: {:.6} ({:.2}% of the mesh diagonal {:.6})",
+        stats.min_clearance,
+        100.0 * stats.min_clearance / stats.mesh_diagonal.max(f64::MIN_POSITIVE),
+        stats.mesh_diagonal
+    ));
+    let source = if stats.mesh_volume_from_voxels {
+        "mesh volume from voxels, the mesh is not closed"
+    } else {
+        "mesh volume from its closed surface"
+    };
+    lines.push(match stats.volume_ratio() {
+        Some(ratio) => format!(
+            "volume ratio (cage / mesh): {ratio:.3} ({:.6} / {:.6}; {source})",
+            stats.cage_volume, stats.mesh_volume
+        ),
+        None => "volume ratio (cage / mesh): none, the mesh encloses no volume".to_owned(),
+    });
+    lines.push(format!("minimum angle: {:.1}°", stats.min_angle_degrees));
+    if show_time {
+        lines.push(format!("time: {:.2} s", stats.seconds));
+    }
+    lines
+}
+
+/// The vertex counts within ±15 % of `target`, as `CageStats::target_reached`
+/// counts them (its slack, whole vertices only).
+fn target_range(target: usize) -> (usize, usize) {
+    let slack = (0.15 * target as f64).floor() as usize;
+    (target - slack, target + slack)
+}
+
+/// A closed box around `mesh`, [`BOX_MARGIN`] of its diagonal away on every
+/// side: the usable cage of a mesh opened alone, until a generated one replaces it.
+pub fn loose_box_cage(mesh: &TriMesh) -> Option<Cage> {
+    let (lo, hi) = mesh.bounds();
+    // A flat or single-point mesh still gets a box of some thickness.
+    let margin = DVec3::splat((mesh.diagonal() * BOX_MARGIN).max(1e-3));
+    let (lo, hi) = (lo - margin, hi + margin);
+    let corner = |i: u32| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let unit = crate::geometry::procedural::cube_cage(1.0);
+    let positions: Vec<DVec3> = (0..8).map(corner).collect();
+    // The unit cube's corners are numbered the same way (bit 0: x, 1: y, 2: z).
+    let cage = TriMesh {
+        positions,
+        triangles: unit.triangles().to_vec(),
+        triangle_faces: unit.triangle_faces().to_vec(),
+    };
+    Cage::new(cage).ok().map(|(cage, _)| cage)
+}
+
+impl EditorApp {
+    /// The Generate cage window's state, for the window and for tests.
+    pub fn cage_generation(&self) -> &CageGeneration {
+        &self.cage_generation
+    }
+
+    pub fn cage_generation_mut(&mut self) -> &mut CageGeneration {
+        &mut self.cage_generation
+    }
+
+    /// File > Generate cage…: open the window, offering the current cage's
+    /// vertex count (or [`DEFAULT_TARGET_VERTICES`] for a box) unless the user
+    /// chose a target before.
+    pub fn open_cage_generation(&mut self) {
+        let generation = &mut self.cage_generation;
+        if !generation.target_chosen {
+            let current = self.document.cage().vertex_count();
+            generation.target_vertices = if current > MIN_TARGET_VERTICES {
+                current.min(MAX_TARGET_VERTICES)
+            } else {
+                DEFAULT_TARGET_VERTICES
+            };
+        }
+        generation.open = true;
+    }
+
+    /// Close the window; a running job is cancelled and a proposal dropped.
+    pub fn close_cage_generation(&mut self) {
+        self.cage_generation.cancel();
+        self.cage_generation.open = false;
+    }
+
+    /// Generate a cage around the document's mesh in the background.
+    pub fn start_cage_generation(&mut self) {
+        let mesh = Arc::clone(self.document.mesh());
+        self.cage_generation.start(mesh);
+    }
+
+    /// Called every frame: take a finished job's result.
+    pub(super) fn poll_cage_generation(&mut self) {
+        let mesh = Arc::clone(self.document.mesh());
+        self.cage_generation.poll(&mesh);
+    }
+
+    /// Replace the document's cage by the proposal, as one undo step, and bind.
+    /// Returns false when there is no proposal.
+    pub fn use_generated_cage(&mut self) -> bool {
+        let Some(proposal) = self.cage_generation.take_proposal() else {
+            return false;
+        };
+        let cage = proposal.generated.cage;
+        let vertices = cage.vertex_count();
+        let rest = cage.positions().to_vec();
+        let document = self.document.with_cage(cage, None, rest);
+        self.replace_document(
+            document,
+            format!("use the generated {vertices}-vertex cage"),
+        );
+        self.info(format!(
+            "using the generated cage of {vertices} vertices; binding"
+        ));
+        self.cage_generation.open = false;
+        self.start_bind();
+        true
+    }
+
+    /// Open a mesh with no cage: it sits in a loose box, and the Generate cage
+    /// window opens to offer a real one. False, with an error, when it fails.
+    pub(super) fn open_mesh_alone(&mut self, path: &Path) -> bool {
+        match crate::geometry::load_mesh(path) {
+            Ok(file) => self.open_mesh_in_box(path, file),
+            Err(error) => {
+                self.error(error.to_string());
+                false
+            }
+        }
+    }
+
+    /// Make `file`, read from `path`, the document's mesh in a loose box cage
+    /// (one undo step), and open the Generate cage window.
+    pub(super) fn open_mesh_in_box(&mut self, path: &Path, file: MeshFile) -> bool {
+        let Some(cage) = loose_box_cage(&file.mesh) else {
+            self.error(format!(
+                "{}: the mesh has no extent to put a cage around",
+                path.display()
+            ));
+            return false;
+        };
+        let title = super::files::file_title(path);
+        let document =
+            Document::new(title.clone(), file.mesh.clone(), cage).with_files(Some(file), None);
+        self.replace_document(document, format!("open {title}"));
+        self.info(format!(
+            "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
+            path.display()
+        ));
+        self.open_cage_generation();
+        true
+    }
+}
+
+/// Whether any vertex of `mesh` lies in the bounding box of `cage`: a cage that
+/// holds none of the mesh is no cage for it.
+pub fn cage_reaches(cage: &Cage, mesh: &TriMesh) -> bool {
+    let (lo, hi) = crate::geometry::bounds_of(cage.positions());
+    mesh.positions
+        .iter()
+        .any(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_target_range_is_fifteen_percent_either_way() {
+        assert_eq!(target_range(64), (55, 73));
+        assert_eq!(target_range(100), (85, 115));
+    }
+
+    #[test]
+    fn a_loose_box_encloses_its_mesh() {
+        let sphere = crate::geometry::procedural::icosphere(1.0, 1);
+        let mesh = TriMesh {
+            positions: sphere.positions().to_vec(),
+            triangles: sphere.triangles().to_vec(),
+            triangle_faces: sphere.triangle_faces().to_vec(),
+        };
+        let cage = loose_box_cage(&mesh).expect("a box");
+        assert_eq!(cage.vertex_count(), 8);
+        let classes = crate::geometry::classify_points(&cage, &mesh.positions);
+        assert!(classes.outside.is_empty());
+        // A single point still gets a box.
+        let point = TriMesh {
+            positions: vec![DVec3::ONE],
+            ..Default::default()
+        };
+        assert!(loose_box_cage(&point).is_some());
+    }
+}

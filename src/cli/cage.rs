@@ -1,0 +1,78 @@
+//! `pmvc cage`: generate a cage of about N vertices around a mesh and write it
+//! as OBJ, then print what was measured on it.
+
+use crate::app::cage_generation::stats_lines;
+use crate::geometry::autocage::{generate_cage, CageOptions};
+use crate::geometry::{self, PendingOutput};
+use anyhow::{anyhow, Result};
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct CageArgs {
+    /// The mesh to enclose (.obj or .off): a triangle mesh, closed or not.
+    #[arg(long, value_name = "MESH")]
+    pub mesh: PathBuf,
+    /// About how many vertices the cage should have (8 to 20000); the result is
+    /// within ±15% of it unless the mesh's shape needs more or allows fewer.
+    #[arg(long, value_name = "N")]
+    pub vertices: usize,
+    /// Output cage as OBJ: closed, outward-facing triangles.
+    #[arg(long, value_name = "C.obj")]
+    pub out: PathBuf,
+    /// The gap between the mesh and the cage, as a fraction of the mesh's
+    /// bounding-box diagonal (e.g. 0.02; default: one voxel).
+    #[arg(long, value_name = "FRACTION")]
+    pub clearance: Option<f64>,
+    /// The voxel size, as a fraction of the diagonal (default: chosen from the
+    /// mesh and N). Parts closer than about three voxels merge.
+    #[arg(long, value_name = "FRACTION")]
+    pub cell_size: Option<f64>,
+}
+
+pub(super) fn cage(args: &CageArgs) -> Result<()> {
+    super::commands::check_output(&args.out, &[&args.mesh], &["obj"], "an OBJ cage")?;
+    let mesh = geometry::load_mesh(&args.mesh)?;
+    // Opened before the work, so that an unwritable folder is reported now and
+    // a signal while generating removes the temporary file.
+    let output = PendingOutput::create(&args.out)?;
+    let options = CageOptions {
+        clearance: args.clearance,
+        cell_size: args.cell_size,
+        ..CageOptions::new(args.vertices)
+    };
+    let bar = progress_bar();
+    let generated = generate_cage(&mesh.mesh, &options, &|fraction| {
+        bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
+        true
+    });
+    bar.finish_and_clear();
+    let generated = generated.map_err(|error| anyhow!("{}: {error}", args.mesh.display()))?;
+    let cage = &generated.cage;
+    output.finish(|out| geometry::write_obj_to(out, cage.positions(), cage.triangles()))?;
+    say!(
+        "wrote {}: a cage around {} ({} vertices, {} triangles)",
+        args.out.display(),
+        args.mesh.display(),
+        mesh.mesh.positions.len(),
+        mesh.mesh.triangles.len()
+    );
+    for line in stats_lines(&generated.stats, true) {
+        say!("{line}");
+    }
+    Ok(())
+}
+
+/// A progress bar on stderr when it is a terminal; hidden otherwise.
+fn progress_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(1000),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{msg} {wide_bar} {percent}%, {elapsed}")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message("generating the cage");
+    bar
+}

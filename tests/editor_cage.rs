@@ -1,0 +1,250 @@
+//! File > Generate cage…: a cage generated in the background is proposed, then
+//! used as one undo step that binds; Cancel and Discard change nothing; a failing
+//! mesh says why in the window; `pmvc edit MESH` with no cage opens the window.
+
+mod common;
+
+use common::editor::*;
+use egui::{Key, Modifiers};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use glam::DVec3;
+use pmvc::app::{EditorApp, EditorOptions};
+use pmvc::geometry::classify_points;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+fn choose_in_file_menu(harness: &mut Harness<'static, EditorApp>, entry: &str) {
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label(entry).click();
+    harness.run_steps(2);
+}
+
+fn click_button(harness: &mut Harness<'static, EditorApp>, label: &str) {
+    harness.get_by_label(label).click();
+    harness.run_steps(2);
+}
+
+/// Step until the generation job has ended.
+fn run_until_generated(harness: &mut Harness<'static, EditorApp>) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while harness.state().cage_generation().is_running() {
+        assert!(
+            Instant::now() < deadline,
+            "the cage was not generated in time"
+        );
+        harness.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    harness.run_steps(3);
+}
+
+fn cage_positions(app: &EditorApp) -> Vec<DVec3> {
+    app.document().cage().positions().to_vec()
+}
+
+fn assets(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+}
+
+#[test]
+fn a_generated_cage_is_proposed_then_used_as_one_undo_step_that_binds() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let old_cage = cage_positions(harness.state());
+    let method = harness.state().active_method();
+
+    choose_in_file_menu(&mut harness, "Generate cage…");
+    assert!(harness.state().cage_generation().is_open());
+    // The window offers the current cage's vertex count.
+    assert_eq!(
+        harness.state().cage_generation().target_vertices,
+        old_cage.len()
+    );
+    harness.state_mut().cage_generation_mut().target_vertices = 24;
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+
+    let proposed = {
+        let proposal = harness
+            .state()
+            .cage_generation()
+            .proposal()
+            .expect("a proposal once generated");
+        assert_eq!(proposal.generated.stats.target_vertices, 24);
+        proposal.generated.cage.positions().to_vec()
+    };
+    harness.get_by_label_contains("(target 24)");
+    harness.get_by_label_contains("minimum clearance: ");
+    harness.get_by_label_contains("volume ratio (cage / mesh): ");
+    harness.get_by_label_contains("minimum angle: ");
+    // Proposed, not used: the document keeps its cage until the user says so.
+    assert_eq!(cage_positions(harness.state()), old_cage);
+    assert!(!harness.state().is_binding());
+
+    let binds = harness.state().bind_count();
+    click_button(&mut harness, "Use this cage");
+    assert_eq!(cage_positions(harness.state()), proposed);
+    assert_eq!(harness.state().document().pose(), proposed.as_slice());
+    assert!(harness.state().cage_generation().proposal().is_none());
+    assert!(!harness.state().cage_generation().is_open());
+    assert!(harness.state().bind_count() > binds, "no bind started");
+    run_until_bound(&mut harness);
+    let weights = harness
+        .state()
+        .document()
+        .weights(method)
+        .expect("bound to the new cage");
+    assert_eq!(weights.cols, proposed.len());
+    assert!(harness
+        .state()
+        .undo_label()
+        .is_some_and(|label| label.contains("generated")));
+
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run_steps(2);
+    assert_eq!(cage_positions(harness.state()), old_cage);
+    let restored = harness
+        .state()
+        .document()
+        .weights(method)
+        .expect("the old cage's weights come back with it");
+    assert_eq!(restored.cols, old_cage.len());
+    assert!(!harness.state().is_binding(), "undo must not bind again");
+}
+
+#[test]
+fn cancel_and_discard_leave_the_scene_as_it_was() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let old_cage = cage_positions(harness.state());
+    let undo_before = harness.state().undo_label();
+    let binds = harness.state().bind_count();
+
+    choose_in_file_menu(&mut harness, "Generate cage…");
+    click_button(&mut harness, "Generate");
+    assert!(harness.state().cage_generation().is_running());
+    harness.get_by_label("Cancel").click();
+    harness.run_steps(2);
+    assert!(!harness.state().cage_generation().is_running());
+    assert_eq!(
+        harness.state().cage_generation().message(),
+        Some("cancelled")
+    );
+    harness.get_by_label("cancelled");
+
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    assert!(harness.state().cage_generation().proposal().is_some());
+    click_button(&mut harness, "Discard");
+    assert!(harness.state().cage_generation().proposal().is_none());
+    assert!(harness.state().cage_generation().is_open());
+
+    assert_eq!(cage_positions(harness.state()), old_cage);
+    assert_eq!(harness.state().undo_label(), undo_before);
+    assert_eq!(harness.state().bind_count(), binds);
+}
+
+#[test]
+fn a_mesh_opened_alone_sits_in_a_box_with_the_window_open() {
+    // What `pmvc edit MESH` passes to the editor.
+    let mesh = assets("comb_mesh.obj");
+    let Some(mut harness) = editor_with(EditorOptions {
+        mesh: Some(mesh.clone()),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    harness.run_steps(3);
+    let app = harness.state();
+    assert_eq!(app.last_error(), None);
+    assert!(app.cage_generation().is_open());
+    assert_eq!(
+        app.cage_generation().target_vertices,
+        pmvc::app::cage_generation::DEFAULT_TARGET_VERTICES
+    );
+    let loaded = pmvc::geometry::load_mesh(&mesh).unwrap();
+    assert_eq!(app.document().mesh().positions, loaded.mesh.positions);
+    assert_eq!(app.document().cage().vertex_count(), 8);
+    let classes = classify_points(app.document().cage(), &loaded.mesh.positions);
+    assert!(classes.outside.is_empty(), "the box must enclose the mesh");
+    harness.get_by_label("Generate");
+    run_until_bound(&mut harness);
+
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    let vertices = harness
+        .state()
+        .cage_generation()
+        .proposal()
+        .expect("a proposal")
+        .generated
+        .cage
+        .vertex_count();
+    click_button(&mut harness, "Use this cage");
+    assert_eq!(harness.state().document().cage().vertex_count(), vertices);
+    run_until_bound(&mut harness);
+    assert!(harness.state().last_error().is_none());
+}
+
+#[test]
+fn a_mesh_with_no_triangles_says_why_in_the_window_and_keeps_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let (points, _, _, _) = common::comb_scene(dir.path(), 30);
+    let Some(mut harness) = editor_with(EditorOptions {
+        mesh: Some(points),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    let cage = cage_positions(harness.state());
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    harness.get_by_label_contains("no triangles");
+    assert!(harness.state().cage_generation().proposal().is_none());
+    assert_eq!(cage_positions(harness.state()), cage);
+    assert!(harness.state().cage_generation().is_open());
+}
+
+#[test]
+fn a_mesh_opened_away_from_the_cage_gets_a_box_and_the_window_and_undo_returns() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let old_cage = cage_positions(harness.state());
+    let comb = pmvc::geometry::load_mesh(&assets("comb_mesh.obj"))
+        .unwrap()
+        .mesh;
+    let far: Vec<DVec3> = comb
+        .positions
+        .iter()
+        .map(|p| *p + DVec3::new(100.0, 0.0, 0.0))
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let path = common::write(
+        dir.path(),
+        "far.obj",
+        &common::triangles_obj(&far, &comb.triangles),
+    );
+    assert!(harness
+        .state_mut()
+        .open_file(pmvc::app::FileRole::Mesh, &path));
+    harness.run_steps(2);
+    let app = harness.state();
+    assert!(app.cage_generation().is_open());
+    assert_eq!(app.document().cage().vertex_count(), 8);
+    let classes = classify_points(app.document().cage(), &far);
+    assert!(classes.outside.is_empty(), "the box must enclose the mesh");
+    run_until_bound(&mut harness);
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run_steps(2);
+    assert_eq!(cage_positions(harness.state()), old_cage);
+    assert_eq!(
+        harness.state().document().mesh().positions.len(),
+        comb.positions.len()
+    );
+    assert_ne!(harness.state().document().mesh().positions, far);
+}
