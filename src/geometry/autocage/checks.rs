@@ -6,6 +6,7 @@ use super::guard::{inside_tetrahedron, min_angle};
 use super::simplify::State;
 use crate::geometry::intersect::triangles_cross;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// New faces may not be sharper than this (unless the faces they replace were).
 const MIN_ANGLE_DEGREES: f64 = 3.0;
@@ -25,7 +26,7 @@ impl State {
         self.stamp += 1;
         self.mesh_hash
             .query(lo, hi, &mut self.seen_mesh_points, self.stamp, &mut nearby);
-        nearby.iter().any(|&i| {
+        any_of(&nearby, |i| {
             let q = self.mesh_points[i as usize];
             if q.cmplt(lo).any() || q.cmpgt(hi).any() {
                 return false;
@@ -163,6 +164,16 @@ impl State {
                 .iter()
                 .any(|corners| inside_tetrahedron(p, position, *corners, self.volume_tolerance))
         })
+    }
+}
+
+/// Whether `test` holds for any of `items`, on every core when there are many:
+/// late in a simplification one face spans thousands of mesh points.
+pub(super) fn any_of(items: &[u32], test: impl Fn(u32) -> bool + Sync) -> bool {
+    if items.len() < 2048 {
+        items.iter().any(|&i| test(i))
+    } else {
+        items.par_iter().with_min_len(1024).any(|&i| test(i))
     }
 }
 

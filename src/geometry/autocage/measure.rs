@@ -120,20 +120,16 @@ pub(super) fn surface_samples(mesh: &TriMesh, spacing: f64) -> Vec<DVec3> {
     points.par_extend(mesh.triangles.par_iter().flat_map_iter(|t| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
         let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-        let n = (longest / spacing).ceil().max(1.0) as usize;
-        // Interior lattice points only: the corners are vertices already.
-        (0..=n).flat_map(move |i| {
-            (0..=n - i).filter_map(move |j| {
-                let corner = (i == 0 && j == 0) || i == n || j == n;
-                (!corner || n == 1 && i == 0 && j == 0).then(|| {
-                    if n == 1 {
-                        (a + b + c) / 3.0
-                    } else {
-                        a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64)
-                    }
+        let n = (longest / spacing).ceil() as usize;
+        // A face no longer than the spacing is covered by its corners, which
+        // are vertices already; larger ones get their interior lattice points.
+        (1..n)
+            .flat_map(move |i| {
+                (0..=n - i).map(move |j| {
+                    a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64)
                 })
             })
-        })
+            .chain((1..n).map(move |j| a + (c - a) * (j as f64 / n as f64)))
     }));
     points
 }

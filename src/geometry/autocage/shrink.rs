@@ -88,7 +88,7 @@ impl State {
         self.stamp += 1;
         self.mesh_hash
             .query(lo, hi, &mut self.seen_mesh_points, self.stamp, &mut nearby);
-        nearby.iter().any(|&i| {
+        super::checks::any_of(&nearby, |i| {
             let q = self.mesh_points[i as usize];
             faces.iter().any(|[a, b, c]| {
                 let (closest, _) = closest_point_on_triangle(q, *a, *b, *c);
