@@ -69,6 +69,46 @@ fn a_cage_around_the_comb_is_written_and_its_properties_printed() {
     assert_eq!(!within, text.contains("target not reached"), "{text}");
 }
 
+/// A larger voxel size is used as asked, said in the summary, and gives a
+/// coarser voxel surface to start from, so the comb's cage ends with fewer
+/// vertices than with the default voxels.
+#[test]
+fn the_voxel_size_is_used_and_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fine, coarse) = (dir.path().join("fine.obj"), dir.path().join("coarse.obj"));
+    let default = generate(&comb_mesh(), "8", &fine);
+    assert!(default.status.success(), "{}", stderr(&default));
+    assert!(
+        stdout(&default).contains("(0.78% of the mesh diagonal)"),
+        "{}",
+        stdout(&default)
+    );
+    let larger = pmvc(&[
+        "cage",
+        "--mesh",
+        path_str(&comb_mesh()),
+        "--vertices",
+        "8",
+        "--cell-size",
+        "0.05",
+        "--out",
+        path_str(&coarse),
+    ]);
+    assert!(larger.status.success(), "{}", stderr(&larger));
+    let text = stdout(&larger);
+    assert!(
+        text.contains("voxel size: ") && text.contains("(5.00% of the mesh diagonal)"),
+        "{text}"
+    );
+    let count = |path: &Path| load_cage(path).unwrap().0.vertex_count();
+    assert!(
+        count(&coarse) < count(&fine),
+        "{} vs {}",
+        count(&coarse),
+        count(&fine)
+    );
+}
+
 #[test]
 fn an_off_mesh_gets_a_cage() {
     let dir = tempfile::tempdir().unwrap();

@@ -248,3 +248,32 @@ fn a_mesh_opened_away_from_the_cage_gets_a_box_and_the_window_and_undo_returns()
     );
     assert_ne!(harness.state().document().mesh().positions, far);
 }
+
+#[test]
+fn the_voxel_size_box_sets_the_voxels_the_proposal_is_made_from() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    choose_in_file_menu(&mut harness, "Generate cage…");
+    harness.state_mut().cage_generation_mut().cell_size_percent = 5.0;
+    assert_eq!(harness.state().cage_generation().options().cell_size, None);
+    harness.get_by_label("Voxel size").click();
+    harness.run_steps(2);
+    assert_eq!(
+        harness.state().cage_generation().options().cell_size,
+        Some(0.05)
+    );
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    let proposal = harness
+        .state()
+        .cage_generation()
+        .proposal()
+        .expect("a proposal");
+    let stats = &proposal.generated.stats;
+    let share = stats.cell_size / stats.mesh_diagonal;
+    assert!(
+        (share - 0.05).abs() < 1e-9,
+        "voxel size {share} of the diagonal"
+    );
+    harness.get_by_label_contains("(5.00% of the mesh diagonal)");
+}

@@ -8,8 +8,8 @@
 use super::document::Document;
 use super::editor::EditorApp;
 use crate::geometry::autocage::{
-    generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, MAX_TARGET_VERTICES,
-    MIN_TARGET_VERTICES,
+    generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
+    MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use crate::render::scene_gpu::unique_edges;
@@ -40,6 +40,10 @@ pub struct CageGeneration {
     pub use_clearance: bool,
     /// The clearance, in % of the mesh's bounding-box diagonal.
     pub clearance_percent: f64,
+    /// Whether to ask for a voxel size (else the generator's default).
+    pub use_cell_size: bool,
+    /// The voxel size, in % of the mesh's bounding-box diagonal.
+    pub cell_size_percent: f64,
     state: State,
     /// Asked to draw a frame as the job progresses and when it ends.
     repaint: Option<egui::Context>,
@@ -54,6 +58,8 @@ impl Default for CageGeneration {
             target_chosen: false,
             use_clearance: false,
             clearance_percent: DEFAULT_CLEARANCE_PERCENT,
+            use_cell_size: false,
+            cell_size_percent: 100.0 * DEFAULT_CELL_SIZE,
             state: State::Idle { message: None },
         }
     }
@@ -129,6 +135,7 @@ impl CageGeneration {
     pub fn options(&self) -> CageOptions {
         CageOptions {
             clearance: self.use_clearance.then_some(self.clearance_percent / 100.0),
+            cell_size: self.use_cell_size.then_some(self.cell_size_percent / 100.0),
             ..CageOptions::new(self.target_vertices)
         }
     }
@@ -245,6 +252,12 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
             "target not reached: {} vertices is outside {} ± 15% ({low} to {high})",
             stats.vertices, stats.target_vertices
         ));
+        if stats.vertices > high {
+            lines.push(
+                "  (larger voxels reach fewer vertices, but parts closer than about three voxels then merge)"
+                    .to_owned(),
+            );
+        }
     }
     lines.push(format!(
         "minimum clearance: {:.6} ({:.2}% of the mesh diagonal {:.6})",
@@ -265,6 +278,11 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         None => "volume ratio (cage / mesh): none, the mesh encloses no volume".to_owned(),
     });
     lines.push(format!("minimum angle: {:.1}°", stats.min_angle_degrees));
+    lines.push(format!(
+        "voxel size: {:.6} ({:.2}% of the mesh diagonal)",
+        stats.cell_size,
+        100.0 * stats.cell_size / stats.mesh_diagonal.max(f64::MIN_POSITIVE)
+    ));
     if show_time {
         lines.push(format!("time: {:.2} s", stats.seconds));
     }

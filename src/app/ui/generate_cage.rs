@@ -73,16 +73,20 @@ impl EditorApp {
                         generation.target_chosen = true;
                     }
                     ui.end_row();
-                    ui.checkbox(&mut generation.use_clearance, "Clearance")
-                        .on_hover_text("The gap between the mesh and the cage; off: one voxel");
-                    ui.add_enabled(
-                        generation.use_clearance,
-                        egui::DragValue::new(&mut generation.clearance_percent)
-                            .range(0.1..=49.0)
-                            .speed(0.05)
-                            .suffix("% of the mesh diagonal"),
+                    optional_percent(
+                        ui,
+                        (&mut generation.use_clearance, "Clearance"),
+                        "The gap between the mesh and the cage; off: one voxel",
+                        &mut generation.clearance_percent,
+                        (0.1, 49.0),
                     );
-                    ui.end_row();
+                    optional_percent(
+                        ui,
+                        (&mut generation.use_cell_size, "Voxel size"),
+                        "Larger voxels reach fewer vertices; parts closer than about three voxels merge",
+                        &mut generation.cell_size_percent,
+                        (0.2, 20.0),
+                    );
                 });
         });
         if let Some(fraction) = generation.progress() {
@@ -147,4 +151,24 @@ impl EditorApp {
             }
         }
     }
+}
+
+/// A grid row: a checkbox that turns a setting on, and its value in % of the
+/// mesh's diagonal, greyed out while the generator's default is used.
+fn optional_percent(
+    ui: &mut egui::Ui,
+    (enabled, label): (&mut bool, &str),
+    hover: &str,
+    percent: &mut f64,
+    (min, max): (f64, f64),
+) {
+    ui.checkbox(enabled, label).on_hover_text(hover);
+    ui.add_enabled(
+        *enabled,
+        egui::DragValue::new(percent)
+            .range(min..=max)
+            .speed(0.01 * (max - min).sqrt())
+            .suffix("% of the mesh diagonal"),
+    );
+    ui.end_row();
 }
