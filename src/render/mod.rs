@@ -15,6 +15,7 @@
 //! Each renderer is paired with its WGSL file in `shaders/render_*.wgsl`.
 
 pub mod cage;
+pub mod callback;
 pub mod camera;
 pub mod colormap;
 pub mod composite;
@@ -25,9 +26,10 @@ pub mod scene_gpu;
 pub mod viewport;
 pub mod weight_chunks;
 
+pub use callback::ViewportCallback;
 pub use camera::{OrbitCamera, ScreenProjection};
 pub use scene_gpu::{FrameUniform, ReadBack};
 pub use viewport::{
-    check_adapter, Colouring, FrameParams, RenderError, SceneUpload, Shading, ViewportCallback,
-    ViewportRenderer, MAX_VIEWS,
+    check_adapter, Colouring, FrameParams, RenderError, SceneUpload, Shading, ViewportRenderer,
+    MAX_VIEWS,
 };

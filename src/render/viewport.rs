@@ -1,7 +1,7 @@
 //! The 3D viewport inside egui: the orchestrator of the renderers. It owns the
 //! scene's GPU state ([`super::scene_gpu`]), one offscreen target per view
-//! ([`super::composite`]) and the paint callback that draws the mesh and cage
-//! there and composites the image into egui's pass.
+//! ([`super::composite`]); the paint callback ([`super::callback`]) asks it to
+//! draw the mesh and cage there and to composite the image into egui's pass.
 //!
 //! Up to [`MAX_VIEWS`] views are drawn in one frame (families side by side, and
 //! their difference). Each has its own slot of the frame uniform (a dynamic
@@ -21,7 +21,6 @@ use super::scene_gpu::{
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 use crate::coords::{Method, Weights};
 use crate::geometry::Cage;
-use eframe::egui_wgpu;
 use glam::{DVec3, Mat4, Vec3};
 
 /// Multisampling smooths the one-pixel cage lines and the mesh silhouette. It
@@ -446,7 +445,7 @@ impl ViewportRenderer {
     }
 
     /// Draw view `params.view` into its offscreen target.
-    fn draw_view(
+    pub(super) fn draw_view(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -566,44 +565,12 @@ impl ViewportRenderer {
     }
 
     /// Composite view `view`'s image into egui's pass.
-    fn composite(&self, pass: &mut wgpu::RenderPass<'static>, view: usize) {
+    pub(super) fn composite(&self, pass: &mut wgpu::RenderPass<'static>, view: usize) {
         let Some(target) = &self.targets[view.min(MAX_VIEWS - 1)] else {
             return;
         };
         pass.set_pipeline(&self.compositor.pipeline);
         pass.set_bind_group(0, &target.composite_group, &[]);
         pass.draw(0..3, 0..1);
-    }
-}
-
-/// The paint callback for one frame of the viewport.
-pub struct ViewportCallback {
-    pub params: FrameParams,
-}
-
-impl egui_wgpu::CallbackTrait for ViewportCallback {
-    fn prepare(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        _screen_descriptor: &egui_wgpu::ScreenDescriptor,
-        encoder: &mut wgpu::CommandEncoder,
-        resources: &mut egui_wgpu::CallbackResources,
-    ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = resources.get_mut::<ViewportRenderer>() {
-            renderer.draw_view(device, queue, encoder, &self.params);
-        }
-        Vec::new()
-    }
-
-    fn paint(
-        &self,
-        _info: egui::PaintCallbackInfo,
-        pass: &mut wgpu::RenderPass<'static>,
-        resources: &egui_wgpu::CallbackResources,
-    ) {
-        if let Some(renderer) = resources.get::<ViewportRenderer>() {
-            renderer.composite(pass, self.params.view);
-        }
     }
 }
