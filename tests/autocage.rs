@@ -10,7 +10,9 @@
 
 use glam::DVec3;
 use pmvc::coords::{cubemap::TexelTable, mvc, pmvc as pmvc_ref};
-use pmvc::geometry::autocage::{generate_cage, AutoCageError, CageOptions, GeneratedCage};
+use pmvc::geometry::autocage::{
+    generate_cage, AutoCageError, CageOptions, GeneratedCage, DEFAULT_CELL_SIZE,
+};
 use pmvc::geometry::procedural::{self, SplitMix64};
 use pmvc::geometry::{load_mesh, Cage, TriMesh};
 use rayon::prelude::*;
@@ -409,7 +411,12 @@ fn assert_outside(name: &str, cage: &Cage, x: DVec3, what: &str) {
 #[test]
 fn comb_prongs_stay_apart_and_the_cage_is_tight() {
     let comb = comb();
-    let generated = generate(&comb, 120);
+    // The finest voxels, asked for: they are never coarsened.
+    let options = CageOptions {
+        cell_size: Some(DEFAULT_CELL_SIZE),
+        ..CageOptions::new(120)
+    };
+    let generated = generate_with(&comb, options);
     assert_eq!(check_cage("comb", &comb, 4, &generated), 2);
     assert_simplified("comb", &generated);
     // Prongs span x ∈ [1.5k, 1.5k + 1], y ∈ [1, 5]: the gaps' centres.
@@ -420,6 +427,37 @@ fn comb_prongs_stay_apart_and_the_cage_is_tight() {
     }
     let ratio = generated.stats.volume_ratio().unwrap();
     assert!(ratio < 3.0, "comb: volume ratio {ratio}");
+}
+
+/// A target too small for the prongs to stay apart: the voxel size is chosen
+/// coarser until the target is reached, and the stats say which was used and
+/// under what distance parts may merge. Asked for, the finest voxels stay.
+#[test]
+fn a_small_target_is_reached_with_coarser_voxels_chosen_for_it() {
+    let comb = comb();
+    let diagonal = comb.diagonal();
+    let generated = generate(&comb, 16);
+    check_cage("comb at 16", &comb, 2, &generated);
+    assert_target("comb at 16", &generated);
+    let stats = &generated.stats;
+    assert!(stats.cell_size_chosen);
+    assert!(
+        stats.cell_size > 1.5 * DEFAULT_CELL_SIZE * diagonal,
+        "voxel size {} of the diagonal",
+        stats.cell_size / diagonal
+    );
+    assert!(stats.merge_distance() >= 3.0 * stats.cell_size);
+    assert!(stats.merge_distance() >= 2.0 * stats.reach);
+    let asked = generate_with(
+        &comb,
+        CageOptions {
+            cell_size: Some(DEFAULT_CELL_SIZE),
+            ..CageOptions::new(16)
+        },
+    );
+    assert!(!asked.stats.cell_size_chosen);
+    assert!((asked.stats.cell_size / diagonal - DEFAULT_CELL_SIZE).abs() < 1e-12);
+    assert!(asked.stats.vertices > generated.stats.vertices);
 }
 
 #[test]
@@ -601,13 +639,16 @@ fn the_hand_made_comb_cage_keeps_the_neighbours_still_under_pmvc() {
     assert!(mvc_moved > 1e-3, "MVC moves the neighbours by {mvc_moved}");
 }
 
-/// The bundled comb at the size of its hand-made cage (40 vertices): the
-/// fingers stay apart, and PMVC bound to the cage keep a finger still when the
-/// cage around the next finger's tip moves.
+/// The bundled comb at 120 vertices, with nothing else asked: the fingers stay
+/// apart, and PMVC bound to the cage keep a finger still when the cage around
+/// the next finger's tip moves, as with the hand-made cage (MVC move it). At
+/// the hand-made cage's 40 vertices the fingers would merge (see
+/// `a_small_target_is_reached_with_coarser_voxels_chosen_for_it`).
 #[test]
 fn bundled_comb_fingers_stay_apart() {
     let comb = asset("comb_mesh.obj");
-    let generated = generate(&comb, 40);
+    let generated = generate(&comb, 120);
+    assert_target("bundled comb", &generated);
     check_cage("bundled comb", &comb, 1, &generated);
     for gap in bundled_comb_gaps() {
         assert!(winding(&comb.positions, &comb.triangles, gap).abs() < 1e-6);
@@ -618,6 +659,9 @@ fn bundled_comb_fingers_stay_apart() {
             "the middle of the gap",
         );
     }
+    let (pmvc_moved, mvc_moved) = neighbours_moved(&comb, &generated.cage);
+    assert!(pmvc_moved < 1e-6, "PMVC moves a neighbour by {pmvc_moved}");
+    assert!(mvc_moved > 1e-3, "MVC moves the neighbours by {mvc_moved}");
 }
 
 #[test]

@@ -275,5 +275,32 @@ fn the_voxel_size_box_sets_the_voxels_the_proposal_is_made_from() {
         (share - 0.05).abs() < 1e-9,
         "voxel size {share} of the diagonal"
     );
-    harness.get_by_label_contains("(5.00% of the mesh diagonal)");
+    harness.get_by_label_contains("(5.00% of the mesh diagonal, as asked)");
+}
+
+/// Bound to a generated cage, the handles drag the mesh as with any other cage.
+#[test]
+fn a_generated_cage_binds_and_its_handles_drag_the_mesh() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    choose_in_file_menu(&mut harness, "Generate cage…");
+    harness.state_mut().cage_generation_mut().target_vertices = 24;
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    click_button(&mut harness, "Use this cage");
+    run_until_bound(&mut harness);
+    let method = harness.state().active_method();
+    let weights = harness.state().document().weights(method).expect("bound");
+    assert_eq!(
+        weights.cols,
+        harness.state().document().cage().vertex_count()
+    );
+    let (handle, rest_drawn) = drag_an_isolated_handle(&mut harness);
+    let app = harness.state();
+    let moved_handle =
+        app.document().pose()[handle].distance(app.document().cage().positions()[handle]);
+    assert!(moved_handle > 1e-3, "the handle moved by {moved_handle}");
+    let drawn = app.read_back_deformed().unwrap().unwrap();
+    let moved = max_distance(&drawn, &rest_drawn);
+    assert!(moved > 1e-3, "the drawn mesh moved by {moved}");
 }

@@ -129,16 +129,7 @@ fn a_dragged_handle_moves_the_mesh_as_the_library_deforms_it() {
     run_until_bound(&mut harness);
     assert_eq!(harness.state().active_method(), Method::Green);
     assert!(harness.state().document().weights(Method::Green).is_some());
-    let rest_drawn = harness.state().read_back_deformed().unwrap().unwrap();
-    let (handle, at) = isolated_handle(&harness);
-    click(&mut harness, at);
-    drag(
-        &mut harness,
-        at,
-        at + egui::vec2(60.0, -30.0),
-        egui::Modifiers::NONE,
-    );
-    harness.run_steps(2);
+    let (handle, rest_drawn) = drag_an_isolated_handle(&mut harness);
     let app = harness.state();
     let cage = app.document().cage();
     let pose = app.document().pose().to_vec();

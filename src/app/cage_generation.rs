@@ -36,7 +36,7 @@ pub struct CageGeneration {
     pub target_vertices: usize,
     /// The user set the target: opening the window keeps it.
     pub(super) target_chosen: bool,
-    /// Whether to ask for a clearance (else the generator picks one voxel).
+    /// Whether to ask for a clearance (else the generator keeps 1/128 of the diagonal).
     pub use_clearance: bool,
     /// The clearance, in % of the mesh's bounding-box diagonal.
     pub clearance_percent: f64,
@@ -71,8 +71,9 @@ enum State {
         message: Option<String>,
     },
     Running(Job),
-    /// A cage generated around `mesh`, not yet used.
-    Proposed(Proposal),
+    /// A cage generated around `mesh`, not yet used (boxed: its statistics
+    /// make it much larger than the other states).
+    Proposed(Box<Proposal>),
 }
 
 struct Job {
@@ -203,11 +204,11 @@ impl CageGeneration {
                 let mesh = Arc::clone(&job.mesh);
                 self.state = match finished {
                     Ok(generated) if Arc::ptr_eq(&mesh, current_mesh) => {
-                        State::Proposed(Proposal {
+                        State::Proposed(Box::new(Proposal {
                             edges: unique_edges(generated.cage.triangles()),
                             generated,
                             mesh,
-                        })
+                        }))
                     }
                     Ok(_) => State::Idle {
                         message: Some("the mesh changed while the cage was generated".into()),
@@ -226,7 +227,7 @@ impl CageGeneration {
 
     fn take_proposal(&mut self) -> Option<Proposal> {
         match std::mem::replace(&mut self.state, State::Idle { message: None }) {
-            State::Proposed(proposal) => Some(proposal),
+            State::Proposed(proposal) => Some(*proposal),
             other => {
                 self.state = other;
                 None
@@ -252,11 +253,13 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
             "target not reached: {} vertices is outside {} ± 15% ({low} to {high})",
             stats.vertices, stats.target_vertices
         ));
-        if stats.vertices > high {
+        if stats.vertices > high && !stats.cell_size_chosen {
             lines.push(
                 "  (larger voxels reach fewer vertices, but parts closer than about three voxels then merge)"
                     .to_owned(),
             );
+        } else if stats.vertices > high {
+            lines.push("  (coarser voxels were tried too; this cage was the closest)".to_owned());
         }
     }
     lines.push(format!(
@@ -278,10 +281,30 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         None => "volume ratio (cage / mesh): none, the mesh encloses no volume".to_owned(),
     });
     lines.push(format!("minimum angle: {:.1}°", stats.min_angle_degrees));
+    let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
     lines.push(format!(
-        "voxel size: {:.6} ({:.2}% of the mesh diagonal)",
+        "voxel size: {:.6} ({:.2}% of the mesh diagonal, {})",
         stats.cell_size,
-        100.0 * stats.cell_size / stats.mesh_diagonal.max(f64::MIN_POSITIVE)
+        percent(stats.cell_size),
+        if stats.cell_size_chosen {
+            "chosen for the target"
+        } else {
+            "as asked"
+        }
+    ));
+    lines.push(format!(
+        "parts of the mesh closer than about {:.6} ({:.1}% of the diagonal) may share one part of the cage{}",
+        stats.merge_distance(),
+        percent(stats.merge_distance()),
+        if stats.merge_distance() > 3.0 * stats.cell_size {
+            "; to reach the target the cage was allowed half that far from the mesh, and more vertices keep closer parts apart"
+        } else if stats.cell_size_chosen
+            && stats.cell_size > 1.05 * DEFAULT_CELL_SIZE * stats.mesh_diagonal
+        {
+            "; a smaller voxel size keeps them apart, with more vertices"
+        } else {
+            ""
+        }
     ));
     if show_time {
         lines.push(format!("time: {:.2} s", stats.seconds));

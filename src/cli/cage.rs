@@ -20,11 +20,12 @@ pub struct CageArgs {
     #[arg(long, value_name = "C.obj")]
     pub out: PathBuf,
     /// The gap between the mesh and the cage, as a fraction of the mesh's
-    /// bounding-box diagonal (e.g. 0.02; default: one voxel).
+    /// bounding-box diagonal (e.g. 0.02; default: 1/128, 0.0078125).
     #[arg(long, value_name = "FRACTION")]
     pub clearance: Option<f64>,
-    /// The voxel size, as a fraction of the diagonal (default: chosen from the
-    /// mesh and N). Parts closer than about three voxels merge.
+    /// The voxel size, as a fraction of the diagonal (default: chosen for N,
+    /// from 1/128 up). Parts closer than about three voxels merge; a size given
+    /// here is never coarsened, even when N is then missed.
     #[arg(long, value_name = "FRACTION")]
     pub cell_size: Option<f64>,
 }

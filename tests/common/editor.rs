@@ -172,6 +172,19 @@ pub fn drag(harness: &mut Harness<'static, EditorApp>, from: Pos2, to: Pos2, mod
     harness.event(Event::ModifiersChanged(Modifiers::NONE));
 }
 
+/// Select a handle away from the others and drag it across the viewport,
+/// returning it and the drawn mesh from before the drag.
+pub fn drag_an_isolated_handle(
+    harness: &mut Harness<'static, EditorApp>,
+) -> (usize, Vec<glam::Vec3>) {
+    let before = harness.state().read_back_deformed().unwrap().unwrap();
+    let (handle, at) = isolated_handle(harness);
+    click(harness, at);
+    drag(harness, at, at + egui::vec2(60.0, -30.0), Modifiers::NONE);
+    harness.run_steps(2);
+    (handle, before)
+}
+
 pub fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
     a.iter()
         .zip(b)

@@ -76,14 +76,14 @@ impl EditorApp {
                     optional_percent(
                         ui,
                         (&mut generation.use_clearance, "Clearance"),
-                        "The gap between the mesh and the cage; off: one voxel",
+                        "The gap between the mesh and the cage; off: 0.78% of the diagonal",
                         &mut generation.clearance_percent,
                         (0.1, 49.0),
                     );
                     optional_percent(
                         ui,
                         (&mut generation.use_cell_size, "Voxel size"),
-                        "Larger voxels reach fewer vertices; parts closer than about three voxels merge",
+                        "Off: chosen for the target, from 0.78% of the diagonal up. Larger voxels reach fewer vertices; parts closer than about three voxels merge",
                         &mut generation.cell_size_percent,
                         (0.2, 20.0),
                     );

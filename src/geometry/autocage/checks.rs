@@ -6,39 +6,21 @@ use super::guard::{inside_tetrahedron, min_angle};
 use super::simplify::State;
 use crate::geometry::intersect::triangles_cross;
 use glam::DVec3;
-use rayon::prelude::*;
 
 /// New faces may not be sharper than this (unless the faces they replace were).
 const MIN_ANGLE_DEGREES: f64 = 3.0;
 /// A new face may turn at most this far from the face it replaces (cosine).
 const MAX_TURN_COSINE: f64 = 0.0;
 
-impl State {
+impl State<'_> {
     /// Whether a mesh point near the collapse lies between the old faces and
     /// the new ones, and so would end up outside the cage.
-    pub(super) fn uncovers_mesh_points(&mut self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for p in old.iter().chain(new).flatten() {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let mut nearby = Vec::new();
-        self.stamp += 1;
-        self.mesh_hash
-            .query(lo, hi, &mut self.seen_mesh_points, self.stamp, &mut nearby);
-        any_of(&nearby, |i| {
-            let q = self.mesh_points[i as usize];
-            if q.cmplt(lo).any() || q.cmpgt(hi).any() {
-                return false;
-            }
-            // The old and new faces bound the swept region; a ray from q crosses
-            // them an odd number of times exactly when q is inside it.
-            let crossings = old
-                .iter()
-                .chain(new)
-                .filter(|t| ray_hits_triangle(q, **t))
-                .count();
-            crossings % 2 == 1
+    pub(super) fn uncovers_mesh_points(&self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
+        // The old and new faces bound the swept region; a ray from a point
+        // crosses them an odd number of times exactly when it is inside.
+        let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
+        self.mesh_points.any_enclosed(&faces, |q, faces| {
+            faces.iter().filter(|t| ray_hits_triangle(q, **t)).count() % 2 == 1
         })
     }
 
@@ -96,9 +78,15 @@ impl State {
                 self.stamp,
                 &mut nearby,
             );
+            let (lo, hi) = (p.min(q).min(r) - pad, p.max(q).max(r) + pad);
             for &other in &nearby {
                 let o = other as usize;
                 if !self.triangle_alive[o] || star.binary_search(&other).is_ok() {
+                    continue;
+                }
+                // Most faces filed in the same cells are not even near.
+                let [u, v, w] = self.corners(o);
+                if u.max(v).max(w).cmplt(lo).any() || u.min(v).min(w).cmpgt(hi).any() {
                     continue;
                 }
                 if self.crosses(*tri, self.triangles[o]) {
@@ -167,19 +155,9 @@ impl State {
     }
 }
 
-/// Whether `test` holds for any of `items`, on every core when there are many:
-/// late in a simplification one face spans thousands of mesh points.
-pub(super) fn any_of(items: &[u32], test: impl Fn(u32) -> bool + Sync) -> bool {
-    if items.len() < 2048 {
-        items.iter().any(|&i| test(i))
-    } else {
-        items.par_iter().with_min_len(1024).any(|&i| test(i))
-    }
-}
-
 /// Whether the ray from `origin` along a fixed direction (chosen to be parallel
 /// to no voxel face or edge) passes through the triangle (Möller and Trumbore).
-fn ray_hits_triangle(origin: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
+pub(super) fn ray_hits_triangle(origin: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
     const DIRECTION: DVec3 = DVec3::new(0.573_462_1, 0.612_345_7, 0.544_125_3);
     let (e1, e2) = (b - a, c - a);
     let p = DIRECTION.cross(e2);

@@ -4,19 +4,20 @@
 
 use glam::DVec3;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// Items (triangle or vertex indices) filed under every cell their box touches.
 /// Entries go stale as the surface changes; callers check what they get back.
 pub(super) struct SpatialHash {
     cell: f64,
-    cells: HashMap<[i32; 3], Vec<u32>>,
+    cells: HashMap<[i32; 3], Vec<u32>, BuildHasherDefault<CellHasher>>,
 }
 
 impl SpatialHash {
     pub(super) fn new(cell: f64) -> SpatialHash {
         SpatialHash {
             cell,
-            cells: HashMap::new(),
+            cells: HashMap::default(),
         }
     }
 
@@ -101,4 +102,31 @@ pub(super) fn min_angle([a, b, c]: [DVec3; 3]) -> f64 {
     let angle = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p);
     let (x, y) = (angle(a, b, c), angle(b, c, a));
     x.min(y).min(std::f64::consts::PI - x - y)
+}
+
+/// A multiply-and-rotate hash for cell keys: the keys are not chosen by an
+/// adversary, and the default hasher was a tenth of the simplification's time.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(4) {
+            let mut word = [0u8; 4];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u32(u32::from_le_bytes(word));
+        }
+    }
+
+    fn write_u32(&mut self, value: u32) {
+        self.0 = (self.0.rotate_left(5) ^ u64::from(value)).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+
+    fn write_usize(&mut self, value: usize) {
+        self.write_u32(value as u32);
+    }
 }

@@ -30,6 +30,7 @@
 mod checks;
 mod guard;
 mod measure;
+mod points;
 mod shrink;
 mod simplify;
 mod surface;
@@ -46,7 +47,7 @@ pub struct CageOptions {
     /// About how many vertices the cage should have (at least 8).
     pub target_vertices: usize,
     /// Gap between the mesh and the cage, as a fraction of the mesh's
-    /// bounding-box diagonal. `None` picks one voxel.
+    /// bounding-box diagonal. `None` picks [`DEFAULT_CLEARANCE`].
     pub clearance: Option<f64>,
     /// Voxel size, as a fraction of the diagonal. `None` picks one from the
     /// mesh's size and the target. Parts closer than about three voxels merge.
@@ -100,6 +101,11 @@ pub struct CageStats {
     pub min_angle_degrees: f64,
     /// Voxel size and grid used.
     pub cell_size: f64,
+    /// Whether the voxel size was chosen by the generator rather than asked for.
+    pub cell_size_chosen: bool,
+    /// How far from the mesh's voxels the cage was allowed to go in the end
+    /// (the envelope, widened when no collapse was left).
+    pub reach: f64,
     pub grid: [usize; 3],
     /// Vertices of the voxel surface before simplification.
     pub surface_vertices: usize,
@@ -110,6 +116,13 @@ impl CageStats {
     /// Cage volume ÷ mesh volume; `None` when the mesh encloses no volume.
     pub fn volume_ratio(&self) -> Option<f64> {
         (self.mesh_volume > 0.0).then(|| self.cage_volume / self.mesh_volume)
+    }
+
+    /// Parts of the mesh closer than this may share one part of the cage: about
+    /// three voxels, or twice the reach (a cage that may stand that far from
+    /// both sides of a gap may cross it).
+    pub fn merge_distance(&self) -> f64 {
+        (3.0 * self.cell_size).max(2.0 * (self.reach + self.cell_size))
     }
 
     /// Whether the vertex count is within ±15 % of the target.
@@ -147,18 +160,45 @@ pub enum AutoCageError {
     NotEnclosing { outside: usize, first: usize },
 }
 
-/// Voxel size when none is asked for, as a fraction of the diagonal: parts
-/// about 2.5 % of the diagonal apart stay apart.
+/// Finest voxel size, as a fraction of the diagonal: parts about 2.5 % of the
+/// diagonal apart stay apart. Coarser voxels are chosen when the target is too
+/// small for this much detail.
 pub const DEFAULT_CELL_SIZE: f64 = 1.0 / 128.0;
+/// Gap between the mesh and the cage when none is asked for, as a fraction of
+/// the diagonal.
+pub const DEFAULT_CLEARANCE: f64 = 1.0 / 128.0;
 /// The most voxels along the longest side, so that a tiny requested cell size
 /// cannot exhaust memory.
 const MAX_CELLS_PER_SIDE: f64 = 512.0;
+/// The coarsest voxel size chosen without being asked, as a fraction of the
+/// diagonal.
+const MAX_CHOSEN_CELL_SIZE: f64 = 1.0 / 12.0;
+/// Vertices of the voxel surface that the first try starts from at most: the
+/// simplification's time grows with it (about 3 s for 16,000 on two cores).
+const MAX_SURFACE_VERTICES: f64 = 26_000.0;
+/// Mean cage edge, in voxels, that the simplification reaches reliably: the
+/// first try's voxels are at least a target-sized cage's mean edge divided by
+/// this (measured on the qmvc meshes, docs/cages.md).
+const EDGE_CELLS: f64 = 16.0;
+/// How many coarser voxel sizes are tried when a cage misses its target.
+const RETRIES: usize = 3;
 
+/// How far past the clearance the envelope may widen on the first try, as a
+/// fraction of the diagonal, however coarse the voxels: the cage's slack from
+/// the mesh. Each retry raises it by half.
+const MAX_REACH: f64 = 0.08;
 /// Empty cells around the mesh's bounds: how far the cage may ever be from it.
 const MARGIN_CELLS: usize = 12;
 
 /// Generate a cage around `mesh`. `progress` is called with the fraction done
 /// (0 to 1) and returns `false` to cancel.
+///
+/// Without a voxel size, the first try uses [`DEFAULT_CELL_SIZE`], or coarser
+/// voxels when the mesh's voxel surface would have more than
+/// [`MAX_SURFACE_VERTICES`]. When that cage has more than 15 % over the target,
+/// coarser voxels are tried (at most [`RETRIES`] times), which merge parts
+/// closer than about three voxels; the cage closest to the target is kept, and
+/// its voxel size is reported.
 pub fn generate_cage(
     mesh: &TriMesh,
     options: &CageOptions,
@@ -168,23 +208,97 @@ pub fn generate_cage(
     check_options(mesh, options)?;
     let diagonal = mesh.diagonal();
     let (lo, hi) = mesh.bounds();
-    let longest = (hi - lo).max_element();
-    let cell = (options.cell_size.unwrap_or(DEFAULT_CELL_SIZE) * diagonal)
-        .max(longest / MAX_CELLS_PER_SIDE);
-    let clearance_cells = options
-        .clearance
-        .map_or(1, |c| (c * diagonal / cell).ceil().max(1.0) as usize);
-    let stage = |from: f32, to: f32| move |f: f32| progress(from + (to - from) * f);
-
+    let finest = (hi - lo).max_element() / MAX_CELLS_PER_SIDE;
+    let clearance = options.clearance.unwrap_or(DEFAULT_CLEARANCE) * diagonal;
     let tree = TriangleTree::new(&mesh.positions, &mesh.triangles);
-    let mut voxels = voxels::voxelise(
-        mesh,
-        &tree,
-        cell,
-        clearance_cells + MARGIN_CELLS,
-        &stage(0.0, 0.15),
-    )
-    .ok_or(AutoCageError::Cancelled)?;
+    let target = options.target_vertices;
+    let mesh_points = points::PointTree::new(measure::surface_samples(mesh, 0.5 * clearance));
+
+    let mut cell = (options.cell_size.unwrap_or(DEFAULT_CELL_SIZE) * diagonal).max(finest);
+    let mut surface = voxel_surface(mesh, &tree, cell, clearance, &|f| progress(0.05 * f))?;
+    let chosen = options.cell_size.is_none();
+    let coarsest = MAX_CHOSEN_CELL_SIZE * diagonal;
+    if chosen {
+        // A voxel surface has about one vertex per cell² of area, so its
+        // vertex count goes as the inverse square of the cell size.
+        let vertices = surface.surface.positions.len() as f64;
+        let for_time = (vertices / MAX_SURFACE_VERTICES).sqrt();
+        let for_target = (1.15 * vertices / target as f64).sqrt() / EDGE_CELLS;
+        let wanted = (cell * for_time.max(for_target)).min(coarsest);
+        if wanted > 1.05 * cell {
+            cell = wanted;
+            surface = voxel_surface(mesh, &tree, cell, clearance, &|f| progress(0.05 + 0.05 * f))?;
+        }
+    }
+    let attempts = if chosen { 1 + RETRIES } else { 1 };
+    let mut best: Option<Attempt> = None;
+    let mut next_surface = Some(surface);
+    for attempt in 0..attempts {
+        // The first try has most of the bar: retries are on smaller surfaces.
+        let share = |k: usize| 0.1 + 0.85 * (1.0 - 0.4f32.powi(k as i32));
+        let (from, to) = (share(attempt), share(attempt + 1));
+        let span = move |f: f32| progress(from + (to - from) * f);
+        let surface = match next_surface.take() {
+            Some(surface) => surface,
+            None => voxel_surface(mesh, &tree, cell, clearance, &|f| span(0.1 * f))?,
+        };
+        // Each retry may also stand further off the mesh.
+        let reach = MAX_REACH * diagonal * 1.5f64.powi(attempt as i32);
+        let goal = Goal {
+            target,
+            clearance,
+            reach,
+        };
+        let result = simplify_surface(surface, &mesh_points, &goal, diagonal, &|f| {
+            span(0.1 + 0.9 * f)
+        })?;
+        let reached = result.simplified.positions.len();
+        let closer = best
+            .as_ref()
+            .is_none_or(|b| reached < b.simplified.positions.len());
+        if closer {
+            best = Some(result);
+        }
+        if reached as f64 <= 1.15 * target as f64 || cell >= coarsest {
+            break;
+        }
+        // Larger steps when the target is far off.
+        let factor = ((reached as f64 / target as f64).sqrt() / 2.0).clamp(1.5, 3.0);
+        cell = (cell * factor).min(coarsest);
+    }
+    let Some(best) = best else {
+        return Err(AutoCageError::Cancelled);
+    };
+    finish(mesh, best, target, chosen, started, progress)
+}
+
+/// A closed voxel surface around the mesh, at least `clearance` from it.
+struct VoxelSurface {
+    surface: surface::Surface,
+    envelope: voxels::Envelope,
+    clearance_cells: usize,
+    voxel_volume: f64,
+}
+
+/// The cage of one voxel size, before it is checked.
+struct Attempt {
+    simplified: simplify::Simplified,
+    cell: f64,
+    grid: [usize; 3],
+    surface_vertices: usize,
+    voxel_volume: f64,
+}
+
+fn voxel_surface(
+    mesh: &TriMesh,
+    tree: &TriangleTree,
+    cell: f64,
+    clearance: f64,
+    progress: &dyn Fn(f32) -> bool,
+) -> Result<VoxelSurface, AutoCageError> {
+    let clearance_cells = (clearance / cell).ceil().max(1.0) as usize;
+    let mut voxels = voxels::voxelise(mesh, tree, cell, clearance_cells + MARGIN_CELLS, progress)
+        .ok_or(AutoCageError::Cancelled)?;
     let voxel_volume = voxels.count() as f64 * cell.powi(3);
     let envelope = voxels::Envelope {
         origin: voxels.origin,
@@ -196,26 +310,79 @@ pub fn generate_cage(
     voxels::dilate(&mut voxels, clearance_cells);
     voxels::fill_cavities(&mut voxels);
     voxels::make_well_composed(&mut voxels);
-    let surface = surface::boundary_surface(&voxels);
-    if !progress(0.2) {
-        return Err(AutoCageError::Cancelled);
-    }
+    Ok(VoxelSurface {
+        surface: surface::boundary_surface(&voxels),
+        envelope,
+        clearance_cells,
+        voxel_volume,
+    })
+}
+
+/// What one try aims for: vertices, and the least and most distance from
+/// the mesh.
+struct Goal {
+    target: usize,
+    clearance: f64,
+    reach: f64,
+}
+
+fn simplify_surface(
+    voxel_surface: VoxelSurface,
+    mesh_points: &points::PointTree,
+    goal: &Goal,
+    diagonal: f64,
+    progress: &dyn Fn(f32) -> bool,
+) -> Result<Attempt, AutoCageError> {
+    let VoxelSurface {
+        surface,
+        envelope,
+        clearance_cells,
+        voxel_volume,
+    } = voxel_surface;
+    let (cell, grid) = (envelope.cell, envelope.dims);
     let surface_vertices = surface.positions.len();
-    let mesh_points = measure::surface_samples(mesh, 0.5 * clearance_cells as f64 * cell);
     let simplified = simplify::simplify(
         mesh_points,
         surface.positions,
         surface.triangles,
         envelope,
         &simplify::Goal {
-            target_vertices: options.target_vertices,
-            max_limit: (clearance_cells + MARGIN_CELLS) as u16,
-            clearance: clearance_cells as f64 * cell,
+            target_vertices: goal.target,
+            max_limit: (clearance_cells + MARGIN_CELLS)
+                .min(clearance_cells + 2 + (goal.reach / cell).ceil() as usize)
+                as u16,
+            clearance: goal.clearance,
             diagonal,
         },
-        &stage(0.2, 0.95),
+        progress,
     )
     .ok_or(AutoCageError::Cancelled)?;
+    Ok(Attempt {
+        simplified,
+        cell,
+        grid,
+        surface_vertices,
+        voxel_volume,
+    })
+}
+
+/// Check the chosen cage independently and measure it.
+fn finish(
+    mesh: &TriMesh,
+    attempt: Attempt,
+    target_vertices: usize,
+    cell_size_chosen: bool,
+    started: Instant,
+    progress: &dyn Fn(f32) -> bool,
+) -> Result<GeneratedCage, AutoCageError> {
+    let Attempt {
+        simplified,
+        cell,
+        grid,
+        surface_vertices,
+        voxel_volume,
+    } = attempt;
+    let reach = f64::from(simplified.envelope_limit) * cell;
     let triangle_faces = (0..simplified.triangles.len() as u32).collect();
     let (cage, report) = Cage::new(TriMesh {
         positions: simplified.positions,
@@ -238,17 +405,19 @@ pub fn generate_cage(
     let stats = CageStats {
         vertices: cage.vertex_count(),
         triangles: cage.triangle_count(),
-        target_vertices: options.target_vertices,
+        target_vertices,
         shells: measure::shell_count(&cage),
         min_clearance: enclosure.min_clearance,
-        mesh_diagonal: diagonal,
+        mesh_diagonal: mesh.diagonal(),
         outside_vertices: 0,
         cage_volume: report.volume,
         mesh_volume,
         mesh_volume_from_voxels,
         min_angle_degrees: measure::min_angle_degrees(&cage),
         cell_size: cell,
-        grid: voxels.dims,
+        cell_size_chosen,
+        reach,
+        grid,
         surface_vertices,
         seconds: started.elapsed().as_secs_f64(),
     };

@@ -4,17 +4,16 @@
 //! the mesh leaves room.
 
 use super::simplify::State;
-use crate::geometry::closest_point_on_triangle;
 use glam::DVec3;
 
 /// Fractions of the step tried for each vertex, largest first.
 const TRIES: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0625];
 const PASSES: usize = 4;
 
-impl State {
+impl State<'_> {
     /// Slide vertices inward, `PASSES` times over all of them, by at most
-    /// `step` each time, never closer than `clearance` to a mesh point.
-    pub(super) fn shrink(&mut self, step: f64, clearance: f64) {
+    /// `step` each time, never closer than the clearance to a mesh point.
+    pub(super) fn shrink(&mut self, step: f64) {
         for _ in 0..PASSES {
             let mut moved = false;
             for v in 0..self.positions.len() {
@@ -27,7 +26,7 @@ impl State {
                 let start = self.positions[v];
                 moved |= TRIES
                     .iter()
-                    .any(|t| self.try_move(v, start + inward * (step * t), clearance));
+                    .any(|t| self.try_move(v, start + inward * (step * t)));
             }
             if !moved {
                 return;
@@ -47,7 +46,7 @@ impl State {
             .map(|n| -n)
     }
 
-    fn try_move(&mut self, v: usize, position: DVec3, clearance: f64) -> bool {
+    fn try_move(&mut self, v: usize, position: DVec3) -> bool {
         let star = self.vertex_triangles[v].clone();
         let replaced: Vec<(u32, [u32; 3])> = star
             .iter()
@@ -63,7 +62,7 @@ impl State {
             && !self.crosses_anything(&replaced, &sorted_star)
             && !self.sweeps_over_vertices(v, v, old, &sorted_star, &new_corners)
             && !self.uncovers_mesh_points(&old_corners, &new_corners)
-            && !self.near_mesh_points(&new_corners, clearance);
+            && !self.near_mesh_points(&new_corners, self.clearance);
         if !accepted {
             self.positions[v] = old;
             return false;
@@ -77,23 +76,7 @@ impl State {
     }
 
     /// Whether a mesh point is closer than `clearance` to one of the faces.
-    fn near_mesh_points(&mut self, faces: &[[DVec3; 3]], clearance: f64) -> bool {
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for p in faces.iter().flatten() {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let (lo, hi) = (lo - DVec3::splat(clearance), hi + DVec3::splat(clearance));
-        let mut nearby = Vec::new();
-        self.stamp += 1;
-        self.mesh_hash
-            .query(lo, hi, &mut self.seen_mesh_points, self.stamp, &mut nearby);
-        super::checks::any_of(&nearby, |i| {
-            let q = self.mesh_points[i as usize];
-            faces.iter().any(|[a, b, c]| {
-                let (closest, _) = closest_point_on_triangle(q, *a, *b, *c);
-                closest.distance_squared(q) < clearance * clearance
-            })
-        })
+    pub(super) fn near_mesh_points(&self, faces: &[[DVec3; 3]], clearance: f64) -> bool {
+        self.mesh_points.any_within(faces, clearance)
     }
 }

@@ -1,12 +1,14 @@
 //! Outward-only simplification (progressive hulls, Sander et al. 2000): edge
-//! collapses in order of quadric error (Garland and Heckbert 1997), where the
-//! new vertex must lie on or outside the plane of every face around the edge.
+//! collapses in order of the volume they add, where the new vertex must lie on
+//! or outside the plane of every face around the edge, and the quadric of
+//! Garland and Heckbert (1997) proposes one of the places it may go.
 //! Each new surface then encloses the one before, and so the voxels and the
 //! mesh. A collapse is refused when it would break the surface's link
 //! condition, flip or squash a face, make two faces cross, or sweep over
 //! another part of the surface.
 
 use super::guard::SpatialHash;
+use super::points::PointTree;
 use super::voxels::Envelope;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -37,10 +39,6 @@ impl Quadric {
             b: self.b + other.b,
             c: self.c + other.c,
         }
-    }
-
-    fn error(&self, v: DVec3) -> f64 {
-        (v.dot(self.a * v) + 2.0 * self.b.dot(v) + self.c).max(0.0)
     }
 
     /// The point of least error, when the quadric pins one down.
@@ -80,9 +78,11 @@ impl PartialOrd for Candidate {
 pub(super) struct Simplified {
     pub positions: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
+    /// The envelope's limit at the end, in cells from the mesh's voxels.
+    pub envelope_limit: u16,
 }
 
-pub(super) struct State {
+pub(super) struct State<'a> {
     pub(super) positions: Vec<DVec3>,
     pub(super) triangles: Vec<[u32; 3]>,
     pub(super) triangle_alive: Vec<bool>,
@@ -98,9 +98,9 @@ pub(super) struct State {
     pub(super) seen_triangles: Vec<u32>,
     pub(super) seen_vertices: Vec<u32>,
     /// Points of the mesh (vertices and face centres) that must stay inside.
-    pub(super) mesh_points: Vec<DVec3>,
-    pub(super) mesh_hash: SpatialHash,
-    pub(super) seen_mesh_points: Vec<u32>,
+    pub(super) mesh_points: &'a PointTree,
+    /// Least distance from the mesh points that a change may leave.
+    pub(super) clearance: f64,
     pub(super) stamp: u32,
     pub(super) tolerance: f64,
     pub(super) volume_tolerance: f64,
@@ -120,15 +120,14 @@ pub(super) struct Goal {
 /// collapse is allowed, then tighten it. Returns `None` when `progress` asks
 /// to stop.
 pub(super) fn simplify(
-    mesh_points: Vec<DVec3>,
+    mesh_points: &PointTree,
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     mut envelope: Envelope,
     goal: &Goal,
     progress: &dyn Fn(f32) -> bool,
 ) -> Option<Simplified> {
-    let mut state = State::new(positions, triangles, envelope.cell, goal.diagonal);
-    state.set_mesh_points(mesh_points);
+    let mut state = State::new(positions, triangles, envelope.cell, mesh_points, goal);
     let start = state.alive_vertices;
     let mut heap = state.all_candidates(&envelope);
     let mut steps = 0usize;
@@ -151,14 +150,14 @@ pub(super) fn simplify(
             continue;
         }
         // Faces nearby may have changed since this entry was made.
-        let Some(fresh) = state.candidate(entry.a, entry.b) else {
+        let positions = state.positions(a, b);
+        let Some(&(cost, _)) = positions.first() else {
             continue;
         };
-        if fresh.cost > entry.cost * (1.0 + 1e-9) + 1e-300 {
-            heap.push(fresh);
+        if cost > entry.cost + 1e-9 * entry.cost.abs() + state.volume_tolerance {
+            heap.push(Candidate { cost, ..entry });
             continue;
         }
-        let positions = state.positions(a, b);
         if !positions
             .iter()
             .any(|&(_, p)| state.collapse(a, b, p, &envelope))
@@ -182,11 +181,11 @@ pub(super) fn simplify(
     if !progress(0.9) {
         return None;
     }
-    state.shrink(2.0 * envelope.cell, goal.clearance);
-    Some(state.finish())
+    state.shrink(2.0 * envelope.cell);
+    Some(state.finish(envelope.limit))
 }
 
-impl State {
+impl<'a> State<'a> {
     fn all_candidates(&self, envelope: &Envelope) -> BinaryHeap<Candidate> {
         let _ = envelope;
         let edges: Vec<(u32, u32)> = (0..self.triangles.len())
@@ -204,7 +203,14 @@ impl State {
             .into()
     }
 
-    fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>, cell: f64, diagonal: f64) -> State {
+    fn new(
+        positions: Vec<DVec3>,
+        triangles: Vec<[u32; 3]>,
+        cell: f64,
+        mesh_points: &'a PointTree,
+        goal: &Goal,
+    ) -> State<'a> {
+        let diagonal = goal.diagonal;
         let mut vertex_triangles = vec![Vec::new(); positions.len()];
         let mut quadrics = vec![Quadric::default(); positions.len()];
         for (t, tri) in triangles.iter().enumerate() {
@@ -229,9 +235,8 @@ impl State {
             triangles_at_rebuild: triangles.len(),
             seen_triangles: vec![0; triangles.len()],
             seen_vertices: vec![0; count],
-            mesh_points: Vec::new(),
-            mesh_hash: SpatialHash::new(cell),
-            seen_mesh_points: Vec::new(),
+            mesh_points,
+            clearance: goal.clearance,
             stamp: 0,
             tolerance: 1e-9 * diagonal,
             volume_tolerance: 1e-12 * diagonal.powi(3),
@@ -242,15 +247,6 @@ impl State {
         };
         state.rebuild_hashes(2.0 * cell);
         state
-    }
-
-    fn set_mesh_points(&mut self, points: Vec<DVec3>) {
-        self.mesh_hash = SpatialHash::new(self.triangle_hash.cell_size());
-        for (i, p) in points.iter().enumerate() {
-            self.mesh_hash.insert(i as u32, *p, *p);
-        }
-        self.seen_mesh_points = vec![0; points.len()];
-        self.mesh_points = points;
     }
 
     pub(super) fn corners(&self, t: usize) -> [DVec3; 3] {
@@ -294,7 +290,8 @@ impl State {
     /// Where the merged vertex may go, best first: the quadric's optimum (when
     /// it is near the edge), points along the edge and its two ends, each
     /// pushed out along the star's mean normal until it is on or outside every
-    /// face plane, ordered by error.
+    /// face plane, ordered by the volume the collapse adds (measured in
+    /// docs/cages.md: cages 20–40 % smaller than ordered by quadric error).
     fn positions(&self, a: usize, b: usize) -> Vec<(f64, DVec3)> {
         let star = self.star(a, b);
         let planes: Vec<(DVec3, DVec3)> = star
@@ -336,11 +333,30 @@ impl State {
                     push = push.max(-distance / rate);
                 }
                 let position = start + mean * push;
-                Some((quadric.error(position), position))
+                Some((self.added_volume(a, b, &star, position), position))
             })
             .collect();
         found.sort_by(|x, y| x.0.total_cmp(&y.0));
         found
+    }
+
+    /// Volume the surface gains when (a, b) collapses to `position`: the
+    /// progressive hull's cost (Sander et al. 2000), which keeps it tight.
+    fn added_volume(&self, a: usize, b: usize, star: &[u32], position: DVec3) -> f64 {
+        let volume = |[p, q, r]: [DVec3; 3]| p.dot(q.cross(r));
+        let before: f64 = star.iter().map(|&t| volume(self.corners(t as usize))).sum();
+        let after: f64 = star
+            .iter()
+            .map(|&t| self.triangles[t as usize])
+            .filter(|tri| !(tri.contains(&(a as u32)) && tri.contains(&(b as u32))))
+            .map(|tri| {
+                volume(tri.map(|i| match i as usize {
+                    i if i == a || i == b => position,
+                    i => self.positions[i],
+                }))
+            })
+            .sum();
+        (after - before) / 6.0
     }
 
     /// Collapse edge (a, b) into `a` at `position` if every check passes.
@@ -364,20 +380,22 @@ impl State {
         let old_corners: Vec<[DVec3; 3]> = star.iter().map(|&t| self.corners(t as usize)).collect();
         let (old_a, old_b) = (self.positions[a], self.positions[b]);
         self.positions[a] = position;
-        let shapes = self.shapes_are_good(&replaced, (a, b), (old_a, old_b))
-            && replaced
-                .iter()
-                .all(|(_, tri)| envelope.allows_triangle(tri.map(|i| self.positions[i as usize])));
-        let crosses = shapes && self.crosses_anything(&replaced, &star);
-        let sweeps =
-            shapes && !crosses && self.sweeps_over_vertices(a, b, position, &star, &old_corners);
-        let new_corners: Vec<[DVec3; 3]> = replaced
-            .iter()
-            .map(|(_, tri)| tri.map(|i| self.positions[i as usize]))
-            .collect();
-        let uncovers =
-            shapes && !crosses && !sweeps && self.uncovers_mesh_points(&old_corners, &new_corners);
-        let accepted = shapes && !crosses && !sweeps && !uncovers;
+        if !self.shapes_are_good(&replaced, (a, b), (old_a, old_b)) {
+            self.positions[a] = old_a;
+            return false;
+        }
+        // In a flat star, unflipped faces around a point of the same plane
+        // cover exactly the region the old ones did: nothing else can change.
+        let flat = self.lies_in_plane_of(&old_corners, position);
+        let accepted = flat
+            || self.changes_nothing_else(
+                (a, b),
+                position,
+                &star,
+                &old_corners,
+                &replaced,
+                envelope,
+            );
         if !accepted {
             self.positions[a] = old_a;
             return false;
@@ -427,6 +445,42 @@ impl State {
         true
     }
 
+    /// The checks a collapse of (a, b) into `a`, already moved to `position`,
+    /// must pass when it changes the region the surface covers.
+    fn changes_nothing_else(
+        &mut self,
+        (a, b): (usize, usize),
+        position: DVec3,
+        star: &[u32],
+        old_corners: &[[DVec3; 3]],
+        replaced: &[(u32, [u32; 3])],
+        envelope: &Envelope,
+    ) -> bool {
+        let new_corners: Vec<[DVec3; 3]> = replaced
+            .iter()
+            .map(|(_, tri)| tri.map(|i| self.positions[i as usize]))
+            .collect();
+        new_corners.iter().all(|&f| envelope.allows_triangle(f))
+            && !self.crosses_anything(replaced, star)
+            && !self.sweeps_over_vertices(a, b, position, star, old_corners)
+            && !self.uncovers_mesh_points(old_corners, &new_corners)
+            && !self.near_mesh_points(&new_corners, self.clearance)
+    }
+
+    /// Whether every corner of `faces` and `point` lie in one plane (to the
+    /// volume tolerance), with the faces all facing the same way.
+    fn lies_in_plane_of(&self, faces: &[[DVec3; 3]], point: DVec3) -> bool {
+        let Some(&[p, q, r]) = faces.first() else {
+            return false;
+        };
+        let normal = (q - p).cross(r - p);
+        let on_plane = |x: DVec3| normal.dot(x - p).abs() <= self.volume_tolerance;
+        on_plane(point)
+            && faces.iter().all(|&[u, v, w]| {
+                (v - u).cross(w - u).dot(normal) > 0.0 && [u, v, w].into_iter().all(on_plane)
+            })
+    }
+
     fn mean_edge_length(&self) -> f64 {
         let (sum, count) = (0..self.triangles.len())
             .filter(|&t| self.triangle_alive[t])
@@ -457,7 +511,7 @@ impl State {
         self.triangles_at_rebuild = self.alive_triangles;
     }
 
-    fn finish(self) -> Simplified {
+    fn finish(self, envelope_limit: u16) -> Simplified {
         let mut remap = vec![u32::MAX; self.positions.len()];
         let mut positions = Vec::with_capacity(self.alive_vertices);
         for (v, p) in self.positions.iter().enumerate() {
@@ -473,6 +527,7 @@ impl State {
         Simplified {
             positions,
             triangles,
+            envelope_limit,
         }
     }
 }

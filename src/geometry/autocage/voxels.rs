@@ -350,12 +350,14 @@ pub(super) struct Envelope {
 }
 
 impl Envelope {
-    fn allows(&self, p: DVec3) -> bool {
-        let c = ((p - self.origin) / self.cell).floor();
-        if c.cmplt(DVec3::ZERO).any() {
+    /// Whether the cell holding `p`, in cell units from the origin, is allowed.
+    fn allows_cell_point(&self, p: DVec3) -> bool {
+        // Truncation is the floor for the non-negative; `floor` itself is a
+        // library call here, and this runs for every sample of every face.
+        if p.x < 0.0 || p.y < 0.0 || p.z < 0.0 {
             return false;
         }
-        let [x, y, z] = [c.x as usize, c.y as usize, c.z as usize];
+        let [x, y, z] = [p.x as usize, p.y as usize, p.z as usize];
         let [nx, ny, nz] = self.dims;
         x < nx && y < ny && z < nz && self.distance[x + nx * (y + ny * z)] <= self.limit
     }
@@ -365,10 +367,12 @@ impl Envelope {
     pub(super) fn allows_triangle(&self, [a, b, c]: [DVec3; 3]) -> bool {
         let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
         let n = (2.0 * longest / self.cell).ceil().max(1.0) as usize;
+        let to_cells = |p: DVec3| (p - self.origin) / self.cell;
+        let a = to_cells(a);
+        let (step_b, step_c) = ((to_cells(b) - a) / n as f64, (to_cells(c) - a) / n as f64);
         (0..=n).all(|i| {
-            (0..=n - i).all(|j| {
-                self.allows(a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64))
-            })
+            let row = a + step_b * i as f64;
+            (0..=n - i).all(|j| self.allows_cell_point(row + step_c * j as f64))
         })
     }
 }
