@@ -9,7 +9,7 @@ use super::document::Document;
 use super::editor::EditorApp;
 use crate::geometry::autocage::{
     generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
-    MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
+    DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use crate::render::scene_gpu::unique_edges;
@@ -21,9 +21,6 @@ use std::sync::Arc;
 
 /// The target a first generation offers when the cage says nothing better.
 pub const DEFAULT_TARGET_VERTICES: usize = 64;
-
-/// Clearance offered when the user asks for one: 1 % of the mesh's diagonal.
-const DEFAULT_CLEARANCE_PERCENT: f64 = 1.0;
 
 /// The loose box a mesh opened alone sits in, this fraction of its diagonal
 /// away from it on every side.
@@ -57,7 +54,8 @@ impl Default for CageGeneration {
             target_vertices: DEFAULT_TARGET_VERTICES,
             target_chosen: false,
             use_clearance: false,
-            clearance_percent: DEFAULT_CLEARANCE_PERCENT,
+            // The box shows, greyed, what the generator uses when it is off.
+            clearance_percent: 100.0 * DEFAULT_CLEARANCE,
             use_cell_size: false,
             cell_size_percent: 100.0 * DEFAULT_CELL_SIZE,
             state: State::Idle { message: None },
