@@ -174,7 +174,8 @@ const MAX_CELLS_PER_SIDE: f64 = 512.0;
 /// diagonal.
 const MAX_CHOSEN_CELL_SIZE: f64 = 1.0 / 12.0;
 /// Vertices of the voxel surface that the first try starts from at most: the
-/// simplification's time grows with it (about 3 s for 16,000 on two cores).
+/// simplification's time grows with it (Beast's 15,000 take about 2.5 s on two
+/// cores, the comb's 26,000 about 4 s).
 const MAX_SURFACE_VERTICES: f64 = 26_000.0;
 /// Mean cage edge, in voxels, that the simplification reaches reliably: the
 /// first try's voxels are at least a target-sized cage's mean edge divided by
@@ -194,11 +195,11 @@ const MARGIN_CELLS: usize = 12;
 /// (0 to 1) and returns `false` to cancel.
 ///
 /// Without a voxel size, the first try uses [`DEFAULT_CELL_SIZE`], or coarser
-/// voxels when the mesh's voxel surface would have more than
-/// [`MAX_SURFACE_VERTICES`]. When that cage has more than 15 % over the target,
-/// coarser voxels are tried (at most [`RETRIES`] times), which merge parts
-/// closer than about three voxels; the cage closest to the target is kept, and
-/// its voxel size is reported.
+/// voxels when a target-sized cage's mean edge would be over [`EDGE_CELLS`]
+/// voxels or the voxel surface over [`MAX_SURFACE_VERTICES`] vertices. When that
+/// cage has more than 15 % over the target, coarser voxels and a wider envelope
+/// are tried (at most [`RETRIES`] times), which merge close parts; the cage
+/// closest to the target is kept, and its voxel size is reported.
 pub fn generate_cage(
     mesh: &TriMesh,
     options: &CageOptions,
@@ -244,14 +245,15 @@ pub fn generate_cage(
         };
         // Each retry may also stand further off the mesh.
         let reach = MAX_REACH * diagonal * 1.5f64.powi(attempt as i32);
-        let goal = Goal {
-            target,
+        let cells = surface.clearance_cells;
+        let goal = simplify::Goal {
+            target_vertices: target,
+            max_limit: (cells + MARGIN_CELLS).min(cells + 2 + (reach / cell).ceil() as usize)
+                as u16,
             clearance,
-            reach,
+            diagonal,
         };
-        let result = simplify_surface(surface, &mesh_points, &goal, diagonal, &|f| {
-            span(0.1 + 0.9 * f)
-        })?;
+        let result = simplify_surface(surface, &mesh_points, &goal, &|f| span(0.1 + 0.9 * f))?;
         let reached = result.simplified.positions.len();
         let closer = best
             .as_ref()
@@ -318,26 +320,17 @@ fn voxel_surface(
     })
 }
 
-/// What one try aims for: vertices, and the least and most distance from
-/// the mesh.
-struct Goal {
-    target: usize,
-    clearance: f64,
-    reach: f64,
-}
-
 fn simplify_surface(
     voxel_surface: VoxelSurface,
     mesh_points: &points::PointTree,
-    goal: &Goal,
-    diagonal: f64,
+    goal: &simplify::Goal,
     progress: &dyn Fn(f32) -> bool,
 ) -> Result<Attempt, AutoCageError> {
     let VoxelSurface {
         surface,
         envelope,
-        clearance_cells,
         voxel_volume,
+        ..
     } = voxel_surface;
     let (cell, grid) = (envelope.cell, envelope.dims);
     let surface_vertices = surface.positions.len();
@@ -346,14 +339,7 @@ fn simplify_surface(
         surface.positions,
         surface.triangles,
         envelope,
-        &simplify::Goal {
-            target_vertices: goal.target,
-            max_limit: (clearance_cells + MARGIN_CELLS)
-                .min(clearance_cells + 2 + (goal.reach / cell).ceil() as usize)
-                as u16,
-            clearance: goal.clearance,
-            diagonal,
-        },
+        goal,
         progress,
     )
     .ok_or(AutoCageError::Cancelled)?;

@@ -388,7 +388,7 @@ impl<'a> State<'a> {
         // cover exactly the region the old ones did: nothing else can change.
         let flat = self.lies_in_plane_of(&old_corners, position);
         let accepted = flat
-            || self.changes_nothing_else(
+            || self.passes_region_checks(
                 (a, b),
                 position,
                 &star,
@@ -447,7 +447,7 @@ impl<'a> State<'a> {
 
     /// The checks a collapse of (a, b) into `a`, already moved to `position`,
     /// must pass when it changes the region the surface covers.
-    fn changes_nothing_else(
+    fn passes_region_checks(
         &mut self,
         (a, b): (usize, usize),
         position: DVec3,
