@@ -25,6 +25,10 @@
 // per pose change (shaders/render_normals.wgsl).
 // The same for the compared method (the difference view).
 @group(0) @binding(5) var<storage, read> other_displacements: array<vec4<f32>>;
+// The first UNIFORM_COLUMNS of both again, in uniform buffers: where the blend
+// reads them (see render::weight_chunks::UNIFORM_COLUMNS for why).
+@group(0) @binding(6) var<uniform> uniform_displacements: array<vec4<f32>, UNIFORM_COLUMNS>;
+@group(0) @binding(7) var<uniform> uniform_other_displacements: array<vec4<f32>, UNIFORM_COLUMNS>;
 
 const NEGATIVE = vec3<f32>(0.16, 0.29, 0.80);
 const ZERO = vec3<f32>(0.97, 0.97, 0.97);

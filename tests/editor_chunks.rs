@@ -1,8 +1,10 @@
 //! Weights split by rows over several storage buffers (`render::weight_chunks`): on
 //! a device whose storage bindings hold only a part of the default scene's weights,
 //! the shaders deform and colour the mesh exactly as the CPU weights say, and a
-//! matrix beyond the device's buffers is refused with its sizes. See
-//! `common::editor` for how a missing GPU is handled.
+//! matrix beyond the device's buffers is refused with its sizes; and the column
+//! displacements the blend reads from a uniform copy give way to the storage
+//! buffer past that copy's columns. See `common::editor` for how a missing GPU is
+//! handled.
 
 mod common;
 
@@ -10,7 +12,8 @@ use common::editor::*;
 use egui_kittest::Harness;
 use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
-use pmvc::render::weight_chunks::ChunkLimits;
+use pmvc::geometry::procedural;
+use pmvc::render::weight_chunks::{ChunkLimits, UNIFORM_COLUMNS};
 use pmvc::render::{Colouring, Shading};
 use std::path::PathBuf;
 
@@ -146,4 +149,61 @@ fn weights_beyond_the_devices_buffers_are_refused_with_their_sizes() {
         .expect("a GPU scene")
         .expect("read back");
     assert_eq!(shown, rest, "the mesh stays at rest without weights");
+}
+
+#[test]
+fn columns_past_the_uniform_copy_of_the_displacements_still_move_the_mesh() {
+    // 2,562 cage vertices: MVC columns well past the uniform copy's 1,024.
+    let cage = procedural::icosphere(1.0, 4);
+    assert!(cage.vertex_count() > 2 * UNIFORM_COLUMNS as usize);
+    let inside = procedural::points_inside(&cage, 150, 11, 0.02);
+    // Translating the whole cage moves every column by the same vector, so with
+    // weights summing to 1 every mesh vertex moves by exactly that vector.
+    let shift = glam::DVec3::new(0.3, -0.2, 0.1);
+    let moved: Vec<glam::DVec3> = cage.positions().iter().map(|p| *p + shift).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = common::write(dir.path(), "mesh.obj", &common::points_obj(&inside));
+    let cage_path = common::write(dir.path(), "cage.obj", &common::cage_obj(&cage));
+    let pose = common::write(
+        dir.path(),
+        "pose.obj",
+        &common::triangles_obj(&moved, cage.triangles()),
+    );
+    let Some(state) = render_state() else {
+        return;
+    };
+    let mut harness = editor_on(
+        state,
+        EditorOptions {
+            mesh: Some(mesh),
+            cage: Some(cage_path),
+            pose: Some(pose),
+            method: Some(Method::Mvc),
+            ..Default::default()
+        },
+    );
+    run_until_bound(&mut harness);
+    let app = harness.state();
+    assert_eq!(app.last_error(), None);
+    let weights = app.document().weights(Method::Mvc).expect("bound");
+    // The columns past the copy carry much of each row, so leaving them out
+    // would leave the mesh far behind the cage.
+    let tail_share = (0..weights.rows)
+        .map(|row| {
+            let values = &weights.values[row * weights.cols..(row + 1) * weights.cols];
+            values[UNIFORM_COLUMNS as usize..].iter().sum::<f32>()
+        })
+        .fold(f32::INFINITY, f32::min);
+    assert!(tail_share > 0.05, "{tail_share}");
+    let expected: Vec<glam::Vec3> = inside.iter().map(|p| (*p + shift).as_vec3()).collect();
+    let gpu = read_back(
+        app,
+        Shading {
+            method: Method::Mvc,
+            ..Default::default()
+        },
+    )
+    .positions;
+    let error = max_distance(&gpu, &expected);
+    assert!(error < 1e-4, "{error}");
 }

@@ -3,6 +3,8 @@
 #  1. `--screenshot` runs: the default scene and the first-run scene bind and a PNG
 #     of the window is saved;
 #     a scripted run with a missing --pose must exit with status 1;
+#     a scripted drag (--drag) moves a handle and reports its frame time, and one
+#     of a handle that does not exist exits with status 1;
 #  2. an interactive run: xdotool drags across the viewport (orbiting the view, or
 #     moving a handle if one is under the cursor), presses M to switch between MVC
 #     and PMVC, and the screen is captured after each.
@@ -46,6 +48,18 @@ if timeout 300 "$PMVC_EDITOR" edit --pose "$out/no-such-pose.obj" --screenshot "
 fi
 grep -q "no-such-pose.obj" "$out/failed-run.log" || { cat "$out/failed-run.log"; exit 1; }
 echo "   exited non-zero, naming the pose file"
+
+echo "== a scripted drag of a handle (--drag), and one of a handle that does not exist"
+timeout 300 "$PMVC_EDITOR" edit --screenshot "$out/dragged.png" --drag 0 2>"$out/drag-run.log" || {
+  cat "$out/drag-run.log"; exit 1; }
+grep "while dragging" "$out/drag-run.log" || { cat "$out/drag-run.log"; exit 1; }
+if timeout 300 "$PMVC_EDITOR" edit --screenshot "$out/no-such-handle.png" --drag 9999 \
+    2>"$out/no-such-handle.log"; then
+  echo "a --screenshot run dragging a handle that does not exist exited with status 0" >&2
+  cat "$out/no-such-handle.log"; exit 1
+fi
+grep -q -- "--drag 9999: the cage has" "$out/no-such-handle.log" || {
+  cat "$out/no-such-handle.log"; exit 1; }
 
 echo "== interactive run with an xdotool drag"
 "$PMVC_EDITOR" edit >"$out/interactive-run.log" 2>&1 &

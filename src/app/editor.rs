@@ -156,7 +156,10 @@ impl EditorApp {
             pose_tools: PoseToolSettings::default(),
             file_dialogs: FileDialogs::default(),
             quit: QuitState::default(),
-            screenshot: options.screenshot.clone().map(ScreenshotState::new),
+            screenshot: options
+                .screenshot
+                .clone()
+                .map(|path| ScreenshotState::new(path, options.drag_handle)),
             focus_frames: 0,
             binding_paused: false,
             hide_timings: options.hide_timings,

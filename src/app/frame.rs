@@ -39,6 +39,11 @@ impl eframe::App for EditorApp {
         self.drive_image_request(&ctx);
     }
 
+    /// A scripted run's pointer events (`--drag`) join the frame's input here.
+    fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        self.script_drag_input(raw_input);
+    }
+
     /// Recent files outlive the run; a scripted run leaves them as they were.
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         if self.screenshot.is_none() {

@@ -31,6 +31,7 @@ pub mod recent;
 pub mod scene_history;
 pub mod scenes;
 mod screenshot;
+mod scripted_drag;
 pub mod session;
 pub mod ui;
 mod viewport;
@@ -60,6 +61,9 @@ pub struct EditorOptions {
     pub method: Option<crate::coords::Method>,
     /// Save a PNG of the window once the first bind finishes, then quit.
     pub screenshot: Option<PathBuf>,
+    /// In that scripted run, first drag the handle of this cage vertex (0-based)
+    /// with the pointer and report the frame time while dragging (`--drag`).
+    pub drag_handle: Option<usize>,
     /// Where binding runs.
     pub bind_on: BindOn,
     /// The views and colouring to start with (`--view`, `--heatmap`, `--negativity`).

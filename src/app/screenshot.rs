@@ -4,6 +4,7 @@
 
 use super::editor::EditorApp;
 use super::exports::save_png;
+use super::scripted_drag::{ScriptedDrag, DRAG_FRAMES, DRAG_START_FRAME};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -17,17 +18,22 @@ pub struct ScreenshotState {
     frames_after_bind: u32,
     requested: bool,
     saved: Arc<AtomicBool>,
+    /// `--drag`: a handle dragged before the capture.
+    pub(super) drag: Option<ScriptedDrag>,
     /// What failed during the run, in order; read by `run_editor` after it ends.
     failures: Arc<Mutex<Vec<String>>>,
 }
 
 impl ScreenshotState {
-    pub fn new(path: PathBuf) -> Self {
+    /// A run saving the window to `path`, dragging the handle of cage vertex
+    /// `drag` first if given.
+    pub fn new(path: PathBuf, drag: Option<usize>) -> Self {
         Self {
             path,
             frames_after_bind: 0,
             requested: false,
             saved: Arc::new(AtomicBool::new(false)),
+            drag: drag.map(ScriptedDrag::new),
             failures: Arc::default(),
         }
     }
@@ -43,6 +49,21 @@ impl ScreenshotState {
             list.extend(recorded.iter().cloned());
         }
         self.failures = shared;
+    }
+
+    /// Frames drawn since the bind finished.
+    pub fn frames_after_bind(&self) -> u32 {
+        self.frames_after_bind
+    }
+
+    /// The frame after the bind at which the window is captured: later by the
+    /// scripted drag's frames when there is one.
+    fn capture_frame(&self) -> u32 {
+        let drag_frames = self
+            .drag
+            .as_ref()
+            .map_or(0, |_| DRAG_START_FRAME + DRAG_FRAMES + 2);
+        SCREENSHOT_FRAMES + drag_frames
     }
 
     pub fn record_failure(&self, text: &str) {
@@ -78,7 +99,8 @@ impl EditorApp {
         }
         // Frames before the capture let the GPU upload settle and give a frame-time
         // sample of the continuously redrawn viewport.
-        if state.frames_after_bind >= SCREENSHOT_FRAMES && !state.requested {
+        let drag_done = state.drag.as_ref().is_none_or(ScriptedDrag::is_done);
+        if state.frames_after_bind >= state.capture_frame() && drag_done && !state.requested {
             state.requested = true;
             let path = state.path.clone();
             let saved = Arc::clone(&state.saved);

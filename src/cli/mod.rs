@@ -200,6 +200,11 @@ pub struct EditArgs {
     /// Wait for the bind, render, save the window as PNG and exit.
     #[arg(long, value_name = "PATH")]
     pub screenshot: Option<PathBuf>,
+    /// With --screenshot: first drag this cage vertex's handle (0-based) with the
+    /// pointer for 60 frames, then print how far it moved and the average frame
+    /// time while dragging. A handle outside the first view fails the run.
+    #[arg(long, value_name = "CAGE_VERTEX", requires = "screenshot")]
+    pub drag: Option<usize>,
     /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
@@ -326,6 +331,7 @@ impl EditArgs {
             grid: self.grid,
             method,
             screenshot: self.screenshot,
+            drag_handle: self.drag,
             bind_on: match self.backend {
                 BackendArg::Auto => crate::app::BindOn::Auto,
                 BackendArg::Cpu => crate::app::BindOn::Cpu,

@@ -4,7 +4,9 @@
 //! never on the orchestrator ([`super::viewport`]), as re_renderer's renderers
 //! depend on its global bindings.
 
-use super::weight_chunks::{ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS};
+use super::weight_chunks::{
+    ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
+};
 use crate::coords::Method;
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
@@ -54,9 +56,13 @@ pub struct FrameUniform {
 
 /// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family
 /// shown (followed by its vertex normals), 3 cage pose, 4 handle states, 5 column
-/// displacements of the compared family; from [`FIRST_CHUNK_BINDING`] the pool of
-/// weight chunks.
+/// displacements of the compared family; 6 and 7 the first [`UNIFORM_COLUMNS`]
+/// column displacements of both families again, as uniforms; from
+/// [`FIRST_CHUNK_BINDING`] the pool of weight chunks.
 const SCENE_STORAGE_BINDINGS: [u32; OTHER_STORAGE_BUFFERS as usize] = [1, 2, 3, 4, 5];
+const UNIFORM_DISPLACEMENT_BINDINGS: [u32; 2] = [6, 7];
+/// Bytes of each uniform copy of the column displacements.
+pub const UNIFORM_DISPLACEMENT_BYTES: u64 = UNIFORM_COLUMNS as u64 * 16;
 
 /// Storage buffers the drawing shaders read in one stage, with the smallest pool
 /// of weight chunks (one per family).
@@ -78,6 +84,18 @@ pub fn scene_layout(device: &wgpu::Device, chunk_slots: u32) -> wgpu::BindGroupL
         count: None,
     }];
     entries.extend(SCENE_STORAGE_BINDINGS.map(|binding| storage_entry(binding, true)));
+    entries.extend(
+        UNIFORM_DISPLACEMENT_BINDINGS.map(|binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(UNIFORM_DISPLACEMENT_BYTES),
+            },
+            count: None,
+        }),
+    );
     entries.extend(
         (FIRST_CHUNK_BINDING..FIRST_CHUNK_BINDING + chunk_slots)
             .map(|binding| storage_entry(binding, true)),
@@ -130,6 +148,9 @@ pub struct WeightSlot {
     /// the normals share the buffer so that drawing needs no storage binding
     /// more than devices with the default 8 per stage have.
     pub displacements: wgpu::Buffer,
+    /// The first [`UNIFORM_COLUMNS`] displacements again, where the blend reads
+    /// them ([`UNIFORM_DISPLACEMENT_BYTES`], zero past the columns).
+    pub uniform_displacements: wgpu::Buffer,
     pub columns: u32,
     /// The pose revision the normals were computed for; `None` before the first.
     pub normals_pose: Option<u64>,
@@ -161,6 +182,8 @@ pub struct SceneGpu {
     pub handle_state: wgpu::Buffer,
     /// Bound where a view's family has no weights yet.
     pub placeholder: wgpu::Buffer,
+    /// The same for the uniform copy of the displacements.
+    pub uniform_placeholder: wgpu::Buffer,
     pub slots: BTreeMap<Method, WeightSlot>,
     /// The rest cage and the current pose, in f64: displacements are taken in f64
     /// and only then rounded.
@@ -216,12 +239,24 @@ impl SceneGpu {
             cage: buffer_with(device, "cage pose", &points_f32(&pose, 1.0), storage),
             handle_state: buffer_with(device, "handle states", &states, storage),
             placeholder: buffer_with(device, "no weights", &[0f32; 4], storage),
+            uniform_placeholder: uniform_displacements_buffer(device, &[]),
             slots: BTreeMap::new(),
             rest_cage: rest_cage.clone(),
             pose,
             chunk_limits,
             bind_groups: HashMap::new(),
         }
+    }
+
+    /// Write `displacements` (a family's columns, as [`Self::displacements_of`]
+    /// gives them) to that family's uniform copy.
+    pub fn write_uniform_displacements(
+        queue: &wgpu::Queue,
+        slot: &WeightSlot,
+        displacements: &[[f32; 4]],
+    ) {
+        let head = &displacements[..displacements.len().min(UNIFORM_COLUMNS as usize)];
+        queue.write_buffer(&slot.uniform_displacements, 0, bytemuck::cast_slice(head));
     }
 
     /// `method`'s column displacements for the current pose, as the shader reads them.
@@ -268,6 +303,8 @@ impl SceneGpu {
     ) -> wgpu::BindGroup {
         let slot = |method: Option<Method>| method.and_then(|m| self.slots.get(&m));
         let moves = |method| slot(method).map_or(&self.placeholder, |s| &s.displacements);
+        let uniform_moves =
+            |method| slot(method).map_or(&self.uniform_placeholder, |s| &s.uniform_displacements);
         let buffers = [
             &self.rest,
             moves(Some(shown)),
@@ -298,6 +335,11 @@ impl SceneGpu {
                 .iter()
                 .copied()
                 .zip(buffers)
+                .chain(
+                    UNIFORM_DISPLACEMENT_BINDINGS
+                        .into_iter()
+                        .zip([uniform_moves(Some(shown)), uniform_moves(against)]),
+                )
                 .chain((FIRST_CHUNK_BINDING..).zip(pool))
                 .map(|(binding, buffer)| wgpu::BindGroupEntry {
                     binding,
@@ -310,6 +352,23 @@ impl SceneGpu {
             entries: &entries,
         })
     }
+}
+
+/// A uniform copy of the first [`UNIFORM_COLUMNS`] of `displacements`, zero past
+/// them.
+pub fn uniform_displacements_buffer(
+    device: &wgpu::Device,
+    displacements: &[[f32; 4]],
+) -> wgpu::Buffer {
+    let mut head = vec![[0f32; 4]; UNIFORM_COLUMNS as usize];
+    let count = displacements.len().min(head.len());
+    head[..count].copy_from_slice(&displacements[..count]);
+    buffer_with(
+        device,
+        "column displacements (uniform copy)",
+        &head,
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    )
 }
 
 /// Points as the shaders' `vec4<f32>`, with `w` as given.

@@ -15,8 +15,8 @@ use super::mesh::MeshRenderer;
 use super::normals::NormalsPass;
 use super::readback::Readback;
 use super::scene_gpu::{
-    buffer_with, points_f32, scene_layout, FrameUniform, ReadBack, SceneGpu, WeightSlot,
-    FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
+    buffer_with, points_f32, scene_layout, uniform_displacements_buffer, FrameUniform, ReadBack,
+    SceneGpu, WeightSlot, FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
 };
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 use crate::coords::{Method, Weights};
@@ -282,6 +282,7 @@ impl ViewportRenderer {
         };
         // The columns' displacements, then room for the vertex normals.
         let mut displacements = scene.displacements_of(method);
+        let uniform_displacements = uniform_displacements_buffer(device, &displacements);
         displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
             device,
@@ -297,6 +298,7 @@ impl ViewportRenderer {
                 chunks,
                 split,
                 displacements,
+                uniform_displacements,
                 columns: weights.cols as u32,
                 normals_pose: None,
             }),
@@ -336,6 +338,7 @@ impl ViewportRenderer {
         for (&method, slot) in &scene.slots {
             let displacements = scene.displacements_of(method);
             queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
+            SceneGpu::write_uniform_displacements(queue, slot, &displacements);
         }
     }
 

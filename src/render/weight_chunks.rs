@@ -14,8 +14,15 @@ use crate::coords::Weights;
 use std::fmt::Write as _;
 
 /// The first binding of the pool in the scene group; below it: the frame, the
-/// rest positions, both families' column displacements, the cage and its handles.
-pub const FIRST_CHUNK_BINDING: u32 = 6;
+/// rest positions, both families' column displacements (in storage and, for the
+/// first [`UNIFORM_COLUMNS`], again in uniform buffers), the cage and its handles.
+pub const FIRST_CHUNK_BINDING: u32 = 8;
+/// Columns whose displacements the blend reads from a uniform buffer: lavapipe
+/// loads from a storage buffer lane by lane, with a bounds check each, and from a
+/// uniform buffer at a loop counter's offset once for all lanes (Ogre's idle frame
+/// went from 255 ms to about 120 ms). 1,024 `vec4`s are 16 KiB, the least every
+/// Vulkan device binds; columns past them come from the storage buffer.
+pub const UNIFORM_COLUMNS: u32 = 1024;
 /// Storage buffers of the scene group besides the weights.
 pub const OTHER_STORAGE_BUFFERS: u32 = 5;
 /// The largest pool: eight chunks per family hold 1 GiB of weights on lavapipe,
@@ -139,18 +146,21 @@ pub fn wgsl(slots: u32) -> String {
         format!("weight = weight_chunk_{slot}[index];")
     });
     out.push_str("    return weight;\n}\n");
-    // Σ_c W[row, c] · d_c over one row, for the method shown and the compared one.
+    let _ = writeln!(out, "\nconst UNIFORM_COLUMNS: u32 = {UNIFORM_COLUMNS}u;");
+    // Σ_c W[row, c] · d_c over one row, for the method shown and the compared one:
+    // the first columns' d_c from the uniform copy, the rest from storage.
     for (name, displacements) in [
         ("blend_row", "displacements"),
         ("blend_other_row", "other_displacements"),
     ] {
         let _ = writeln!(
             out,
-            "\nfn {name}(chunk: u32, start: u32, columns: u32) -> vec3<f32> {{\n    var moved = vec3<f32>(0.0);"
+            "\nfn {name}(chunk: u32, start: u32, columns: u32) -> vec3<f32> {{\n    var moved = vec3<f32>(0.0);\n    let in_uniform = min(columns, UNIFORM_COLUMNS);"
         );
         switch(&mut out, &|slot| {
             format!(
-                "for (var c = 0u; c < columns; c++) {{ moved += weight_chunk_{slot}[start + c] * {displacements}[c].xyz; }}"
+                "for (var c = 0u; c < in_uniform; c++) {{ moved += weight_chunk_{slot}[start + c] * uniform_{displacements}[c].xyz; }} \
+                 for (var c = in_uniform; c < columns; c++) {{ moved += weight_chunk_{slot}[start + c] * {displacements}[c].xyz; }}"
             )
         });
         out.push_str("    return moved;\n}\n");

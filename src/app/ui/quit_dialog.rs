@@ -56,7 +56,10 @@ impl EditorApp {
 
     /// A close asked for by the window system waits for the question's answer.
     pub(in crate::app) fn intercept_close(&mut self, ctx: &egui::Context) {
+        // A scripted run (`--screenshot`) ends on its own; its pose (`--drag`) is
+        // not work to keep.
         if ctx.input(|i| i.viewport().close_requested())
+            && self.screenshot.is_none()
             && !self.quit.confirmed
             && self.pose_is_unsaved()
         {

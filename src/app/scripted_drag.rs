@@ -1,0 +1,155 @@
+//! `--drag CAGE_VERTEX` in a scripted run: after the bind, the pointer presses on
+//! that cage vertex's handle in the first view, moves a little every frame and
+//! lets go, through the same input path as a user's drag. The run then prints
+//! how far the handle moved and the average frame time while it was dragged,
+//! the figure the editor's drag benchmark quotes. A handle that is off screen or
+//! that did not move is a failure of the run (exit status 1).
+
+use super::editor::EditorApp;
+use super::viewport::Drag;
+use egui::{Event, Modifiers, PointerButton, Pos2, RawInput, Vec2};
+
+/// Frames after the bind before the pointer presses (the views settle).
+pub const DRAG_START_FRAME: u32 = 10;
+/// Frames the pointer moves with the button held.
+pub const DRAG_FRAMES: u32 = 60;
+/// Pointer motion per frame, in points (120 points right and 60 up in all).
+const STEP: Vec2 = Vec2::new(2.0, -1.0);
+
+#[derive(Clone, Debug)]
+enum Phase {
+    Waiting,
+    /// The button is down at `from`; `frames` moves sent so far.
+    Held {
+        from: Pos2,
+        frames: u32,
+    },
+    Done,
+}
+
+/// The scripted drag of one handle.
+#[derive(Clone, Debug)]
+pub struct ScriptedDrag {
+    handle: usize,
+    phase: Phase,
+    /// Input time and frame count when the editor first saw the move begin.
+    moving_since: Option<(f64, u32)>,
+    frames_moving: u32,
+}
+
+impl ScriptedDrag {
+    pub fn new(handle: usize) -> Self {
+        Self {
+            handle,
+            phase: Phase::Waiting,
+            moving_since: None,
+            frames_moving: 0,
+        }
+    }
+
+    /// Whether the drag has ended (or could not start).
+    pub fn is_done(&self) -> bool {
+        matches!(self.phase, Phase::Done)
+    }
+}
+
+impl EditorApp {
+    /// Add this frame's pointer events of the scripted drag to `input`.
+    pub(super) fn script_drag_input(&mut self, input: &mut RawInput) {
+        let Some(frame) = self.screenshot.as_ref().map(|s| s.frames_after_bind()) else {
+            return;
+        };
+        let Some(mut drag) = self.screenshot.as_mut().and_then(|s| s.drag.take()) else {
+            return;
+        };
+        let time = input.time.unwrap_or(0.0);
+        let moving = matches!(self.viewport.drag, Some(Drag::Move { .. }));
+        if moving && drag.moving_since.is_none() {
+            drag.moving_since = Some((time, 0));
+        }
+        if moving {
+            drag.frames_moving += 1;
+        }
+        match drag.phase.clone() {
+            Phase::Waiting if frame >= DRAG_START_FRAME && !self.is_binding() => {
+                match self.start_drag(drag.handle) {
+                    Ok(from) => {
+                        input.events.push(Event::PointerMoved(from));
+                        input.events.push(button(from, true));
+                        drag.phase = Phase::Held { from, frames: 0 };
+                    }
+                    Err(text) => {
+                        self.error(text);
+                        drag.phase = Phase::Done;
+                    }
+                }
+            }
+            Phase::Held { from, frames } if frames < DRAG_FRAMES => {
+                let at = from + STEP * (frames + 1) as f32;
+                input.events.push(Event::PointerMoved(at));
+                drag.phase = Phase::Held {
+                    from,
+                    frames: frames + 1,
+                };
+            }
+            Phase::Held { from, frames } => {
+                input
+                    .events
+                    .push(button(from + STEP * frames as f32, false));
+                self.report_drag(&drag, time);
+                drag.phase = Phase::Done;
+            }
+            _ => {}
+        }
+        if let Some(screenshot) = self.screenshot.as_mut() {
+            screenshot.drag = Some(drag);
+        }
+    }
+
+    /// Where the handle to drag is on screen, or why it cannot be dragged.
+    fn start_drag(&mut self, handle: usize) -> Result<Pos2, String> {
+        let count = self.document.pose().len();
+        if handle >= count {
+            return Err(format!(
+                "--drag {handle}: the cage has {count} vertices (0 to {})",
+                count.saturating_sub(1)
+            ));
+        }
+        self.view.show_cage = true;
+        let on_screen = self.handle_screen_position(handle).filter(|at| {
+            self.viewport
+                .pane_rects()
+                .first()
+                .is_some_and(|(_, rect)| rect.shrink(8.0).contains(*at))
+        });
+        on_screen.ok_or_else(|| format!("--drag {handle}: that handle is not in the first view"))
+    }
+
+    fn report_drag(&mut self, drag: &ScriptedDrag, now: f64) {
+        let handle = drag.handle;
+        let rest = self.document.cage().positions()[handle];
+        let moved = self.document.pose()[handle].distance(rest);
+        let diagonal = self.document.cage().diagonal();
+        let Some((since, _)) = drag.moving_since.filter(|_| moved > 0.0) else {
+            self.error(format!("--drag {handle}: the handle did not move"));
+            return;
+        };
+        // Frame intervals from the first frame that moved it to the release.
+        let intervals = drag.frames_moving.saturating_sub(1).max(1);
+        eprintln!(
+            "pmvc editor: dragged cage vertex {handle} by {:.3} % of the cage diagonal; average frame time while dragging {:.1} ms over {intervals} frames",
+            100.0 * moved / diagonal,
+            (now - since) * 1000.0 / intervals as f64,
+        );
+        self.stats.restart();
+    }
+}
+
+fn button(pos: Pos2, pressed: bool) -> Event {
+    Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    }
+}
