@@ -32,6 +32,8 @@ enum Phase {
 pub struct ScriptedDrag {
     handle: usize,
     phase: Phase,
+    /// Where the handle was when the pointer pressed on it.
+    start: Option<glam::DVec3>,
     /// Input time and frame count when the editor first saw the move begin.
     moving_since: Option<(f64, u32)>,
     frames_moving: u32,
@@ -42,6 +44,7 @@ impl ScriptedDrag {
         Self {
             handle,
             phase: Phase::Waiting,
+            start: None,
             moving_since: None,
             frames_moving: 0,
         }
@@ -76,6 +79,7 @@ impl EditorApp {
                     Ok(from) => {
                         input.events.push(Event::PointerMoved(from));
                         input.events.push(button(from, true));
+                        drag.start = self.document.pose().get(drag.handle).copied();
                         drag.phase = Phase::Held { from, frames: 0 };
                     }
                     Err(text) => {
@@ -115,6 +119,7 @@ impl EditorApp {
                 count.saturating_sub(1)
             ));
         }
+        // Handles are picked only while the cage is shown.
         self.view.show_cage = true;
         let on_screen = self.handle_screen_position(handle).filter(|at| {
             self.viewport
@@ -127,8 +132,8 @@ impl EditorApp {
 
     fn report_drag(&mut self, drag: &ScriptedDrag, now: f64) {
         let handle = drag.handle;
-        let rest = self.document.cage().positions()[handle];
-        let moved = self.document.pose()[handle].distance(rest);
+        let now_at = self.document.pose().get(handle).copied();
+        let moved = now_at.zip(drag.start).map_or(0.0, |(a, b)| a.distance(b));
         let diagonal = self.document.cage().diagonal();
         let Some((since, _)) = drag.moving_since.filter(|_| moved > 0.0) else {
             self.error(format!("--drag {handle}: the handle did not move"));
