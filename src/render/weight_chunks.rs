@@ -18,10 +18,10 @@ use std::fmt::Write as _;
 /// first [`UNIFORM_COLUMNS`], again in uniform buffers), the cage and its handles.
 pub const FIRST_CHUNK_BINDING: u32 = 8;
 /// Columns whose displacements the blend reads from a uniform buffer: lavapipe
-/// loads from a storage buffer lane by lane, with a bounds check each, and from a
-/// uniform buffer at a loop counter's offset once for all lanes (Ogre's idle frame
-/// went from 255 ms to about 120 ms). 1,024 `vec4`s are 16 KiB, the least every
-/// Vulkan device binds; columns past them come from the storage buffer.
+/// loads from a storage buffer lane by lane, each behind a branch and a bounds
+/// check, and from a uniform buffer with one gather (Ogre's idle frame went from
+/// 255 ms to 156 ms). 1,024 `vec4`s are 16 KiB, the least every Vulkan device
+/// binds; columns past them come from the storage buffer.
 pub const UNIFORM_COLUMNS: u32 = 1024;
 /// Storage buffers of the scene group besides the weights.
 pub const OTHER_STORAGE_BUFFERS: u32 = 5;
