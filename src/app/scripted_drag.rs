@@ -34,8 +34,8 @@ pub struct ScriptedDrag {
     phase: Phase,
     /// Where the handle was when the pointer pressed on it.
     start: Option<glam::DVec3>,
-    /// Input time and frame count when the editor first saw the move begin.
-    moving_since: Option<(f64, u32)>,
+    /// Input time when the editor first saw the move begin.
+    moving_since: Option<f64>,
     frames_moving: u32,
 }
 
@@ -68,7 +68,7 @@ impl EditorApp {
         let time = input.time.unwrap_or(0.0);
         let moving = matches!(self.viewport.drag, Some(Drag::Move { .. }));
         if moving && drag.moving_since.is_none() {
-            drag.moving_since = Some((time, 0));
+            drag.moving_since = Some(time);
         }
         if moving {
             drag.frames_moving += 1;
@@ -135,7 +135,7 @@ impl EditorApp {
         let now_at = self.document.pose().get(handle).copied();
         let moved = now_at.zip(drag.start).map_or(0.0, |(a, b)| a.distance(b));
         let diagonal = self.document.cage().diagonal();
-        let Some((since, _)) = drag.moving_since.filter(|_| moved > 0.0) else {
+        let Some(since) = drag.moving_since.filter(|_| moved > 0.0) else {
             self.error(format!("--drag {handle}: the handle did not move"));
             return;
         };
