@@ -2,7 +2,9 @@
 // dense weights (row-major f32, split by rows over chunk buffers that
 // `blend_row`, `blend_other_row`, `lowest_in_row` and `chunk_weight` read;
 // render::weight_chunks appends them and their bindings, whose number depends on
-// the device) and each weights column's displacement d_k
+// the device; where the device allows, the first columns of each row arrive as
+// vertex attributes instead, see render::weight_attributes, whose entry points
+// `vs_*_attributes` are appended too) and each weights column's displacement d_k
 // (`Method::column_displacements`, uploaded per pose change), so the CPU never
 // touches mesh positions per frame. The displacement form is exact at rest for any
 // weights and keeps its precision far from the origin. Smooth shading reads each
@@ -37,6 +39,10 @@ const POSITIVE = vec3<f32>(0.80, 0.08, 0.10);
 const OUTSIDE = vec3<f32>(0.55, 0.55, 0.55);
 // Set from colormap::LOG_DECADES when the pipeline is made.
 override LOG_DECADES: f32 = 3.0;
+// False in the pipeline that only shades (render::mesh): the colouring code is
+// then compiled out, which lavapipe would otherwise run for every vertex and
+// fragment, since it runs both sides of a branch it cannot prove uniform.
+override COLOURED: bool = true;
 const LN_10: f32 = 2.302585093;
 
 // Where a vertex's weights row starts: x, the pool slot of its chunk; y, the
@@ -48,11 +54,18 @@ fn row_start(vertex: u32, rows_per_chunk: u32, columns: u32, first_chunk: u32) -
 }
 
 fn deformed_position(vertex: u32) -> vec3<f32> {
+    return deformed_position_after(vertex, 0u, vec3<f32>(0.0));
+}
+
+// The deformed position when the row's first `first_column` columns, blended
+// elsewhere (from vertex attributes), moved the vertex by `head`. The sum goes on
+// in the same order as from column 0.
+fn deformed_position_after(vertex: u32, first_column: u32, head: vec3<f32>) -> vec3<f32> {
     if frame.weights_bound == 0u {
         return rest[vertex].xyz;
     }
     let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
-    return rest[vertex].xyz + blend_row(start.x, start.y, frame.columns);
+    return rest[vertex].xyz + blend_row(start.x, start.y, first_column, frame.columns, head);
 }
 
 fn other_deformed_position(vertex: u32) -> vec3<f32> {
@@ -62,7 +75,8 @@ fn other_deformed_position(vertex: u32) -> vec3<f32> {
         frame.other_columns,
         frame.other_first_chunk,
     );
-    return rest[vertex].xyz + blend_other_row(start.x, start.y, frame.other_columns);
+    return rest[vertex].xyz
+        + blend_other_row(start.x, start.y, 0u, frame.other_columns, vec3<f32>(0.0));
 }
 
 // The scalar the mesh is coloured by (0 when shaded or unbound).
@@ -146,12 +160,18 @@ fn vs_mesh(@builtin(vertex_index) vertex: u32) -> MeshVarying {
 }
 
 fn mesh_vertex(vertex: u32) -> MeshVarying {
-    let world = deformed_position(vertex);
+    return mesh_vertex_at(vertex, deformed_position(vertex));
+}
+
+// Everything but the blend, for a vertex deformed to `world`.
+fn mesh_vertex_at(vertex: u32, world: vec3<f32>) -> MeshVarying {
     var out: MeshVarying;
     out.clip = frame.view_projection * vec4<f32>(world, 1.0);
     out.world = world;
     out.outside = rest[vertex].w * f32(frame.highlight_outside);
-    out.value = vertex_value(vertex, world);
+    if COLOURED {
+        out.value = vertex_value(vertex, world);
+    }
     out.outside_cage = rest[vertex].w;
     if frame.smooth_shading == 1u && frame.weights_bound == 1u {
         out.normal = displacements[frame.columns + vertex].xyz;
@@ -163,9 +183,45 @@ fn mesh_vertex(vertex: u32) -> MeshVarying {
 // little towards the camera so they win against the faces they bound.
 @vertex
 fn vs_wire(@builtin(vertex_index) vertex: u32) -> MeshVarying {
-    var out = mesh_vertex(vertex);
+    return pulled_forward(mesh_vertex(vertex));
+}
+
+fn pulled_forward(surface: MeshVarying) -> MeshVarying {
+    var out = surface;
     out.clip.z -= 5e-5 * out.clip.w;
     return out;
+}
+
+// What the vertex shader draws, read back (render::drawn): vertex i as a point on
+// texel (i mod width, i / width) of a float image, carrying its deformed position.
+struct ProbeVarying {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(flat) world: vec3<f32>,
+}
+
+fn probe_vertex(vertex: u32, world: vec3<f32>) -> ProbeVarying {
+    let width = frame.probe_width;
+    let height = (frame.vertex_count + width - 1u) / width;
+    let texel = vec2<f32>(f32(vertex % width), f32(vertex / width)) + 0.5;
+    var out: ProbeVarying;
+    out.clip = vec4<f32>(
+        texel.x / f32(width) * 2.0 - 1.0,
+        1.0 - texel.y / f32(height) * 2.0,
+        0.0,
+        1.0,
+    );
+    out.world = world;
+    return out;
+}
+
+@vertex
+fn vs_probe(@builtin(vertex_index) vertex: u32) -> ProbeVarying {
+    return probe_vertex(vertex, deformed_position(vertex));
+}
+
+@fragment
+fn fs_probe(in: ProbeVarying) -> @location(0) vec4<f32> {
+    return vec4<f32>(in.world, 1.0);
 }
 
 @fragment
@@ -189,7 +245,7 @@ fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
     let half_vector = normalize(key + to_eye);
     let specular = 0.25 * pow(max(dot(normal, half_vector), 0.0), 40.0);
     var colour: vec3<f32>;
-    if frame.colouring == COLOURING_SHADED {
+    if !COLOURED || frame.colouring == COLOURING_SHADED {
         let base = mix(vec3<f32>(0.78, 0.72, 0.62), vec3<f32>(0.95, 0.2, 0.15), in.outside);
         colour = base * (0.18 + diffuse) + vec3<f32>(specular);
     } else {

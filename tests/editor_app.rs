@@ -505,8 +505,7 @@ fn an_adapter_too_weak_for_the_viewport_gets_a_notice_not_a_panic() {
 /// instead of widening it (and squeezing the viewport).
 #[test]
 fn a_long_path_in_a_notice_does_not_widen_the_side_panel() {
-    let pose = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("docs/poses/middle-finger-sideways.obj");
+    let pose = guide_pose();
     let directory = tempfile::tempdir().unwrap();
     let side_panel_left = |folder: &str| {
         let copy = directory.path().join(folder).join("pose.obj");

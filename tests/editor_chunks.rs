@@ -15,7 +15,6 @@ use pmvc::coords::Method;
 use pmvc::geometry::procedural;
 use pmvc::render::weight_chunks::{ChunkLimits, UNIFORM_COLUMNS};
 use pmvc::render::{Colouring, Shading};
-use std::path::PathBuf;
 
 /// Small storage bindings: 256 KiB, a fifth of the default scene's weights (and
 /// room for its rest positions and readback output, which are not split).
@@ -31,12 +30,10 @@ fn limits(storage_buffers_per_stage: u32) -> wgpu::Limits {
 
 /// The default scene, posed (the guide's bent prong), bound on a device with `limits`.
 fn posed_editor_on(limits: wgpu::Limits) -> Option<Harness<'static, EditorApp>> {
-    let pose =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj");
     let mut harness = editor_on(
         render_state_limited_to(limits)?,
         EditorOptions {
-            pose: Some(pose),
+            pose: Some(guide_pose()),
             ..Default::default()
         },
     );
@@ -162,13 +159,7 @@ fn columns_past_the_uniform_copy_of_the_displacements_still_move_the_mesh() {
     let shift = glam::DVec3::new(0.3, -0.2, 0.1);
     let moved: Vec<glam::DVec3> = cage.positions().iter().map(|p| *p + shift).collect();
     let dir = tempfile::tempdir().unwrap();
-    let mesh = common::write(dir.path(), "mesh.obj", &common::points_obj(&inside));
-    let cage_path = common::write(dir.path(), "cage.obj", &common::cage_obj(&cage));
-    let pose = common::write(
-        dir.path(),
-        "pose.obj",
-        &common::triangles_obj(&moved, cage.triangles()),
-    );
+    let (mesh, cage_path, pose) = common::posed_scene_files(dir.path(), &cage, &inside, &moved);
     let Some(state) = render_state() else {
         return;
     };

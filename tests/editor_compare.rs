@@ -14,17 +14,11 @@ use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
 use pmvc::render::colormap::{self, Scale};
 use pmvc::render::{Colouring, Shading};
-use std::path::PathBuf;
-
-/// The guide's pose: the default scene's middle prong bent sideways.
-fn pose_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj")
-}
 
 /// The default scene, bound with both methods, in `view`, posed.
 fn posed_editor(view: ViewSettings) -> Option<Harness<'static, EditorApp>> {
     let mut harness = editor_with(EditorOptions {
-        pose: Some(pose_path()),
+        pose: Some(guide_pose()),
         view,
         ..Default::default()
     })?;

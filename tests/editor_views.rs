@@ -8,7 +8,6 @@ use egui_kittest::Harness;
 use pmvc::app::compare::{Layout, Pane, ViewSettings, DIFFERENCE_FLOOR};
 use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
-use std::path::PathBuf;
 
 const DIFFERENCE: Pane = Pane::Difference {
     against: Method::Mvc,
@@ -19,9 +18,7 @@ fn difference_editor(
     pose: bool,
     difference_limit: Option<f32>,
 ) -> Option<Harness<'static, EditorApp>> {
-    let pose = pose.then(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj")
-    });
+    let pose = pose.then(guide_pose);
     let mut harness = editor_with(EditorOptions {
         pose,
         view: ViewSettings {

@@ -60,6 +60,7 @@ fn frame_uniform_matches_the_wgsl_frame() {
             other_first_chunk,
             smooth_shading,
             vertex_columns,
+            probe_width,
         ]
     );
     for source in [

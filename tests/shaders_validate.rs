@@ -44,24 +44,53 @@ fn every_shader_parses_and_validates() {
         checked, on_disk,
         "every shader file is composed and checked"
     );
-    let mut failures = Vec::new();
-    for (name, source) in &shaders {
-        assert!(!source.contains("#import"), "{name}: an import was left");
-        let module = match naga::front::wgsl::parse_str(source) {
-            Ok(module) => module,
-            Err(error) => {
-                failures.push(error.emit_to_string_with_path(source, name));
-                continue;
-            }
-        };
-        // Default capabilities: what WebGPU guarantees, so the shaders run anywhere.
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        );
-        if let Err(error) = validator.validate(&module) {
-            failures.push(error.emit_to_string_with_path(source, name));
+    let failures: Vec<String> = shaders
+        .iter()
+        .filter_map(|(name, source)| validate(name, source).err())
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Parse and validate `source`; the error names `name` and the place.
+fn validate(name: &str, source: &str) -> Result<naga::Module, String> {
+    assert!(!source.contains("#import"), "{name}: an import was left");
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|error| error.emit_to_string_with_path(source, name))?;
+    // Default capabilities: what WebGPU guarantees, so the shaders run anywhere.
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    );
+    validator
+        .validate(&module)
+        .map_err(|error| error.emit_to_string_with_path(source, name))?;
+    Ok(module)
+}
+
+#[test]
+fn the_mesh_shader_reading_weights_as_vertex_attributes_validates() {
+    use pmvc::render::weight_attributes::AttributeBlend;
+    let limits = wgpu::Limits {
+        max_vertex_attributes: 32,
+        ..Default::default()
+    };
+    // Ogre's 118 columns, all in attributes; a 162-vertex cage's, past them; one column.
+    for columns in [118, 162, 1] {
+        let blend = AttributeBlend::new(&limits, columns, 1).expect("fits");
+        let source = pmvc::render::mesh::shader_source_for(16, Some(&blend));
+        let name = format!("render_mesh.wgsl with {columns} columns as attributes");
+        let module = validate(&name, &source).unwrap_or_else(|error| panic!("{error}"));
+        let entries: Vec<&str> = module
+            .entry_points
+            .iter()
+            .map(|e| e.name.as_str())
+            .collect();
+        for entry in [
+            "vs_mesh_attributes",
+            "vs_wire_attributes",
+            "vs_probe_attributes",
+        ] {
+            assert!(entries.contains(&entry), "{name}: no {entry}");
         }
     }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

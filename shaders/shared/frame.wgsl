@@ -33,6 +33,8 @@ struct Frame {
     // The weights columns of the cage vertices; Green coordinates' triangle
     // columns follow them. The negativity view's minimum runs over these.
     vertex_columns: u32,
+    // Texels per row of the image that render::drawn reads the drawn positions from.
+    probe_width: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

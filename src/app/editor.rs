@@ -535,6 +535,23 @@ impl EditorApp {
         .and_then(Result::ok)
     }
 
+    /// `method`'s deformed positions as the vertex shader draws them.
+    pub fn read_back_drawn(
+        &self,
+        method: crate::coords::Method,
+    ) -> Option<Result<Vec<Vec3>, RenderError>> {
+        self.with_renderer(|renderer, device, queue| {
+            renderer.read_back_drawn(device, queue, method)
+        })
+    }
+
+    /// The weights columns of `method` drawn from vertex attributes; `None`
+    /// when the viewport reads them all from storage.
+    pub fn attribute_columns(&self, method: crate::coords::Method) -> Option<u32> {
+        self.with_renderer(|renderer, _, _| renderer.attribute_columns(method))
+            .flatten()
+    }
+
     /// Positions, colouring values and colours as the shaders compute them.
     pub fn read_back(&self, shading: &Shading) -> Option<Result<ReadBack, RenderError>> {
         self.with_renderer(|renderer, device, queue| renderer.read_back(device, queue, shading))

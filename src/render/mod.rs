@@ -6,9 +6,13 @@
 //!   [`scene_gpu`] uses);
 //! - [`mesh`]: the deformed mesh (deformation in the vertex shader);
 //! - [`cage`]: the cage's edges and handles;
+//! - [`weight_attributes`]: the first weights columns read as vertex attributes
+//!   where the device allows (a leaf that [`scene_gpu`] uses);
 //! - [`readback`]: the mesh shader's results read back, for tests and checks;
+//! - [`drawn`]: the positions the vertex shader draws, read back;
 //! - [`composite`]: offscreen targets and compositing into egui's pass;
 //! - [`viewport`]: the orchestrator and the paint callback;
+//! - [`shading`]: what a view shows, as plain values (no GPU);
 //! - [`camera`]: the orbit camera and screen projection (no GPU);
 //! - [`colormap`]: the heatmaps' colour maps, CPU twins of the shader's (no GPU).
 //!
@@ -19,11 +23,14 @@ pub mod callback;
 pub mod camera;
 pub mod colormap;
 pub mod composite;
+pub mod drawn;
 pub mod mesh;
 pub mod normals;
 pub mod readback;
 pub mod scene_gpu;
+pub mod shading;
 pub mod viewport;
+pub mod weight_attributes;
 pub mod weight_chunks;
 
 pub use callback::ViewportCallback;

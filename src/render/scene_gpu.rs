@@ -4,6 +4,7 @@
 //! never on the orchestrator ([`super::viewport`]), as re_renderer's renderers
 //! depend on its global bindings.
 
+use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use super::weight_chunks::{
     ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
 };
@@ -50,8 +51,10 @@ pub struct FrameUniform {
     /// The weights columns of the cage vertices (the negativity view's minimum
     /// runs over these; Green coordinates' triangle columns follow them).
     pub vertex_columns: u32,
+    /// Texels per row of the image [`super::drawn`] reads the drawn positions from.
+    pub probe_width: u32,
     /// Rounds the size up to WGSL's 16-byte struct alignment.
-    pub _padding: [u32; 3],
+    pub _padding: [u32; 2],
 }
 
 /// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family
@@ -152,8 +155,18 @@ pub struct WeightSlot {
     /// them ([`UNIFORM_DISPLACEMENT_BYTES`], zero past the columns).
     pub uniform_displacements: wgpu::Buffer,
     pub columns: u32,
+    /// How the rows' first columns are read as vertex attributes from the one
+    /// chunk; `None`: from storage alone.
+    pub attributes: Option<AttributeBlend>,
     /// The pose revision the normals were computed for; `None` before the first.
     pub normals_pose: Option<u64>,
+}
+
+impl WeightSlot {
+    /// The weights as vertex attributes, where they are read so.
+    pub fn attribute_weights(&self) -> Option<AttributeWeights<'_>> {
+        Some((self.attributes?, self.chunks.first()?))
+    }
 }
 
 /// The scene's GPU buffers: one mesh and cage, and the weights of every family

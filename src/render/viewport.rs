@@ -11,13 +11,16 @@
 use super::cage::CageRenderer;
 use super::colormap::Scale;
 use super::composite::{Compositor, OffscreenTarget};
-use super::mesh::MeshRenderer;
+use super::drawn::DrawnPositions;
+use super::mesh::{MeshPipelineKey, MeshRenderer};
 use super::normals::NormalsPass;
 use super::readback::Readback;
 use super::scene_gpu::{
     buffer_with, points_f32, scene_layout, uniform_displacements_buffer, FrameUniform, ReadBack,
     SceneGpu, WeightSlot, FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
 };
+pub use super::shading::{Colouring, FrameParams, Shading};
+use super::weight_attributes::AttributeBlend;
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 use crate::coords::{Method, Weights};
 use crate::geometry::Cage;
@@ -74,88 +77,6 @@ pub fn check_adapter(adapter: &wgpu::Adapter, device: &wgpu::Device) -> Result<(
     })
 }
 
-/// What the mesh is coloured by.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Colouring {
-    /// Plain shading.
-    #[default]
-    Shaded,
-    /// The weight of one column: λᵢ of cage vertex i.
-    CageVertexWeight(u32),
-    /// Green coordinates' ψⱼ of cage triangle j: the column after the cage
-    /// vertices'; a family without it shows the mesh shaded.
-    TriangleWeight(u32),
-    /// minⱼ λⱼ per mesh vertex: where the coordinates go negative.
-    MostNegativeWeight,
-    /// |p′ − p′_against| between two families' deformations, over the cage size.
-    MethodDistance,
-}
-
-impl Colouring {
-    /// The shader's `COLOURING_*` constant and the column it shows, for weights
-    /// of `columns` columns whose first `vertex_columns` are the cage vertices'.
-    fn code(self, vertex_columns: u32, columns: u32) -> [u32; 2] {
-        match self {
-            Colouring::Shaded => [0, 0],
-            Colouring::CageVertexWeight(vertex) => [1, vertex],
-            Colouring::TriangleWeight(triangle) => match vertex_columns.checked_add(triangle) {
-                Some(column) if column < columns => [1, column],
-                _ => [0, 0],
-            },
-            Colouring::MostNegativeWeight => [2, 0],
-            Colouring::MethodDistance => [3, 0],
-        }
-    }
-}
-
-/// How one view colours the mesh, and with which method's weights.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Shading {
-    /// The weights the mesh is deformed (and coloured) with.
-    pub method: Method,
-    /// The family compared with in the difference view ([`Colouring::MethodDistance`]).
-    pub against: Option<Method>,
-    pub colouring: Colouring,
-    pub scale: Scale,
-    /// Magnitude at which the colour map saturates.
-    pub colour_limit: f32,
-    /// Distances of [`Colouring::MethodDistance`] are divided by this.
-    pub cage_size: f32,
-}
-
-impl Default for Shading {
-    fn default() -> Self {
-        Self {
-            method: Method::Pmvc,
-            against: None,
-            colouring: Colouring::Shaded,
-            scale: Scale::Linear,
-            colour_limit: 1.0,
-            cage_size: 1.0,
-        }
-    }
-}
-
-/// Per-frame camera settings, carried by the paint callback.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameParams {
-    /// Which view this is, below [`MAX_VIEWS`].
-    pub view: usize,
-    pub shading: Shading,
-    pub view_projection: Mat4,
-    pub eye: Vec3,
-    /// Viewport size in physical pixels.
-    pub size_px: [u32; 2],
-    pub handle_radius_px: f32,
-    pub highlight_outside: bool,
-    /// Draw the cage's edges and handles over the mesh.
-    pub show_cage: bool,
-    /// Draw the mesh's edges over it.
-    pub wireframe: bool,
-    /// Light with per-vertex normals of the deformed mesh (else per face).
-    pub smooth_shading: bool,
-}
-
 /// What the viewport draws, uploaded when the scene changes.
 pub struct SceneUpload<'a> {
     pub rest_positions: &'a [Vec3],
@@ -174,6 +95,8 @@ pub struct ViewportRenderer {
     compositor: Compositor,
     /// Made on the first readback.
     readback: Option<Readback>,
+    /// Made on the first readback of the drawn positions.
+    drawn: Option<DrawnPositions>,
     /// Made when smooth shading first needs normals.
     normals: Option<NormalsPass>,
     targets: [Option<OffscreenTarget>; MAX_VIEWS],
@@ -203,6 +126,7 @@ impl ViewportRenderer {
             cage: CageRenderer::new(device, &scene_layout, sample_count),
             compositor: Compositor::new(device, target_format),
             readback: None,
+            drawn: None,
             normals: None,
             sample_count,
             scene_layout,
@@ -273,13 +197,17 @@ impl ViewportRenderer {
                 return Err(too_large.into());
             }
         };
+        // Readable as vertex attributes too (render::weight_attributes).
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX;
         let chunks = match resident {
             Some(buffer) if split.chunks == 1 => vec![buffer.clone()],
             _ => split
                 .chunks_of(weights)
-                .map(|values| buffer_with(device, "weights", values, wgpu::BufferUsages::STORAGE))
+                .map(|values| buffer_with(device, "weights", values, usage))
                 .collect(),
         };
+        let attributes = AttributeBlend::new(&device.limits(), weights.cols as u32, chunks.len())
+            .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
         // The columns' displacements, then room for the vertex normals.
         let mut displacements = scene.displacements_of(method);
         let uniform_displacements = uniform_displacements_buffer(device, &displacements);
@@ -300,6 +228,7 @@ impl ViewportRenderer {
                 displacements,
                 uniform_displacements,
                 columns: weights.cols as u32,
+                attributes,
                 normals_pose: None,
             }),
         );
@@ -392,7 +321,8 @@ impl ViewportRenderer {
             other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
             smooth_shading: u32::from(params.smooth_shading),
             vertex_columns: cage_vertices,
-            _padding: [0; 3],
+            probe_width: super::drawn::PROBE_WIDTH,
+            _padding: [0; 2],
         }
     }
 
@@ -412,6 +342,57 @@ impl ViewportRenderer {
         queue: &wgpu::Queue,
         shading: &Shading,
     ) -> Result<ReadBack, RenderError> {
+        let (bind_group, offset) = self.readback_bind_group(device, queue, shading)?;
+        let slots = self.chunk_limits.slots;
+        let readback =
+            (self.readback).get_or_insert_with(|| Readback::new(device, &self.scene_layout, slots));
+        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
+        readback
+            .run(device, queue, scene, &bind_group, offset)
+            .map_err(|_| RenderError::ReadBack)
+    }
+
+    /// `method`'s deformed mesh positions as the vertex shader draws them: read
+    /// as vertex attributes where the viewport reads them so ([`Self::attribute_columns`]).
+    pub fn read_back_drawn(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        method: Method,
+    ) -> Result<Vec<Vec3>, RenderError> {
+        let shading = Shading {
+            method,
+            ..Default::default()
+        };
+        let (bind_group, offset) = self.readback_bind_group(device, queue, &shading)?;
+        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
+        let weights = scene
+            .slots
+            .get(&method)
+            .and_then(WeightSlot::attribute_weights);
+        let slots = self.chunk_limits.slots;
+        let drawn = (self.drawn)
+            .get_or_insert_with(|| DrawnPositions::new(device, &self.scene_layout, slots));
+        drawn
+            .run(device, queue, scene, &bind_group, offset, weights)
+            .map_err(|_| RenderError::ReadBack)
+    }
+
+    /// The weights columns `method`'s rows are drawn with from vertex attributes
+    /// (the rest from storage); `None` when they are all read from storage.
+    pub fn attribute_columns(&self, method: Method) -> Option<u32> {
+        let slot = self.scene.as_ref()?.slots.get(&method)?;
+        Some(slot.attributes?.attribute_columns())
+    }
+
+    /// The readback slot of the frame uniform set for `shading`, and the scene's
+    /// bind group with its offset.
+    fn readback_bind_group(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        shading: &Shading,
+    ) -> Result<(wgpu::BindGroup, u32), RenderError> {
         let params = FrameParams {
             view: READBACK_SLOT,
             shading: *shading,
@@ -426,25 +407,16 @@ impl ViewportRenderer {
         };
         let uniform = self.frame_uniform(&params);
         self.write_frame_slot(queue, READBACK_SLOT, &uniform);
-        let readback = self.readback.get_or_insert_with(|| {
-            Readback::new(device, &self.scene_layout, self.chunk_limits.slots)
-        });
-        let Some(scene) = self.scene.as_mut() else {
-            return Err(RenderError::NoScene);
-        };
-        let bind_group = scene
-            .bind_group(
-                device,
-                &self.scene_layout,
-                &self.frame,
-                shading.method,
-                shading.against,
-            )
-            .clone();
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let bind_group = scene.bind_group(
+            device,
+            &self.scene_layout,
+            &self.frame,
+            shading.method,
+            shading.against,
+        );
         let offset = (READBACK_SLOT as u64 * FRAME_SLOT_BYTES) as u32;
-        readback
-            .run(device, queue, scene, &bind_group, offset)
-            .map_err(|_| RenderError::ReadBack)
+        Ok((bind_group.clone(), offset))
     }
 
     /// Draw view `params.view` into its offscreen target.
@@ -479,6 +451,14 @@ impl ViewportRenderer {
                 self.update_normals(device, encoder, params.shading.method, bind_group, offset);
             }
         }
+        let key = MeshPipelineKey {
+            attributes: self.scene.as_ref().and_then(|scene| {
+                let slot = scene.slots.get(&params.shading.method)?;
+                slot.attributes
+            }),
+            coloured: params.shading.colouring != Colouring::Shaded,
+        };
+        self.mesh.prepare(device, key);
         let Some(target) = &self.targets[view] else {
             return;
         };
@@ -513,10 +493,14 @@ impl ViewportRenderer {
         });
         if let (Some(scene), Some(bind_group)) = (&self.scene, bind_group) {
             let offset = (view as u64 * FRAME_SLOT_BYTES) as u32;
-            self.mesh.draw(&mut pass, scene, &bind_group, offset);
+            let weights = scene.slots.get(&params.shading.method);
+            let weights = weights.and_then(WeightSlot::attribute_weights);
+            let buffer = weights.map(|(_, buffer)| buffer);
+            self.mesh
+                .draw(&mut pass, scene, &bind_group, offset, key, buffer);
             if params.wireframe {
                 self.mesh
-                    .draw_wireframe(&mut pass, scene, &bind_group, offset);
+                    .draw_wireframe(&mut pass, scene, &bind_group, offset, key, buffer);
             }
             if params.show_cage {
                 self.cage.draw(&mut pass, scene, &bind_group, offset);

@@ -147,20 +147,21 @@ pub fn wgsl(slots: u32) -> String {
     });
     out.push_str("    return weight;\n}\n");
     let _ = writeln!(out, "\nconst UNIFORM_COLUMNS: u32 = {UNIFORM_COLUMNS}u;");
-    // Σ_c W[row, c] · d_c over one row, for the method shown and the compared one:
-    // the first columns' d_c from the uniform copy, the rest from storage.
+    // `head` + Σ_c W[row, c] · d_c over columns `first..columns` of one row, for
+    // the method shown and the compared one: the first columns' d_c from the
+    // uniform copy, the rest from storage.
     for (name, displacements) in [
         ("blend_row", "displacements"),
         ("blend_other_row", "other_displacements"),
     ] {
         let _ = writeln!(
             out,
-            "\nfn {name}(chunk: u32, start: u32, columns: u32) -> vec3<f32> {{\n    var moved = vec3<f32>(0.0);\n    let in_uniform = min(columns, UNIFORM_COLUMNS);"
+            "\nfn {name}(chunk: u32, start: u32, first: u32, columns: u32, head: vec3<f32>) -> vec3<f32> {{\n    var moved = head;\n    let in_uniform = min(columns, UNIFORM_COLUMNS);"
         );
         switch(&mut out, &|slot| {
             format!(
-                "for (var c = 0u; c < in_uniform; c++) {{ moved += weight_chunk_{slot}[start + c] * uniform_{displacements}[c].xyz; }} \
-                 for (var c = in_uniform; c < columns; c++) {{ moved += weight_chunk_{slot}[start + c] * {displacements}[c].xyz; }}"
+                "for (var c = first; c < in_uniform; c++) {{ moved += weight_chunk_{slot}[start + c] * uniform_{displacements}[c].xyz; }} \
+                 for (var c = max(first, in_uniform); c < columns; c++) {{ moved += weight_chunk_{slot}[start + c] * {displacements}[c].xyz; }}"
             )
         });
         out.push_str("    return moved;\n}\n");

@@ -56,6 +56,11 @@ fn render_state_with(
     }
 }
 
+/// The user guide's pose of the default scene: one prong bent sideways.
+pub fn guide_pose() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj")
+}
+
 pub fn editor() -> Option<Harness<'static, EditorApp>> {
     editor_binding_on(BindOn::Auto)
 }

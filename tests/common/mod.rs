@@ -35,6 +35,21 @@ pub fn points_obj(points: &[glam::DVec3]) -> String {
         .collect()
 }
 
+/// `points` as a mesh, `cage` and its pose `posed` (the cage's positions moved),
+/// written to `dir` as mesh.obj, cage.obj and pose.obj.
+pub fn posed_scene_files(
+    dir: &Path,
+    cage: &Cage,
+    points: &[glam::DVec3],
+    posed: &[glam::DVec3],
+) -> (PathBuf, PathBuf, PathBuf) {
+    (
+        write(dir, "mesh.obj", &points_obj(points)),
+        write(dir, "cage.obj", &cage_obj(cage)),
+        write(dir, "pose.obj", &triangles_obj(posed, cage.triangles())),
+    )
+}
+
 /// A comb cage and points inside it, written to `dir` as cage.obj and mesh.obj.
 pub fn comb_scene(dir: &Path, points: usize) -> (PathBuf, PathBuf, Cage, Vec<glam::DVec3>) {
     let cage = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);

@@ -243,10 +243,12 @@ impl<'a> GpuBind<'a> {
                         limit: resident_limit,
                     });
                 }
+                // VERTEX: the viewport reads a row's first columns as vertex
+                // attributes (render::weight_attributes).
                 Some(buffer(
                     "weights",
                     needed,
-                    U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                    U::STORAGE | U::COPY_SRC | U::COPY_DST | U::VERTEX,
                 ))
             } else {
                 None
