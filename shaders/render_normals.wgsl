@@ -1,6 +1,7 @@
 // Smooth shading: each mesh vertex's normal, the area-weighted sum of the
 // normals of the deformed triangles around it, recomputed per pose change from
-// the positions the vertex shader's deformation gives (written by cs_positions
+// the positions the vertex shader's deformation gives (drawn by vs_probe_attributes
+// where the weights are read as attributes, else written by cs_positions; both
 // in render_mesh.wgsl). CPU twin: geometry::vertex_normals. Paired with
 // src/render/normals.rs.
 

@@ -103,11 +103,7 @@ fn columns_past_the_vertex_attributes_come_from_storage() {
 #[test]
 fn weights_split_over_several_buffers_are_drawn_from_storage() {
     // Storage bindings of 256 KiB: the default scene's weights take several.
-    let limits = wgpu::Limits {
-        max_storage_buffer_binding_size: 256 << 10,
-        max_storage_buffers_per_shader_stage: 32,
-        ..Default::default()
-    };
+    let limits = small_storage_bindings(256 << 10);
     let options = EditorOptions {
         pose: Some(guide_pose()),
         ..Default::default()

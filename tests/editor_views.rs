@@ -4,6 +4,7 @@
 mod common;
 
 use common::editor::*;
+use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use pmvc::app::compare::{Layout, Pane, ViewSettings, DIFFERENCE_FLOOR};
 use pmvc::app::{EditorApp, EditorOptions};
@@ -438,8 +439,29 @@ fn the_wireframe_draws_the_mesh_edges_over_the_surface_and_goes_away_again() {
 
 #[test]
 fn smooth_shading_normals_follow_the_pose_as_the_cpu_twin_computes_them() {
-    let Some(mut harness) = editor() else { return };
+    let Some(harness) = editor() else { return };
+    // The positions are drawn with the weights read as vertex attributes.
+    normals_follow_the_pose(harness, true);
+}
+
+#[test]
+fn smooth_shading_normals_of_weights_split_over_buffers_follow_the_pose() {
+    // Storage bindings of 512 KiB split the default scene's weights (1.2 MiB),
+    // which are then read from storage alone, and a compute pass finds the
+    // positions; the normals' own buffers still fit.
+    let Some(state) = render_state_limited_to(small_storage_bindings(512 << 10)) else {
+        return;
+    };
+    normals_follow_the_pose(editor_on(state, Default::default()), false);
+}
+
+fn normals_follow_the_pose(mut harness: Harness<'static, EditorApp>, attributes: bool) {
     run_until_bound(&mut harness);
+    let method = harness.state().active_method();
+    assert_eq!(
+        harness.state().attribute_columns(method).is_some(),
+        attributes
+    );
     let rest = harness.state().document().cage().positions().to_vec();
     // Bend the middle finger: its normals must turn with it.
     for handle in [10, 11, 30, 31] {
@@ -480,4 +502,33 @@ fn smooth_shading_normals_follow_the_pose_as_the_cpu_twin_computes_them() {
     harness.state_mut().view_mut().smooth_shading = false;
     harness.run_steps(2);
     assert_ne!(harness.render().unwrap(), smooth);
+}
+
+#[test]
+fn normals_beyond_the_storage_bindings_light_each_face_and_the_menu_says_why() {
+    // 256 KiB storage bindings: the comb's triangle corners (349 KiB) do not fit.
+    let Some(state) = render_state_limited_to(small_storage_bindings(256 << 10)) else {
+        return;
+    };
+    let options = EditorOptions {
+        pose: Some(guide_pose()),
+        ..Default::default()
+    };
+    let mut harness = editor_on(state, options);
+    run_until_bound(&mut harness);
+    let reason = harness.state().smooth_shading_refusal().expect("refused");
+    assert!(
+        reason.contains("0.34 MiB") && reason.contains("0.25 MiB"),
+        "{reason}"
+    );
+    // Asked for, smooth shading draws what faceted shading draws.
+    assert!(harness.state().view().smooth_shading);
+    harness.run_steps(2);
+    let asked = harness.render().unwrap();
+    harness.state_mut().view_mut().smooth_shading = false;
+    harness.run_steps(2);
+    assert_eq!(harness.render().unwrap(), asked);
+    harness.get_by_label("View").click();
+    harness.run_steps(2);
+    harness.get_by_label("Smooth shading (unavailable)");
 }

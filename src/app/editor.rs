@@ -545,6 +545,13 @@ impl EditorApp {
         })
     }
 
+    /// Why smooth shading cannot be shown for this scene on this GPU, if it
+    /// cannot (the mesh is then lit per face).
+    pub fn smooth_shading_refusal(&self) -> Option<String> {
+        self.with_renderer(|renderer, device, _| renderer.smooth_shading_refusal(device))
+            .flatten()
+    }
+
     /// The weights columns of `method` drawn from vertex attributes; `None`
     /// when the viewport reads them all from storage.
     pub fn attribute_columns(&self, method: crate::coords::Method) -> Option<u32> {

@@ -5,25 +5,28 @@
 //! drawn as points with the viewport's own vertex fetch: vertex i lands on texel
 //! (i mod [`PROBE_WIDTH`], i / [`PROBE_WIDTH`]) of a float image and writes its
 //! deformed position there (`vs_probe`, `vs_probe_attributes` and `fs_probe` in
-//! `shaders/render_mesh.wgsl`). Tests compare it with the CPU's deformation.
+//! `shaders/render_mesh.wgsl`). Tests compare it with the CPU's deformation, and
+//! smooth shading takes its positions from here where the weights are read as
+//! attributes ([`super::normals`]): one vertex fetch per vertex instead of a
+//! compute pass loading every weight from storage.
 
 use super::mesh::{shader_module_for, vertex_entry, CONSTANTS};
 use super::readback::map_vec4s;
-use super::scene_gpu::SceneGpu;
+use super::scene_gpu::{padded_bytes, SceneGpu, PROBE_WIDTH};
 use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use glam::Vec3;
 use std::collections::HashMap;
 
-/// Texels per row of the image: 1,024 `vec4<f32>`s are 16 KiB, a multiple of the
-/// 256-byte row alignment of texture copies, so the rows read back contiguous.
-pub const PROBE_WIDTH: u32 = 1024;
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+const ROW_BYTES: u32 = PROBE_WIDTH * 16;
 
 pub struct DrawnPositions {
     layout: wgpu::PipelineLayout,
     chunk_slots: u32,
     /// Per way of reading the weights (`None`: storage alone), made on first use.
     pipelines: HashMap<Option<AttributeBlend>, wgpu::RenderPipeline>,
+    /// The image the points are drawn into, kept while the mesh keeps its size.
+    image: Option<wgpu::Texture>,
 }
 
 impl DrawnPositions {
@@ -41,14 +44,12 @@ impl DrawnPositions {
             layout,
             chunk_slots,
             pipelines: HashMap::new(),
+            image: None,
         }
     }
 
-    fn pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        attributes: Option<AttributeBlend>,
-    ) -> &wgpu::RenderPipeline {
+    /// Make the pipeline for `attributes`, once.
+    fn prepare_pipeline(&mut self, device: &wgpu::Device, attributes: Option<AttributeBlend>) {
         self.pipelines.entry(attributes).or_insert_with(|| {
             let module = shader_module_for(device, self.chunk_slots, attributes.as_ref());
             let vertex_attributes = attributes.map(|blend| blend.vertex_attributes());
@@ -85,7 +86,7 @@ impl DrawnPositions {
                 multiview_mask: None,
                 cache: None,
             })
-        })
+        });
     }
 
     /// Draw every mesh vertex as the viewport does (with `weights` as vertex
@@ -102,39 +103,86 @@ impl DrawnPositions {
         frame_offset: u32,
         weights: Option<AttributeWeights<'_>>,
     ) -> Result<Vec<Vec3>, wgpu::BufferAsyncError> {
-        let vertices = scene.vertex_count;
+        let vertices = scene.vertex_count as usize;
         if vertices == 0 {
             return Ok(Vec::new());
         }
-        let height = vertices.div_ceil(PROBE_WIDTH);
-        if height > device.limits().max_texture_dimension_2d {
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("drawn positions staging"),
+            size: padded_bytes(scene.vertex_count),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let encoded = self.encode(
+            device,
+            &mut encoder,
+            scene,
+            bind_group,
+            frame_offset,
+            weights,
+            &staging,
+        );
+        if !encoded {
             return Err(wgpu::BufferAsyncError);
+        }
+        queue.submit([encoder.finish()]);
+        let texels = map_vec4s(device, &staging)?;
+        Ok(texels[..vertices]
+            .iter()
+            .map(|texel| Vec3::new(texel[0], texel[1], texel[2]))
+            .collect())
+    }
+
+    /// Encode drawing every mesh vertex's deformed position and copying the
+    /// positions to `output` (vertex i at `vec4` i; at least [`padded_bytes`]
+    /// long, with `COPY_DST`). False, with nothing encoded, when there are no
+    /// vertices or the image would be taller than the device allows.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneGpu,
+        bind_group: &wgpu::BindGroup,
+        frame_offset: u32,
+        weights: Option<AttributeWeights<'_>>,
+        output: &wgpu::Buffer,
+    ) -> bool {
+        let vertices = scene.vertex_count;
+        let height = vertices.div_ceil(PROBE_WIDTH);
+        if vertices == 0 || height > device.limits().max_texture_dimension_2d {
+            return false;
         }
         let size = wgpu::Extent3d {
             width: PROBE_WIDTH,
             height,
             depth_or_array_layers: 1,
         };
-        let image = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("drawn positions"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let row_bytes = PROBE_WIDTH * 16;
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("drawn positions staging"),
-            size: u64::from(row_bytes) * u64::from(height),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let pipeline = self.pipeline(device, weights.map(|(blend, _)| blend));
+        if self
+            .image
+            .as_ref()
+            .is_none_or(|image| image.height() != height)
+        {
+            self.image = Some(device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("drawn positions"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            }));
+        }
+        self.prepare_pipeline(device, weights.map(|(blend, _)| blend));
+        let (Some(image), Some(pipeline)) = (
+            self.image.as_ref(),
+            self.pipelines.get(&weights.map(|(blend, _)| blend)),
+        ) else {
+            return false;
+        };
         let view = image.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("drawn positions"),
@@ -162,20 +210,15 @@ impl DrawnPositions {
         encoder.copy_texture_to_buffer(
             image.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
+                buffer: output,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(row_bytes),
+                    bytes_per_row: Some(ROW_BYTES),
                     rows_per_image: Some(height),
                 },
             },
             size,
         );
-        queue.submit([encoder.finish()]);
-        let texels = map_vec4s(device, &staging)?;
-        Ok(texels[..vertices as usize]
-            .iter()
-            .map(|texel| Vec3::new(texel[0], texel[1], texel[2]))
-            .collect())
+        true
     }
 }

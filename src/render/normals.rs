@@ -1,8 +1,10 @@
 //! Smooth shading's vertex normals on the GPU, recomputed per pose change (never
-//! per frame): a compute pass writes the deformed positions as the vertex shader
-//! computes them (`cs_positions` in `shaders/render_mesh.wgsl`), a second sums
-//! each vertex's incident triangles (`shaders/render_normals.wgsl`) through an
-//! adjacency built once per mesh. CPU twin: [`crate::geometry::vertex_normals`].
+//! per frame): the vertex shader's deformed positions are drawn into a float image
+//! ([`super::drawn`]) where the weights are read as vertex attributes, or else a
+//! compute pass computes them (`cs_positions` in `shaders/render_mesh.wgsl`); a
+//! second pass sums each vertex's incident triangles
+//! (`shaders/render_normals.wgsl`) through an adjacency built once per mesh.
+//! CPU twin: [`crate::geometry::vertex_normals`].
 
 use super::mesh::{shader_module, CONSTANTS};
 use super::scene_gpu::{buffer_with, SceneGpu};
@@ -132,7 +134,10 @@ impl NormalsPass {
 
     /// Recompute the vertex normals of the family `bind_group` shows (its frame
     /// uniform at `frame_offset`) into the end of its `displacements` buffer,
-    /// after the columns, into `encoder`.
+    /// after the columns, into `encoder`. With `positions_drawn` the deformed
+    /// positions are already in the scene's scratch buffer ([`super::drawn`]);
+    /// otherwise the first pass computes them.
+    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -141,6 +146,7 @@ impl NormalsPass {
         bind_group: &wgpu::BindGroup,
         frame_offset: u32,
         displacements: &wgpu::Buffer,
+        positions_drawn: bool,
     ) {
         let groups = scene.vertex_count.div_ceil(64).max(1);
         let positions_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -173,14 +179,31 @@ impl NormalsPass {
             label: Some("vertex normals"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.positions);
-        pass.set_bind_group(0, bind_group, &[frame_offset]);
-        pass.set_bind_group(1, &positions_group, &[]);
-        pass.dispatch_workgroups(groups, 1, 1);
+        if !positions_drawn {
+            pass.set_pipeline(&self.positions);
+            pass.set_bind_group(0, bind_group, &[frame_offset]);
+            pass.set_bind_group(1, &positions_group, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
         pass.set_pipeline(&self.normals);
         pass.set_bind_group(0, &normals_group, &[]);
         pass.dispatch_workgroups(groups, 1, 1);
     }
+}
+
+/// The largest storage binding the normals passes add to drawing's: the corners
+/// of the triangles around each vertex, as a rule (24 bytes per triangle, so
+/// about 2.8 million vertices fill lavapipe's 128 MiB).
+pub fn largest_binding(scene: &SceneGpu) -> u64 {
+    [
+        &scene.adjacency_offsets,
+        &scene.adjacency_corners,
+        &scene.deformed_scratch,
+    ]
+    .iter()
+    .map(|buffer| buffer.size())
+    .max()
+    .unwrap_or(0)
 }
 
 /// The adjacency's GPU buffers: offsets, then corners.

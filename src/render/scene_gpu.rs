@@ -57,6 +57,16 @@ pub struct FrameUniform {
     pub _padding: [u32; 2],
 }
 
+/// Texels per row of the image [`super::drawn`] draws the deformed positions
+/// into: 1,024 `vec4<f32>`s are 16 KiB, a multiple of the 256-byte row alignment
+/// of texture copies, so the rows read back contiguous.
+pub const PROBE_WIDTH: u32 = 1024;
+
+/// Bytes of the drawn positions of `vertex_count` vertices: whole image rows.
+pub fn padded_bytes(vertex_count: u32) -> u64 {
+    u64::from(vertex_count.div_ceil(PROBE_WIDTH).max(1)) * u64::from(PROBE_WIDTH) * 16
+}
+
 /// Scene bindings: 0 frame, 1 rest positions, 2 column displacements of the family
 /// shown (followed by its vertex normals), 3 cage pose, 4 handle states, 5 column
 /// displacements of the compared family; 6 and 7 the first [`UNIFORM_COLUMNS`]
@@ -227,10 +237,11 @@ impl SceneGpu {
         let adjacency = super::normals::Adjacency::of(rest_positions.len(), triangles);
         let [adjacency_offsets, adjacency_corners] =
             super::normals::adjacency_buffers(device, &adjacency);
+        // Whole rows of the image `render::drawn` copies the positions from.
         let deformed_scratch = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("deformed positions"),
-            size: (rest_positions.len() as u64 * 16).max(16),
-            usage: wgpu::BufferUsages::STORAGE,
+            size: padded_bytes(rest_positions.len() as u32),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let pose = rest_cage.positions().to_vec();

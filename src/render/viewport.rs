@@ -321,7 +321,7 @@ impl ViewportRenderer {
             other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
             smooth_shading: u32::from(params.smooth_shading),
             vertex_columns: cage_vertices,
-            probe_width: super::drawn::PROBE_WIDTH,
+            probe_width: super::scene_gpu::PROBE_WIDTH,
             _padding: [0; 2],
         }
     }
@@ -521,12 +521,31 @@ impl ViewportRenderer {
         let Some(slot) = scene.slots.get(&method) else {
             return;
         };
-        if slot.normals_pose == Some(scene.pose_revision) {
+        // Without normals the shader lights each face with its own.
+        let too_large = super::normals::largest_binding(scene)
+            > device.limits().max_storage_buffer_binding_size;
+        if slot.normals_pose == Some(scene.pose_revision) || too_large {
             return;
         }
-        let pass = self.normals.get_or_insert_with(|| {
-            NormalsPass::new(device, &self.scene_layout, self.chunk_limits.slots)
+        let slots = self.chunk_limits.slots;
+        // Where the weights are read as attributes, the positions are drawn with
+        // them: one vertex fetch per vertex, where the compute pass would load
+        // every weight from storage.
+        let positions_drawn = slot.attribute_weights().is_some_and(|weights| {
+            let drawn = (self.drawn)
+                .get_or_insert_with(|| DrawnPositions::new(device, &self.scene_layout, slots));
+            drawn.encode(
+                device,
+                encoder,
+                scene,
+                bind_group,
+                frame_offset,
+                Some(weights),
+                &scene.deformed_scratch,
+            )
         });
+        let pass = (self.normals)
+            .get_or_insert_with(|| NormalsPass::new(device, &self.scene_layout, slots));
         pass.encode(
             device,
             encoder,
@@ -534,11 +553,27 @@ impl ViewportRenderer {
             bind_group,
             frame_offset,
             &slot.displacements,
+            positions_drawn,
         );
         let revision = scene.pose_revision;
         if let Some(slot) = self.scene.as_mut().and_then(|s| s.slots.get_mut(&method)) {
             slot.normals_pose = Some(revision);
         }
+    }
+
+    /// Why this device cannot compute smooth shading's normals for the scene,
+    /// if it cannot: the mesh needs a larger storage binding than it offers.
+    pub fn smooth_shading_refusal(&self, device: &wgpu::Device) -> Option<String> {
+        let needed = super::normals::largest_binding(self.scene.as_ref()?);
+        let limit = device.limits().max_storage_buffer_binding_size;
+        (needed > limit).then(|| {
+            format!(
+                "this mesh's normals need {:.2} MiB in one storage buffer and this GPU binds at \
+                 most {:.2} MiB, so each face is lit with its own normal",
+                needed as f64 / 1048576.0,
+                limit as f64 / 1048576.0
+            )
+        })
     }
 
     /// `method`'s smooth-shading normals as last computed (for tests).

@@ -28,6 +28,16 @@ pub fn render_state_limited_to(limits: wgpu::Limits) -> Option<eframe::egui_wgpu
     render_state_with(setup)
 }
 
+/// Limits whose storage bindings hold only `bytes`, with room for a pool of
+/// weight chunks (32 storage buffers per stage, as on lavapipe).
+pub fn small_storage_bindings(bytes: u64) -> wgpu::Limits {
+    wgpu::Limits {
+        max_storage_buffer_binding_size: bytes,
+        max_storage_buffers_per_shader_stage: 32,
+        ..Default::default()
+    }
+}
+
 fn render_state_with(
     setup: eframe::egui_wgpu::WgpuSetup,
 ) -> Option<eframe::egui_wgpu::RenderState> {

@@ -161,11 +161,23 @@ impl EditorApp {
         ui.separator();
         ui.checkbox(&mut self.view.show_cage, "Cage and handles (H)")
             .on_hover_text("Hidden handles cannot be picked or box-selected");
-        ui.checkbox(&mut self.view.smooth_shading, "Smooth shading")
-            .on_hover_text(
-                "Light the mesh with each vertex's normal of the deformed mesh, recomputed on \
-                 the GPU when the pose changes; off: one normal per face (faceted)",
-            );
+        match self.smooth_shading_refusal() {
+            None => {
+                ui.checkbox(&mut self.view.smooth_shading, "Smooth shading")
+                    .on_hover_text(
+                        "Light the mesh with each vertex's normal of the deformed mesh, \
+                         recomputed on the GPU when the pose changes; off: one normal per face \
+                         (faceted)",
+                    );
+            }
+            Some(reason) => {
+                ui.add_enabled(
+                    false,
+                    egui::Checkbox::new(&mut false, "Smooth shading (unavailable)"),
+                )
+                .on_disabled_hover_text(reason);
+            }
+        }
         ui.checkbox(&mut self.view.wireframe, "Wireframe")
             .on_hover_text("The mesh's edges over its surface, deformed with it");
         let label = ui.label("Handle size");
