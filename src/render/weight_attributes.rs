@@ -14,8 +14,8 @@
 use super::weight_chunks::UNIFORM_COLUMNS;
 use std::fmt::Write as _;
 
-/// Attributes used at most: 32 is the most devices offer (lavapipe's count), and
-/// every column they hold is unrolled into the shader.
+/// Attributes used at most, lavapipe's count: every column they hold is
+/// unrolled into the shader, so more would only lengthen it.
 pub const MAX_WEIGHT_ATTRIBUTES: u32 = 32;
 
 /// One family's weights for drawing: how its rows are read as attributes, and
