@@ -243,13 +243,9 @@ impl<'a> GpuBind<'a> {
                         limit: resident_limit,
                     });
                 }
-                // VERTEX: the viewport reads a row's first columns as vertex
-                // attributes (render::weight_attributes).
-                Some(buffer(
-                    "weights",
-                    needed,
-                    U::STORAGE | U::COPY_SRC | U::COPY_DST | U::VERTEX,
-                ))
+                // VERTEX: the viewport reads rows as vertex attributes too.
+                let usage = U::STORAGE | U::COPY_SRC | U::COPY_DST | U::VERTEX;
+                Some(buffer("weights", needed, usage))
             } else {
                 None
             };
