@@ -25,6 +25,7 @@ mod files;
 mod focus;
 mod frame;
 pub mod history;
+mod offscreen;
 pub mod pose_tools;
 mod readouts;
 pub mod recent;
@@ -38,6 +39,7 @@ mod viewport;
 pub mod widgets;
 
 pub use editor::{EditorApp, FileRole};
+pub use offscreen::run_offscreen;
 pub use viewport::TransformKind;
 
 use std::path::PathBuf;
@@ -107,8 +109,24 @@ pub enum BindOn {
 pub enum EditorError {
     #[error("the editor window failed: {0}")]
     Window(String),
+    #[error("--offscreen: {0}")]
+    Offscreen(String),
     #[error("--screenshot: {} error(s) in the run: {}", .0.len(), .0.join("; "))]
     ScriptedRun(Vec<String>),
+}
+
+/// The window of a scripted run and of a first start, in points.
+pub const SCRIPTED_WINDOW_SIZE: [f32; 2] = [1280.0, 800.0];
+
+/// The device the editor asks for: the adapter's own limits, not wgpu's portable
+/// defaults (weight matrices beyond 128 MiB on GPUs that allow them, and storage
+/// buffers in the vertex stage on GL drivers that have them).
+fn editor_device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    wgpu::DeviceDescriptor {
+        label: Some("pmvc editor"),
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }
 }
 
 /// Open the editor window and run until it is closed.
@@ -116,7 +134,7 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
     let mut native_options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("pmvc editor")
-            .with_inner_size([1280.0, 800.0])
+            .with_inner_size(SCRIPTED_WINDOW_SIZE)
             .with_drag_and_drop(true),
         renderer: eframe::Renderer::Wgpu,
         // A scripted run's window is always the size asked for, whatever size
@@ -127,14 +145,7 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
     if let eframe::egui_wgpu::WgpuSetup::CreateNew(setup) =
         &mut native_options.wgpu_options.wgpu_setup
     {
-        // The adapter's own limits, not wgpu's portable defaults: weight matrices
-        // beyond 128 MiB on GPUs that allow them, and storage buffers in the vertex
-        // stage on GL drivers that have them (the viewport needs both kinds).
-        setup.device_descriptor = std::sync::Arc::new(|adapter| wgpu::DeviceDescriptor {
-            label: Some("pmvc editor"),
-            required_limits: adapter.limits(),
-            ..Default::default()
-        });
+        setup.device_descriptor = std::sync::Arc::new(editor_device_descriptor);
     }
     let failures: std::sync::Arc<std::sync::Mutex<Vec<String>>> = Default::default();
     let failures_of_run = std::sync::Arc::clone(&failures);

@@ -205,6 +205,10 @@ pub struct EditArgs {
     /// time while dragging. A handle outside the first view fails the run.
     #[arg(long, value_name = "CAGE_VERTEX", requires = "screenshot")]
     pub drag: Option<usize>,
+    /// With --screenshot: run without a window or display, drawing the editor's
+    /// frames on the GPU that wgpu finds (a server, a CI machine).
+    #[arg(long, requires = "screenshot")]
+    pub offscreen: bool,
     /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
@@ -398,7 +402,14 @@ pub fn main() -> ExitCode {
         None => crate::app::run_editor(crate::app::EditorOptions::first_run())
             .map_err(anyhow::Error::from),
         Some(Command::Edit(args)) => {
-            crate::app::run_editor(args.editor_options()).map_err(anyhow::Error::from)
+            let offscreen = args.offscreen;
+            let options = args.editor_options();
+            if offscreen {
+                crate::app::run_offscreen(options)
+            } else {
+                crate::app::run_editor(options)
+            }
+            .map_err(anyhow::Error::from)
         }
         Some(Command::Bind(args)) => commands::bind(&args),
         Some(Command::Deform(args)) => commands::deform(&args),
