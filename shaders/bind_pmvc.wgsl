@@ -11,6 +11,10 @@
 //      corner sums for the band;
 //   3. if two triangles reached the same depth somewhere in the band (rare: a ray
 //      exactly through a shared edge), the band's sums are redone from the claims.
+// A triangle whose part of a band is large is rasterised by the whole workgroup, a
+// texel per invocation, in both passes (the owner adds up the invocations' sums,
+// in another order than the CPU's): coarse cages have a few large triangles, which
+// would keep one invocation busy while the others wait at the barrier.
 // Finally each cage vertex gathers its incident triangles' sums and the row is
 // normalised by its total (Σ_k E_k/det · Ω/|d| = w, so the row sum is Σ w).
 
@@ -43,6 +47,15 @@ var<workgroup> missed: atomic<u32>;
 // Set when two triangles claim a texel of the band.
 var<workgroup> tied: atomic<u32>;
 var<workgroup> partial_totals: array<f32, WORKGROUP_SIZE>;
+// The band's shared triangles (more than SHARED_TEXELS texels in it), and the
+// invocations' sums over one of them.
+var<workgroup> shared_count: atomic<u32>;
+var<workgroup> shared_triangles: array<u32, MAX_SHARED>;
+var<workgroup> partial_sums: array<vec3<f32>, WORKGROUP_SIZE>;
+
+// Above this many texels in a band, a triangle is rasterised by the whole workgroup.
+const SHARED_TEXELS: u32 = 128u;
+const MAX_SHARED: u32 = 64u;
 
 struct Triangle {
     a: vec3<f32>,
@@ -129,6 +142,38 @@ fn face_setup(tri: Triangle, axes: mat3x3<f32>) -> FaceSetup {
     return setup;
 }
 
+// The triangle's texels in the band: [x, y) × [z, w), possibly empty.
+fn band_part(setup: FaceSetup, band_start: u32, band_end: u32) -> vec4<u32> {
+    let j0 = max(setup.range.z, band_start);
+    let j1 = max(min(setup.range.w, band_end), j0);
+    return vec4<u32>(setup.range.x, max(setup.range.y, setup.range.x), j0, j1);
+}
+
+fn texel_count(part: vec4<u32>) -> u32 {
+    return (part.y - part.x) * (part.w - part.z);
+}
+
+// An invocation's texels of a shared triangle's part: n = lane + k · WORKGROUP_SIZE
+// in row-major order, stepped by `texel_step` (columns, rows) with no division per
+// texel (CPUs have no vector one). The part is not empty.
+fn first_texel(part: vec4<u32>, lane: u32) -> vec2<u32> {
+    let width = part.y - part.x;
+    return vec2<u32>(part.x + lane % width, part.z + lane / width);
+}
+
+fn texel_step(part: vec4<u32>) -> vec2<u32> {
+    let width = part.y - part.x;
+    return vec2<u32>(WORKGROUP_SIZE % width, WORKGROUP_SIZE / width);
+}
+
+fn next_texel(part: vec4<u32>, at: vec2<u32>, step: vec2<u32>) -> vec2<u32> {
+    let next = at + step;
+    if next.x >= part.y {
+        return vec2<u32>(next.x - (part.y - part.x), next.y + 1u);
+    }
+    return next;
+}
+
 // Computed rather than loaded: storage loads dominate the inner loop on lavapipe.
 // The same expression for every triangle, so shared edges still cancel exactly.
 fn texel_centre(index: u32) -> f32 {
@@ -142,6 +187,20 @@ fn hit(setup: FaceSetup, i: u32, j: u32) -> vec4<f32> {
         return vec4<f32>(e, (e.x + e.y + e.z) * setup.inverse_det);
     }
     return vec4<f32>(e, 0.0);
+}
+
+// Step 2 at texel (i, j) of the band: if triangle t reaches the nearest depth there,
+// it claims the texel, and the texel's share of t's corner sums is returned.
+fn claim(setup: FaceSetup, t: u32, i: u32, j: u32, band_start: u32) -> vec3<f32> {
+    let h = hit(setup, i, j);
+    let texel = (j - band_start) * params.resolution + i;
+    if h.w > 0.0 && bitcast<u32>(h.w) == atomicLoad(&nearest[texel]) {
+        if atomicMin(&nearest_triangle[texel], t) != NO_TRIANGLE {
+            atomicStore(&tied, 1u);
+        }
+        return (texels[j * params.resolution + i] * setup.inverse_det) * h.xyz;
+    }
+    return vec3<f32>(0.0);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -175,14 +234,29 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             }
             if lane == 0u {
                 atomicStore(&tied, 0u);
+                atomicStore(&shared_count, 0u);
             }
             workgroupBarrier();
 
-            // 1. Nearest inverse depth per texel.
+            // 1. Nearest inverse depth per texel. Bit k of `shared_mask`: this
+            // invocation's k-th triangle is shared.
+            var shared_mask = 0u;
+            var k = 0u;
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
                 let setup = face_setup(triangle_at(t, x), axes);
-                for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
-                    for (var i = setup.range.x; i < setup.range.y; i++) {
+                let part = band_part(setup, band_start, band_end);
+                let owned = k;
+                k++;
+                if owned < 32u && texel_count(part) > SHARED_TEXELS {
+                    let slot = atomicAdd(&shared_count, 1u);
+                    if slot < MAX_SHARED {
+                        shared_triangles[slot] = t;
+                        shared_mask |= 1u << owned;
+                        continue;
+                    }
+                }
+                for (var j = part.z; j < part.w; j++) {
+                    for (var i = part.x; i < part.y; i++) {
                         let h = hit(setup, i, j);
                         if h.w > 0.0 {
                             atomicMax(&nearest[(j - band_start) * resolution + i], bitcast<u32>(h.w));
@@ -190,27 +264,65 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                     }
                 }
             }
+            let shared_total = min(workgroupUniformLoad(&shared_count), MAX_SHARED);
+            for (var s = 0u; s < shared_total; s++) {
+                let setup = face_setup(triangle_at(shared_triangles[s], x), axes);
+                let part = band_part(setup, band_start, band_end);
+                let step = texel_step(part);
+                var at = first_texel(part, lane);
+                while at.y < part.w {
+                    let h = hit(setup, at.x, at.y);
+                    if h.w > 0.0 {
+                        atomicMax(&nearest[(at.y - band_start) * resolution + at.x], bitcast<u32>(h.w));
+                    }
+                    at = next_texel(part, at, step);
+                }
+            }
             workgroupBarrier();
 
             // 2. Claim the texels reached at that depth and sum them, assuming no ties.
+            k = 0u;
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
+                let owned = k;
+                k++;
+                if owned < 32u && (shared_mask & (1u << owned)) != 0u {
+                    continue;
+                }
                 let setup = face_setup(triangle_at(t, x), axes);
                 var sums = vec3<f32>(0.0);
                 for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
                     for (var i = setup.range.x; i < setup.range.y; i++) {
-                        let h = hit(setup, i, j);
-                        let texel = (j - band_start) * resolution + i;
-                        if h.w > 0.0 && bitcast<u32>(h.w) == atomicLoad(&nearest[texel]) {
-                            if atomicMin(&nearest_triangle[texel], t) != NO_TRIANGLE {
-                                atomicStore(&tied, 1u);
-                            }
-                            sums += (texels[j * resolution + i] * setup.inverse_det) * h.xyz;
-                        }
+                        sums += claim(setup, t, i, j, band_start);
                     }
                 }
                 triangle_sums[band_base + 3u * t] = sums.x;
                 triangle_sums[band_base + 3u * t + 1u] = sums.y;
                 triangle_sums[band_base + 3u * t + 2u] = sums.z;
+            }
+            for (var s = 0u; s < shared_total; s++) {
+                let t = shared_triangles[s];
+                let setup = face_setup(triangle_at(t, x), axes);
+                let part = band_part(setup, band_start, band_end);
+                var sums = vec3<f32>(0.0);
+                let step = texel_step(part);
+                var at = first_texel(part, lane);
+                while at.y < part.w {
+                    sums += claim(setup, t, at.x, at.y, band_start);
+                    at = next_texel(part, at, step);
+                }
+                partial_sums[lane] = sums;
+                workgroupBarrier();
+                // The owner of t, which adds the band's sums to its totals in step 3.
+                if lane == t % WORKGROUP_SIZE {
+                    var total = vec3<f32>(0.0);
+                    for (var q = 0u; q < WORKGROUP_SIZE; q++) {
+                        total += partial_sums[q];
+                    }
+                    triangle_sums[band_base + 3u * t] = total.x;
+                    triangle_sums[band_base + 3u * t + 1u] = total.y;
+                    triangle_sums[band_base + 3u * t + 2u] = total.z;
+                }
+                workgroupBarrier();
             }
             let any_tie = workgroupUniformLoad(&tied) != 0u;
 

@@ -107,6 +107,15 @@ fn gpu(context: &Arc<GpuContext>, input: &BindInput, batch: BatchSize) -> Weight
         output.stats.batches,
         output.stats.elapsed
     );
+    // `pmvc bench` reports this share: the GPU's part of the bind, never all of it.
+    if output.stats.gpu_rows > 0 {
+        let wait = output.stats.gpu_wait;
+        assert!(
+            wait > Duration::ZERO && wait < output.stats.elapsed,
+            "waited {wait:?} on the GPU in a bind of {:?}",
+            output.stats.elapsed
+        );
+    }
     output.weights.expect("CPU weights requested")
 }
 

@@ -44,6 +44,11 @@ pub struct BenchRow {
     pub backend: String,
     pub median_seconds: f64,
     pub runs: Vec<f64>,
+    /// GPU rows: the median time waiting for the kernels (their share of the run),
+    /// and the last run's batches and rows redone on the CPU.
+    pub gpu_wait_seconds: Option<f64>,
+    pub batches: usize,
+    pub cpu_rows: usize,
     /// The paper's time for this scene size and method (its 2007 GPU for MVC and
     /// PMVC, its CPU solver for HC), for scale.
     pub paper_seconds: Option<f64>,
@@ -200,12 +205,17 @@ fn bench_scene(
             };
             let binder = Binder::new(timed.backend.clone());
             let mut times = Vec::with_capacity(runs);
+            let mut waits = Vec::with_capacity(runs);
+            let mut last = None;
             for _ in 0..runs.max(1) {
                 // Wall time of the whole bind: uploads and readbacks included.
                 let start = Instant::now();
-                binder.bind_blocking(&input, &BindProgress::default())?;
+                let output = binder.bind_blocking(&input, &BindProgress::default())?;
                 times.push(start.elapsed().as_secs_f64());
+                waits.push(output.stats.gpu_wait.as_secs_f64());
+                last = Some(output.stats);
             }
+            let last = last.unwrap_or_default();
             let label = match options.parameter() {
                 Some((spec, value)) => format!("{} {}", method.name(), (spec.format)(value)),
                 None => method.name().to_owned(),
@@ -218,10 +228,19 @@ fn bench_scene(
                 backend: timed.name.clone(),
                 median_seconds: median(&times),
                 runs: times,
+                gpu_wait_seconds: gpu_backend.then(|| median(&waits)),
+                batches: last.batches,
+                cpu_rows: last.cpu_rows,
                 paper_seconds: paper_seconds(name, method, resolution),
             };
+            let detail = row.gpu_wait_seconds.map_or(String::new(), |wait| {
+                format!(
+                    " ({:.3} s waiting on the GPU, {} batches, {} rows on the CPU)",
+                    wait, row.batches, row.cpu_rows
+                )
+            });
             warn_line!(
-                "  {} | {} | {}: {:.3} s",
+                "  {} | {} | {}: {:.3} s{detail}",
                 row.scene,
                 row.method,
                 row.backend,

@@ -1,9 +1,10 @@
 //! One bind on a GPU: device buffers, batches of rows, flagged rows redone on the
 //! CPU, and typed readback.
 
+use super::topology::topology;
 use super::{BatchSize, BindConfig, BindError, BindInput, BindOutput, BindStats, GpuWeights};
 use crate::coords::{self, cubemap::TexelTable, BindProgress, Weights};
-use crate::geometry::{bounds_of, Cage, PointClass};
+use crate::geometry::{bounds_of, PointClass};
 use crate::gpu::context::GpuContext;
 use crate::gpu::kernels::{Kernel, Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
 use crate::gpu::GpuError;
@@ -321,7 +322,10 @@ impl<'a> GpuBind<'a> {
             progress.advance(end - start);
             if let BatchSize::Adaptive { target } = self.config.batch {
                 let elapsed = clock.elapsed().as_secs_f64().max(1e-4);
-                let scale = (target.as_secs_f64() / elapsed).clamp(0.5, 2.0);
+                // Up to 8× larger: the first batches are short by design, and on a
+                // fast GPU their time is mostly latency, so doubling took a dozen
+                // batches to reach a useful size. Never beyond the target's rows.
+                let scale = (target.as_secs_f64() / elapsed).clamp(0.5, 8.0);
                 batch_rows = ((batch_rows as f64 * scale) as usize).clamp(1, self.capacity);
             }
             start = end;
@@ -384,6 +388,7 @@ impl<'a> GpuBind<'a> {
             return Ok(());
         }
         let queue = &self.context.queue;
+        let mut waited = std::time::Duration::ZERO;
         let flagged = scoped(&self.context.device, || {
             if self.resident.is_some() {
                 // The batch block is copied whole into the resident matrix.
@@ -468,11 +473,13 @@ impl<'a> GpuBind<'a> {
                     );
                 }
             }
+            let submitted = Instant::now();
             queue.submit([encoder.finish()]);
             if inside.is_empty() {
                 return self.wait().map(|()| Vec::new());
             }
             let status: Vec<u32> = read_back(self, &self.status_readback, status_bytes)?;
+            waited = submitted.elapsed();
             if let (Some(readback), Some(weights)) =
                 (&self.weights_readback, weights.as_deref_mut())
             {
@@ -490,6 +497,7 @@ impl<'a> GpuBind<'a> {
                 .map(|(&row, _)| row)
                 .collect::<Vec<usize>>())
         })?;
+        stats.gpu_wait += waited;
 
         if !flagged.is_empty() {
             let values = cpu_rows(input, &flagged);
@@ -526,49 +534,6 @@ fn padded<T: Default + Clone>(mut values: Vec<T>) -> Vec<T> {
         values.push(T::default());
     }
     values
-}
-
-/// Triangle corners, then the vertex → incident-corner CSR, and the kernel params
-/// that locate them.
-fn topology(cage: &Cage, kernel: Kernel, resolution: u32, rows: usize) -> (Vec<u32>, Params) {
-    let triangles = cage.triangle_count();
-    let vertices = cage.vertex_count();
-    let mut topology: Vec<u32> = cage.triangles().iter().flatten().copied().collect();
-    let offsets_at = topology.len();
-    let mut counts = vec![0u32; vertices + 1];
-    for &corner in cage.triangles().iter().flatten() {
-        counts[corner as usize + 1] += 1;
-    }
-    for v in 0..vertices {
-        counts[v + 1] += counts[v];
-    }
-    topology.extend_from_slice(&counts);
-    let entries_at = topology.len();
-    topology.resize(entries_at + 3 * triangles, 0);
-    let mut next = counts;
-    for (t, corners) in cage.triangles().iter().enumerate() {
-        for (k, &corner) in corners.iter().enumerate() {
-            let slot = &mut next[corner as usize];
-            topology[entries_at + *slot as usize] = (3 * t + k) as u32;
-            *slot += 1;
-        }
-    }
-    let texels = f64::from(resolution) * f64::from(resolution);
-    let params = Params {
-        point_count: rows as u32,
-        triangle_count: triangles as u32,
-        vertex_count: vertices as u32,
-        resolution,
-        band_rows: (BAND_TEXELS / resolution).max(1),
-        max_missed: if kernel == Kernel::Pmvc {
-            (0.01 * 6.0 * texels).floor() as u32
-        } else {
-            0
-        },
-        incidence_offsets: offsets_at as u32,
-        incidence_entries: entries_at as u32,
-    };
-    (topology, params)
 }
 
 /// Map `buffer`, wait for the device, and copy out its first `bytes` as `T`s.

@@ -14,6 +14,7 @@
 //! identities (Σφ = 1, the rest pose) by more than f32 rounding.
 
 mod gpu_bind;
+mod topology;
 
 use super::context::GpuContext;
 use super::GpuError;
@@ -124,6 +125,9 @@ pub struct BindStats {
     pub gpu_rows: usize,
     /// Rows computed on the CPU: on the surface, outside, or flagged by a kernel.
     pub cpu_rows: usize,
+    /// Time from each batch's submission until its status was read back: the
+    /// kernel, its copies and the wait, against the host's share of `elapsed`.
+    pub gpu_wait: Duration,
     /// Where it ran.
     pub device: String,
 }
@@ -337,6 +341,7 @@ fn run(
                     batches: 1,
                     gpu_rows: 0,
                     cpu_rows: input.points.len(),
+                    gpu_wait: Duration::ZERO,
                     device: "CPU".into(),
                 },
             })
