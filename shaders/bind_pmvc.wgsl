@@ -289,9 +289,10 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                     continue;
                 }
                 let setup = face_setup(triangle_at(t, x), axes);
+                let part = band_part(setup, band_start, band_end);
                 var sums = vec3<f32>(0.0);
-                for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
-                    for (var i = setup.range.x; i < setup.range.y; i++) {
+                for (var j = part.z; j < part.w; j++) {
+                    for (var i = part.x; i < part.y; i++) {
                         sums += claim(setup, t, i, j, band_start);
                     }
                 }

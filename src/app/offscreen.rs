@@ -235,20 +235,8 @@ impl Target {
             },
             self.texture.size(),
         );
-        let submitted = state.queue.submit([encoder.finish()]);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        buffer
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |result| drop(sender.send(result)));
-        wait_for(state, submitted)?;
-        receiver
-            .recv()
-            .map_err(|error| error.to_string())
-            .and_then(|mapped| mapped.map_err(|error| error.to_string()))
-            .map_err(|error| EditorError::Offscreen(format!("cannot read the frame: {error}")))?;
-        let mapped = buffer
-            .slice(..)
-            .get_mapped_range()
+        state.queue.submit([encoder.finish()]);
+        let mapped = crate::render::readback::map_bytes(&state.device, &buffer)
             .map_err(|error| EditorError::Offscreen(format!("cannot read the frame: {error}")))?;
         let blue_first = matches!(
             state.target_format,

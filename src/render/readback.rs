@@ -112,20 +112,29 @@ pub(super) fn map_vec4s(
     device: &wgpu::Device,
     staging: &wgpu::Buffer,
 ) -> Result<Vec<[f32; 4]>, wgpu::BufferAsyncError> {
+    Ok(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&map_bytes(
+        device, staging,
+    )?))
+}
+
+/// Map `staging` (filled by commands already submitted), wait for the GPU, and
+/// copy out its bytes.
+pub fn map_bytes(
+    device: &wgpu::Device,
+    staging: &wgpu::Buffer,
+) -> Result<Vec<u8>, wgpu::BufferAsyncError> {
     let (sender, receiver) = std::sync::mpsc::channel();
     staging.map_async(wgpu::MapMode::Read, .., move |result| {
         let _ = sender.send(result);
     });
     let _ = device.poll(wgpu::PollType::wait_indefinitely());
     receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
-    let values = {
-        let view = staging
-            .get_mapped_range(..)
-            .map_err(|_| wgpu::BufferAsyncError)?;
-        bytemuck::cast_slice::<u8, [f32; 4]>(&view).to_vec()
-    };
+    let bytes = staging
+        .get_mapped_range(..)
+        .map_err(|_| wgpu::BufferAsyncError)?
+        .to_vec();
     staging.unmap();
-    Ok(values)
+    Ok(bytes)
 }
 
 /// A compute-only writable buffer: writable storage in other stages needs features
