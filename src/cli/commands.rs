@@ -234,7 +234,7 @@ pub(super) fn check_output(
 /// cannot fit in the memory left, instead of an abort once it is allocated.
 fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
     let bytes = 4 * rows as u64 * cols as u64;
-    if let Some(available) = super::environment::available_memory() {
+    if let Some(available) = crate::geometry::budget::available_memory() {
         if bytes > available {
             bail!(
                 "{}: its weights would take {} ({rows} vertices × {cols} cage vertices × 4 bytes), but only {} of memory is available; bind the mesh in parts, or use a coarser cage",

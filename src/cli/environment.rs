@@ -29,22 +29,6 @@ fn private_runtime_dir() -> Option<std::path::PathBuf> {
     private.then_some(directory)
 }
 
-/// Memory the process can still get, from the kernel's estimate of what is
-/// available without swapping, plus free swap. `None` where that is not known.
-pub(super) fn available_memory() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kib = |key: &str| -> Option<u64> {
-        let line = meminfo.lines().find(|line| line.starts_with(key))?;
-        line[key.len()..]
-            .trim()
-            .trim_end_matches("kB")
-            .trim()
-            .parse()
-            .ok()
-    };
-    Some((kib("MemAvailable:")? + kib("SwapFree:").unwrap_or(0)) * 1024)
-}
-
 /// Ctrl-C, SIGTERM and SIGHUP end a process without running destructors, which
 /// would leave a half-written output's temporary file behind (hundreds of MiB for
 /// a large bind). A watcher thread removes those files, then ends the process

@@ -4,6 +4,7 @@
 //! *i*-th `v` line of the mesh file, column *j* the *j*-th `v` line of the cage file.
 
 pub mod autocage;
+pub mod budget;
 mod cage;
 mod classify;
 mod error;

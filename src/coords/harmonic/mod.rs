@@ -134,16 +134,6 @@ fn predicted_bytes(frame: &Frame, inside: usize, points: usize, columns: usize) 
     per_level * 8 / 7 + (points as u64) * (columns as u64) * 4 + (64 << 20)
 }
 
-/// MemAvailable from /proc/meminfo, if the system says.
-fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text
-        .lines()
-        .find(|line| line.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
 /// What a bind of `points` points at `grid` would use.
 pub fn plan(cage: &Cage, grid: u32, points: usize) -> Result<HarmonicPlan, HarmonicError> {
     let (frame, levels) = frame_for(cage, grid)?;
@@ -161,7 +151,7 @@ pub fn plan(cage: &Cage, grid: u32, points: usize) -> Result<HarmonicPlan, Harmo
 
 /// Refuse a plan that would not fit, naming a grid that would.
 fn check_memory(cage: &Cage, plan: &HarmonicPlan, points: usize) -> Result<(), HarmonicError> {
-    let Some(available) = available_memory() else {
+    let Some(available) = crate::geometry::budget::available_memory() else {
         return Ok(());
     };
     let budget = (available as f64 * MEMORY_SHARE) as u64;
