@@ -116,3 +116,31 @@ pub struct WriteError {
     pub path: PathBuf,
     pub source: std::io::Error,
 }
+
+/// A file name as a one-line message shows it: as it is when it prints on one
+/// line, quoted with escapes when it holds a control character (a newline would
+/// split the message) or starts or ends with a space.
+pub fn shown_path(path: &std::path::Path) -> String {
+    let text = path.to_string_lossy();
+    let plain = !text.chars().any(char::is_control)
+        && !text.starts_with(char::is_whitespace)
+        && !text.ends_with(char::is_whitespace);
+    if plain {
+        text.into_owned()
+    } else {
+        format!("{text:?}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown_path;
+    use std::path::Path;
+
+    #[test]
+    fn names_that_would_break_a_line_are_quoted() {
+        assert_eq!(shown_path(Path::new("dir/mesh.obj")), "dir/mesh.obj");
+        assert_eq!(shown_path(Path::new("a\nb.obj")), "\"a\\nb.obj\"");
+        assert_eq!(shown_path(Path::new("trailing ")), "\"trailing \"");
+    }
+}

@@ -24,7 +24,7 @@ pub use classify::{
     classify_points, closest_point_on_triangle, generalized_winding_number, PointClass,
     PointClasses,
 };
-pub use error::{CageError, CageLoadError, LoadError, WriteError};
+pub use error::{shown_path, CageError, CageLoadError, LoadError, WriteError};
 pub use io::{
     cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_mesh_with_normals,
     write_obj, write_obj_to,
