@@ -10,6 +10,28 @@ use crate::geometry::subdivide_midpoint;
 use crate::gpu::Backend;
 use std::time::{Duration, Instant};
 
+/// `options` with the parameters `pmvc edit` was given put over them, each
+/// checked by its spec; a refused value leaves the option as it was and is
+/// returned as a message.
+pub(super) fn with_asked_parameters(
+    options: &mut crate::coords::BindOptions,
+    asked: &super::EditorOptions,
+) -> Vec<String> {
+    let mut refused = Vec::new();
+    for (parameter, value) in [
+        (Parameter::Resolution, asked.resolution),
+        (Parameter::Grid, asked.grid),
+    ] {
+        if let Some(value) = value {
+            match parameter.validate(value.into()) {
+                Ok(value) => options.set(parameter, value),
+                Err(error) => refused.push(error.to_string()),
+            }
+        }
+    }
+    refused
+}
+
 impl EditorApp {
     /// Bind the methods the views show, the active one first, replacing any
     /// running bind. Existing weights stay in use until new ones arrive.
@@ -98,7 +120,13 @@ impl EditorApp {
     /// Set a family parameter (PMVC's resolution, …) and rebind the families
     /// that read it; the others keep their weights.
     pub fn set_parameter(&mut self, parameter: Parameter, value: u32) {
-        let value = value.max(1);
+        let value = match parameter.validate(value.into()) {
+            Ok(value) => value,
+            Err(error) => {
+                self.error(error.to_string());
+                return;
+            }
+        };
         if self.bind_options.get(parameter) == value {
             return;
         }

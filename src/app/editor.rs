@@ -130,12 +130,7 @@ impl EditorApp {
         // The comb is generated, so it cannot fail to load.
         let (mesh, cage) = (scenes::comb_mesh(), scenes::comb_cage());
         let mut bind_options = BindOptions::for_method(options.method.unwrap_or(Method::Pmvc));
-        if let Some(resolution) = options.resolution {
-            bind_options.resolution = resolution.max(1);
-        }
-        if let Some(grid) = options.grid {
-            bind_options.grid = grid.max(crate::coords::harmonic::MIN_GRID);
-        }
+        let refused_parameters = super::binding::with_asked_parameters(&mut bind_options, &options);
         let mut app = Self {
             gpu,
             document: Document::new(BundledScene::Comb.title(), mesh, cage)
@@ -169,6 +164,9 @@ impl EditorApp {
             dropped: None,
             cage_generation: CageGeneration::new(cc.egui_ctx.clone()),
         };
+        for refused in refused_parameters {
+            app.error(refused);
+        }
         if let Some(error) = unsupported {
             app.error(error.to_string());
         } else if app.gpu.is_none() {

@@ -88,11 +88,8 @@ impl EditorApp {
         if let Some(method) = options.method {
             self.bind_options.method = method;
         }
-        if let Some(resolution) = options.resolution {
-            self.bind_options.resolution = resolution.max(1);
-        }
-        if let Some(grid) = options.grid {
-            self.bind_options.grid = grid.max(crate::coords::harmonic::MIN_GRID);
+        for refused in super::binding::with_asked_parameters(&mut self.bind_options, options) {
+            self.error(refused);
         }
     }
 

@@ -105,10 +105,10 @@ pub struct MethodChoice {
     #[arg(long, value_enum, default_value_t = crate::coords::Method::Pmvc)]
     pub method: crate::coords::Method,
     /// PMVC cube-map resolution: texels along one face edge (1–1024).
-    #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
     /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
-    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = parse_grid)]
     pub grid: u32,
     /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
@@ -169,8 +169,8 @@ pub struct CheckArgs {
     /// Mesh vertices sampled for the MVC negativity statistic.
     #[arg(long, default_value_t = 2000)]
     pub sample: usize,
-    /// The harmonic grid to report on: cells along the cage's longest side.
-    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    /// The harmonic grid to report on: cells along the cage's longest side (4–2048).
+    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = parse_grid)]
     pub grid: u32,
 }
 
@@ -189,10 +189,10 @@ pub struct EditArgs {
     #[arg(long, value_name = "POSE.obj")]
     pub pose: Option<PathBuf>,
     /// PMVC cube-map resolution (1–1024).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<u32>,
     /// Harmonic grid: cells along the cage's longest side (4–2048).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(4..=2048))]
+    #[arg(long, value_parser = parse_grid)]
     pub grid: Option<u32>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
@@ -262,6 +262,24 @@ pub enum ViewArg {
 }
 
 /// A percentage in (0, 100], with or without the % sign.
+/// `--resolution`, checked by its spec: the one check sessions and the editor use.
+fn parse_resolution(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::Resolution, text)
+}
+
+/// `--grid`, checked by its spec.
+fn parse_grid(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::Grid, text)
+}
+
+fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
+    let value: u64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a whole number"))?;
+    parameter.validate(value).map_err(|error| error.to_string())
+}
+
 fn parse_percent(text: &str) -> Result<f32, String> {
     let number = text.trim().trim_end_matches('%');
     match number.parse::<f32>() {
@@ -471,6 +489,40 @@ mod tests {
             error_line(&error),
             "--out: w.npy: cannot write: No space left on device"
         );
+    }
+
+    #[test]
+    fn parameter_flags_take_their_range_from_the_spec_and_their_help_says_it() {
+        use crate::coords::Parameter;
+        use clap::CommandFactory;
+        let mut cli = Cli::command();
+        cli.build();
+        for (subcommand, parameter) in [
+            ("bind", Parameter::Resolution),
+            ("bind", Parameter::Grid),
+            ("edit", Parameter::Resolution),
+            ("edit", Parameter::Grid),
+            ("check", Parameter::Grid),
+        ] {
+            let spec = parameter.spec();
+            let flag = spec.flag.trim_start_matches('-');
+            let help = cli
+                .find_subcommand(subcommand)
+                .and_then(|command| command.get_arguments().find(|a| a.get_id() == flag))
+                .and_then(|argument| argument.get_help())
+                .map(|help| help.to_string())
+                .unwrap_or_default();
+            let range = format!("({}–{})", spec.min, spec.max);
+            assert!(help.contains(&range), "{subcommand} {}: {help}", spec.flag);
+            let too_large = (spec.max + 1).to_string();
+            let error = Cli::try_parse_from(["pmvc", subcommand, spec.flag, &too_large])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.contains(&format!("{} to {}", spec.min, spec.max)),
+                "{error}"
+            );
+        }
     }
 
     fn edit_options(args: &[&str]) -> crate::app::EditorOptions {

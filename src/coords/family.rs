@@ -37,8 +37,40 @@ pub struct ParameterSpec {
     /// The values the editor offers.
     pub choices: &'static [u32],
     pub default: u32,
+    /// The smallest and largest values accepted from any source ([`Self::validate`]).
+    pub min: u32,
+    pub max: u32,
     /// How a value reads in titles, e.g. "32²".
     pub format: fn(u32) -> String,
+}
+
+/// A parameter value outside its family's range.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{id} {value} is out of range: the {label} must be {min} to {max}")]
+pub struct ParameterError {
+    /// The name saved files give it ("resolution").
+    pub id: &'static str,
+    pub label: &'static str,
+    pub value: u64,
+    pub min: u32,
+    pub max: u32,
+}
+
+impl ParameterSpec {
+    /// The one check of a value, wherever it comes from (the command line, a
+    /// session, the editor's controls): `value` when it is in `min..=max`.
+    pub fn validate(&self, value: u64) -> Result<u32, ParameterError> {
+        match u32::try_from(value) {
+            Ok(value) if (self.min..=self.max).contains(&value) => Ok(value),
+            _ => Err(ParameterError {
+                id: self.key.id(),
+                label: self.label,
+                value,
+                min: self.min,
+                max: self.max,
+            }),
+        }
+    }
 }
 
 /// The parameters families can have; each is a field of [`super::BindOptions`].
@@ -59,6 +91,19 @@ impl Parameter {
             Parameter::Resolution => "resolution",
             Parameter::Grid => "grid",
         }
+    }
+
+    /// Its spec: label, flag, range and the editor's choices.
+    pub fn spec(self) -> &'static ParameterSpec {
+        match self {
+            Parameter::Resolution => &RESOLUTION,
+            Parameter::Grid => &GRID,
+        }
+    }
+
+    /// [`ParameterSpec::validate`] of this parameter.
+    pub fn validate(self, value: u64) -> Result<u32, ParameterError> {
+        self.spec().validate(value)
     }
 }
 
@@ -112,18 +157,37 @@ const MVC: FamilySpec = FamilySpec {
     rows_independent: true,
 };
 
+/// PMVC's cube-map resolution. Past 1024 the six faces of one point's cube map
+/// alone are 24 MiB and a bind of a real mesh takes hours.
+const RESOLUTION: ParameterSpec = ParameterSpec {
+    key: Parameter::Resolution,
+    label: "PMVC resolution",
+    flag: "--resolution",
+    choices: &[16, 32, 64, 128],
+    default: DEFAULT_RESOLUTION,
+    min: 1,
+    max: 1024,
+    format: |value| format!("{value}²"),
+};
+
+/// Harmonic coordinates' grid: fewer than `MIN_GRID` cells cannot resolve a
+/// cage; 2048 cells along the longest side is already billions of nodes.
+const GRID: ParameterSpec = ParameterSpec {
+    key: Parameter::Grid,
+    label: "harmonic grid",
+    flag: "--grid",
+    choices: &[32, 64, 128],
+    default: super::harmonic::DEFAULT_GRID,
+    min: super::harmonic::MIN_GRID,
+    max: 2048,
+    format: |value| format!("grid {value}"),
+};
+
 const PMVC: FamilySpec = FamilySpec {
     id: "pmvc",
     name: "PMVC",
     summary: "positive mean value coordinates: only the visible cage counts (cube map)",
-    parameter: Some(ParameterSpec {
-        key: Parameter::Resolution,
-        label: "PMVC resolution",
-        flag: "--resolution",
-        choices: &[16, 32, 64, 128],
-        default: DEFAULT_RESOLUTION,
-        format: |value| format!("{value}²"),
-    }),
+    parameter: Some(RESOLUTION),
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -134,14 +198,7 @@ const HARMONIC: FamilySpec = FamilySpec {
     id: "harmonic",
     name: "HC",
     summary: "harmonic coordinates: a grid solve of Laplace's equation inside the cage",
-    parameter: Some(ParameterSpec {
-        key: Parameter::Grid,
-        label: "harmonic grid",
-        flag: "--grid",
-        choices: &[32, 64, 128],
-        default: super::harmonic::DEFAULT_GRID,
-        format: |value| format!("grid {value}"),
-    }),
+    parameter: Some(GRID),
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -304,6 +361,34 @@ mod tests {
         }
         assert_eq!(Method::from_id("PMVC"), Some(Method::Pmvc));
         assert_eq!(Method::from_id("nope"), None);
+    }
+
+    #[test]
+    fn a_parameter_outside_its_range_is_refused_with_its_name_value_and_range() {
+        let error = Parameter::Grid.validate(4_294_967_295).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "grid 4294967295 is out of range: the harmonic grid must be 4 to 2048"
+        );
+        let error = Parameter::Resolution.validate(1 << 40).unwrap_err();
+        assert!(error.to_string().contains("1099511627776"), "{error}");
+        assert!(Parameter::Resolution.validate(0).is_err());
+        assert!(Parameter::Grid.validate(3).is_err());
+        assert_eq!(Parameter::Resolution.validate(1024), Ok(1024));
+        assert_eq!(Parameter::Grid.validate(4), Ok(4));
+    }
+
+    #[test]
+    fn every_family_parameter_is_its_parameters_spec_and_offers_valid_choices() {
+        for method in Method::ALL {
+            let Some(spec) = method.spec().parameter else {
+                continue;
+            };
+            assert_eq!(spec.label, spec.key.spec().label);
+            for &value in spec.choices.iter().chain([&spec.default]) {
+                assert_eq!(spec.validate(value.into()), Ok(value), "{}", spec.label);
+            }
+        }
     }
 
     #[test]

@@ -30,7 +30,9 @@ pub mod pmvc;
 pub mod quality;
 
 use crate::geometry::{Cage, PointClass};
-pub use family::{FamilySpec, Method, Parameter, ParameterSpec, DEFAULT_RESOLUTION};
+pub use family::{
+    FamilySpec, Method, Parameter, ParameterError, ParameterSpec, DEFAULT_RESOLUTION,
+};
 use glam::DVec3;
 pub use quality::WeightQuality;
 use rayon::prelude::*;
