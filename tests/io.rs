@@ -308,3 +308,103 @@ fn polylines_are_skipped_and_short_faces_are_errors() {
         )
     );
 }
+
+/// A device as a mesh (`/dev/zero` under an .obj name) ends in an error naming
+/// it at its first NUL byte; a pipe still delivers a mesh.
+#[cfg(unix)]
+#[test]
+fn devices_are_read_with_a_limit_and_pipes_still_deliver_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let zero = dir.path().join("zero.obj");
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    let message = load_mesh(&zero).unwrap_err().to_string();
+    assert!(message.contains("zero.obj"), "{message}");
+    assert!(message.contains("binary data near byte 0"), "{message}");
+
+    let fifo = dir.path().join("piped.obj");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|status| status.success()) {
+        eprintln!("not run: no mkfifo");
+        return;
+    }
+    let writer = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::write(fifo, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"))
+    };
+    let file = load_mesh(&fifo).unwrap();
+    writer.join().unwrap().unwrap();
+    assert_eq!(file.mesh.positions.len(), 3);
+    assert_eq!(file.mesh.triangles, vec![[0, 1, 2]]);
+}
+
+/// Run by the test below in a child process with little address space: loads
+/// the mesh named by `PMVC_TEST_MESH` and prints how it ended.
+#[test]
+fn child_loads_the_mesh_named_by_its_environment() {
+    let Ok(path) = std::env::var("PMVC_TEST_MESH") else {
+        return;
+    };
+    match load_mesh(std::path::Path::new(&path)) {
+        Ok(file) => println!("CHILD: loaded {} vertices", file.mesh.positions.len()),
+        Err(error) => println!("CHILD: refused: {error}"),
+    }
+}
+
+/// `load_mesh(path)` in a child process limited to 1 GiB of address space:
+/// what it printed, once it ended with success (no abort).
+#[cfg(unix)]
+fn load_in_a_limited_child(path: &std::path::Path) -> String {
+    let output = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1048576 && exec \"$0\" \"$@\"")
+        .arg(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "child_loads_the_mesh_named_by_its_environment",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("PMVC_TEST_MESH", path)
+        .output()
+        .expect("run the test binary");
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stdout}\n{stderr}");
+    stdout
+}
+
+/// A regular file too large to read is refused by its size before it is read:
+/// with 1 GiB of address space, a 768 MiB mesh file (sparse, so nothing is
+/// written) and its copy would not fit.
+#[cfg(unix)]
+#[test]
+fn a_mesh_file_too_large_to_read_is_refused_by_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = dir.path().join("big.obj");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(768 << 20)
+        .unwrap();
+    let stdout = load_in_a_limited_child(&big);
+    assert!(stdout.contains("CHILD: refused: "), "{stdout}");
+    assert!(stdout.contains("big.obj"), "{stdout}");
+    assert!(stdout.contains("768.0 MiB"), "{stdout}");
+}
+
+/// A file whose parse would not fit is refused by what its text holds before
+/// it is parsed: 38 MiB of nine-cornered faces take about 1.1 GiB to parse
+/// (the OBJ library keeps 24 bytes per corner), more than 1 GiB of address space.
+#[cfg(unix)]
+#[test]
+fn a_mesh_whose_parse_would_not_fit_is_refused_before_it_is_parsed() {
+    let dir = tempfile::tempdir().unwrap();
+    let dense = dir.path().join("dense.obj");
+    let mut text = String::from("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n");
+    text.push_str("v 1 0 1\nv 1 1 1\nv 0 1 1\nv 0 0 2\n");
+    text.push_str(&"f 1 2 3 4 5 6 7 8 9\n".repeat(2_000_000));
+    std::fs::write(&dense, text).unwrap();
+    let stdout = load_in_a_limited_child(&dense);
+    assert!(stdout.contains("CHILD: refused: "), "{stdout}");
+    assert!(stdout.contains("dense.obj"), "{stdout}");
+    assert!(stdout.contains("parsing its 38.1 MiB of text"), "{stdout}");
+}

@@ -122,6 +122,18 @@ fn address_space_left() -> Option<u64> {
 /// is read until it ends or passes the limit, whichever comes first. Either way
 /// the contents must also fit in memory ([`check_memory`]).
 pub fn read_limited(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    read_up_to(path, limit, false)
+}
+
+/// [`read_limited`] for a text format: an input that is not a regular file is
+/// also read no further than its first NUL byte, which no text holds, so that
+/// `/dev/zero` ends after one read instead of at the limit. The bytes returned
+/// then end with that NUL.
+pub fn read_limited_text(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    read_up_to(path, limit, true)
+}
+
+fn read_up_to(path: &Path, limit: u64, stop_at_nul: bool) -> std::io::Result<Vec<u8>> {
     let file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
     if metadata.is_dir() {
@@ -142,7 +154,24 @@ pub fn read_limited(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     } else {
         0
     });
-    file.take(limit.saturating_add(1)).read_to_end(&mut bytes)?;
+    let mut reader = file.take(limit.saturating_add(1));
+    if stop_at_nul && !metadata.is_file() {
+        let mut chunk = vec![0u8; 1 << 16];
+        loop {
+            let count = match reader.read(&mut chunk) {
+                Ok(count) => count,
+                Err(error) if error.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(error) => return Err(error),
+            };
+            let read = &chunk[..count];
+            bytes.extend_from_slice(read);
+            if count == 0 || read.contains(&0) {
+                break;
+            }
+        }
+    } else {
+        reader.read_to_end(&mut bytes)?;
+    }
     if bytes.len() as u64 > limit {
         return Err(over_limit(None, limit));
     }
@@ -208,6 +237,14 @@ mod tests {
         let error = read_limited(Path::new("/dev/zero"), 1 << 16).unwrap_err();
         assert_eq!(error.kind(), std::io::ErrorKind::InvalidData);
         assert!(error.to_string().contains("not a regular file"), "{error}");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn text_from_a_device_stops_at_its_first_nul() {
+        let bytes = read_limited_text(Path::new("/dev/zero"), 1 << 30).unwrap();
+        assert!(bytes.len() <= 1 << 16, "{} bytes", bytes.len());
+        assert_eq!(bytes.last(), Some(&0));
     }
 
     #[test]
