@@ -166,6 +166,10 @@ pub struct ViewSettings {
 /// The handle radii the View menu offers, in points; the default is 4.
 pub const HANDLE_SIZES: std::ops::RangeInclusive<f32> = 1.5..=12.0;
 
+/// The fixed ends the difference's colour scale may have, as fractions of the
+/// cage diagonal (the toolbar shows them in percent: 0.0001% to 100%).
+pub const DIFFERENCE_LIMITS: std::ops::RangeInclusive<f32> = 1e-6..=1.0;
+
 impl From<Vec<Method>> for MethodSet {
     fn from(methods: Vec<Method>) -> Self {
         Self::of(&methods)

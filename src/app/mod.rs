@@ -34,6 +34,7 @@ pub mod scenes;
 mod screenshot;
 mod scripted_drag;
 pub mod session;
+pub mod session_checks;
 pub mod ui;
 mod viewport;
 pub mod widgets;

@@ -9,13 +9,18 @@
 use super::compare::ViewSettings;
 use super::document::{Document, NamedPose};
 use super::scenes::BundledScene;
-use crate::coords::{BindOptions, Method, Parameter};
+use super::session_checks::{
+    camera_in_range, checked_pose, cut_text, inline_cage_defect, view_in_range, Reach,
+    SESSION_SIZE_LIMIT,
+};
+use crate::coords::{BindOptions, Method, Parameter, ParameterError};
+use crate::geometry::budget::read_limited;
 use crate::geometry::{
-    load_cage, load_mesh, refuse_same_file, write_atomically, write_deformed_mesh, write_obj, Cage,
-    CageError, CageLoadError, LoadError, MeshFile, TriMesh, WriteError,
+    load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
+    write_obj, Cage, CageLoadError, LoadError, MeshFile, TriMesh, WriteError,
 };
 use crate::render::OrbitCamera;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -76,7 +81,7 @@ pub struct SessionFile {
     pub method: Method,
     /// Each family's parameter by name ("resolution": 32).
     #[serde(default)]
-    pub parameters: BTreeMap<String, u32>,
+    pub parameters: BTreeMap<String, u64>,
     #[serde(default)]
     pub view: ViewSettings,
     /// One camera per view (the first is every view's while they are locked).
@@ -87,43 +92,54 @@ pub struct SessionFile {
 /// A session could not be read or written; each message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
-    #[error("{path}: cannot read: {source}", path = path.display())]
+    #[error("{path}: cannot read: {source}", path = shown_path(path))]
     Read {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: line {line}, column {column}: {message}", path = path.display())]
+    #[error("{path}: line {line}, column {column}: {message}", path = shown_path(path))]
     Parse {
         path: PathBuf,
         line: usize,
         column: usize,
         message: String,
     },
-    #[error("{path}: a session of format {found}; this editor reads format {SESSION_VERSION}", path = path.display())]
+    #[error("{path}: a session of format {found}; this editor reads format {SESSION_VERSION}", path = shown_path(path))]
     Version { path: PathBuf, found: u32 },
-    #[error("{path}: no bundled scene is called \"{id}\"", path = path.display())]
+    #[error("{path}: no bundled scene is called \"{id}\"", path = shown_path(path))]
     UnknownScene { path: PathBuf, id: String },
-    #[error("{path}: the rest cage: {source}", path = path.display())]
-    InlineCage { path: PathBuf, source: CageError },
-    #[error("{path}: {what} has {found} positions but the cage has {expected} vertices", path = path.display())]
+    #[error("{path}: the edited cage it holds (\"cage\": {{\"inline\": …}}): {message}", path = shown_path(path))]
+    InlineCage { path: PathBuf, message: String },
+    #[error("{path}: {what} has {found} positions but the cage has {expected} vertices", path = shown_path(path))]
     PoseLength {
         path: PathBuf,
         what: String,
         found: usize,
         expected: usize,
     },
-    #[error("{path}: {what} has a coordinate that is not a finite number", path = path.display())]
+    #[error("{path}: {what} has a coordinate that is not a finite number", path = shown_path(path))]
     NonFinite { path: PathBuf, what: String },
-    #[error("{path}: the mesh: {source}", path = path.display())]
+    #[error("{path}: {what}: {message}", path = shown_path(path))]
+    BeyondReach {
+        path: PathBuf,
+        what: String,
+        message: String,
+    },
+    #[error("{path}: \"parameters\": {source}", path = shown_path(path))]
+    Parameter {
+        path: PathBuf,
+        source: ParameterError,
+    },
+    #[error("{path}: the mesh: {source}", path = shown_path(path))]
     Mesh { path: PathBuf, source: LoadError },
-    #[error("{path}: the cage: {source}", path = path.display())]
+    #[error("{path}: the cage: {source}", path = shown_path(path))]
     Cage {
         path: PathBuf,
         source: CageLoadError,
     },
     #[error(transparent)]
     Write(#[from] WriteError),
-    #[error("{path}: cannot encode the session: {message}", path = path.display())]
+    #[error("{path}: cannot encode the session: {message}", path = shown_path(path))]
     Encode { path: PathBuf, message: String },
 }
 
@@ -147,7 +163,7 @@ fn to_array(p: DVec3) -> [f64; 3] {
     p.to_array()
 }
 
-fn to_points(points: &[[f64; 3]]) -> Vec<DVec3> {
+pub(super) fn to_points(points: &[[f64; 3]]) -> Vec<DVec3> {
     points.iter().map(|&p| DVec3::from_array(p)).collect()
 }
 
@@ -243,7 +259,7 @@ pub fn save_session(
         method: settings.bind_options.method,
         parameters: Parameter::ALL
             .into_iter()
-            .map(|p| (p.id().to_owned(), settings.bind_options.get(p)))
+            .map(|p| (p.id().to_owned(), settings.bind_options.get(p).into()))
             .collect(),
         view: settings.view,
         cameras: settings
@@ -318,19 +334,25 @@ fn cage_source(folder: &Path, document: &Document) -> CageSource {
 }
 
 /// Read the session at `path` and everything it names. Nothing is changed on
-/// failure; the error names the file and what is wrong.
+/// failure; the error names the file and what is wrong. The file is read up to
+/// [`SESSION_SIZE_LIMIT`]; a UTF-8 byte-order mark before it is skipped.
 pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SessionError::Read {
+    let bytes = read_limited(path, SESSION_SIZE_LIMIT).map_err(|source| SessionError::Read {
         path: path.to_owned(),
         source,
     })?;
-    let session: SessionFile = serde_json::from_str(&text).map_err(|error| {
+    let text = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(&bytes);
+    let session: SessionFile = serde_json::from_slice(text).map_err(|error| {
         // serde_json counts lines and columns from 1, as editors do.
         let message = error.to_string();
         let message = message
             .rsplit_once(" at line ")
-            .map_or(message.as_str(), |(head, _)| head)
-            .to_owned();
+            .map_or(message.as_str(), |(head, _)| head);
+        // It may quote a whole value of the file (a string of millions of characters).
+        let message = match cut_text(message, "") {
+            (kept, Some(_)) => kept + "…",
+            (kept, None) => kept,
+        };
         SessionError::Parse {
             path: path.to_owned(),
             line: error.line(),
@@ -356,6 +378,25 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         source,
     };
     let mut notes = Vec::new();
+    let mut note = |text: String| notes.push(format!("{}: {text}", shown_path(path)));
+    let (title, cut) = cut_text(&session.title, "the title");
+    cut.into_iter().for_each(&mut note);
+    let mut bind_options = BindOptions::for_method(session.method);
+    for (name, &value) in &session.parameters {
+        match Parameter::ALL.into_iter().find(|p| p.id() == name) {
+            Some(parameter) => {
+                let value =
+                    parameter
+                        .validate(value)
+                        .map_err(|source| SessionError::Parameter {
+                            path: path.to_owned(),
+                            source,
+                        })?;
+                bind_options.set(parameter, value);
+            }
+            None => note(format!("ignored the unknown parameter \"{name}\"")),
+        }
+    }
     let (mesh, mesh_file, bundled_mesh): (TriMesh, Option<MeshFile>, Option<BundledScene>) =
         match &session.mesh {
             MeshSource::Bundled(id) => {
@@ -375,7 +416,7 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         CageSource::File(file) => {
             let cage_path = folder.join(file);
             let (cage, report) = load_cage(&cage_path).map_err(cage_error)?;
-            notes.extend(report.messages());
+            report.messages().into_iter().for_each(&mut note);
             (cage, Some(cage_path))
         }
         CageSource::Inline {
@@ -387,77 +428,46 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
                 triangle_faces: (0..triangles.len() as u32).collect(),
                 triangles: triangles.clone(),
             };
-            let (cage, report) = Cage::new(mesh).map_err(|source| SessionError::InlineCage {
+            let (cage, report) = Cage::new(mesh).map_err(|error| SessionError::InlineCage {
                 path: path.to_owned(),
-                source,
+                message: inline_cage_defect(&error),
             })?;
-            notes.extend(report.messages());
+            report.messages().into_iter().for_each(&mut note);
             (cage, None)
         }
     };
-    let check = |what: String, points: &[[f64; 3]]| -> Result<Vec<DVec3>, SessionError> {
-        if points.len() != cage.vertex_count() {
-            return Err(SessionError::PoseLength {
-                path: path.to_owned(),
-                what,
-                found: points.len(),
-                expected: cage.vertex_count(),
-            });
-        }
-        if points.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(SessionError::NonFinite {
-                path: path.to_owned(),
-                what,
-            });
-        }
-        Ok(to_points(points))
+    let reach = Reach::of(cage.positions());
+    let check = |what: String, points: &[[f64; 3]]| {
+        checked_pose(path, what, points, cage.vertex_count(), &reach)
     };
     let pose = check("the pose".into(), &session.pose)?;
     let mut named_poses = Vec::new();
     for (index, named) in session.named_poses.iter().enumerate() {
-        let what = format!("named pose {} (\"{}\")", index + 1, named.name);
+        let number = index + 1;
+        let (name, cut) = cut_text(&named.name, &format!("the name of named pose {number}"));
+        cut.into_iter().for_each(&mut note);
+        let what = format!("named pose {number} ({name:?})");
         named_poses.push(NamedPose {
-            name: named.name.clone(),
+            name,
             positions: check(what, &named.positions)?,
         });
     }
-
-    let mut bind_options = BindOptions::for_method(session.method);
-    for (name, &value) in &session.parameters {
-        match Parameter::ALL.into_iter().find(|p| p.id() == name) {
-            Some(parameter) => bind_options.set(parameter, value.max(1)),
-            None => notes.push(format!(
-                "{}: ignored the unknown parameter \"{name}\"",
-                path.display()
-            )),
-        }
-    }
-    let mut view = session.view;
-    if view.heat_vertex >= cage.vertex_count() {
-        view.heat_vertex = 0;
-    }
-    if view.heat_triangle >= Some(cage.triangle_count()) {
-        view.heat_triangle = None;
-    }
+    let mut view_notes = Vec::new();
+    let view = view_in_range(
+        session.view,
+        cage.vertex_count(),
+        cage.triangle_count(),
+        &mut view_notes,
+    );
     let cameras = session
         .cameras
         .iter()
-        .filter(|c| {
-            c.target.iter().all(|v| v.is_finite())
-                && c.distance.is_finite()
-                && c.distance > 0.0
-                && c.yaw.is_finite()
-                && c.pitch.is_finite()
-        })
-        .map(|c| OrbitCamera {
-            target: Vec3::from_array(c.target),
-            distance: c.distance,
-            yaw: c.yaw,
-            pitch: c.pitch.clamp(-1.55, 1.55),
-        })
+        .enumerate()
+        .map(|(index, entry)| camera_in_range(entry, index, &reach, &mut view_notes))
         .collect();
+    view_notes.into_iter().for_each(&mut note);
 
-    let mut document = Document::new(session.title.clone(), mesh, cage)
+    let mut document = Document::new(title, mesh, cage)
         .with_files(mesh_file, cage_path)
         .with_poses(pose, named_poses);
     if let Some(bundled) = bundled_mesh {

@@ -1,7 +1,7 @@
 //! The comparison controls above the viewport: the method shown, the layout,
 //! which methods are compared, and the colouring.
 
-use crate::app::compare::{Layout, Overlay, Pane};
+use crate::app::compare::{Layout, Overlay, Pane, DIFFERENCE_LIMITS};
 use crate::app::editor::EditorApp;
 use crate::coords::Method;
 use crate::render::colormap::Scale;
@@ -159,7 +159,7 @@ impl EditorApp {
             ui.add(
                 egui::DragValue::new(&mut percent)
                     .speed(0.01)
-                    .range(1e-4..=100.0)
+                    .range(DIFFERENCE_LIMITS.start() * 100.0..=DIFFERENCE_LIMITS.end() * 100.0)
                     .suffix("%"),
             );
             self.view.difference_limit = Some(percent / 100.0);
