@@ -259,10 +259,12 @@ fn raw_nesting_and_garbage_fail_cleanly() {
     }
 }
 
+#[cfg(unix)]
 /// An address-space limit for the children below: far less than reading a
 /// device to its end needs, far more than a clean refusal needs.
 const ADDRESS_SPACE_KIB: u64 = 1 << 20;
 
+#[cfg(unix)]
 /// `program args…` with its address space limited to `ADDRESS_SPACE_KIB`.
 fn limited(program: &Path, args: &[&str]) -> std::process::Output {
     Command::new("sh")
@@ -277,6 +279,7 @@ fn limited(program: &Path, args: &[&str]) -> std::process::Output {
         .expect("run sh")
 }
 
+#[cfg(unix)]
 /// A cage file for the commands below.
 fn write_cage(dir: &Path) -> PathBuf {
     let (_, cage) = BundledScene::Comb.build().unwrap();
