@@ -287,7 +287,7 @@ fn a_file_its_user_may_not_write_is_refused() {
     }
     let dir = tempfile::tempdir().unwrap();
     std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o777)).unwrap();
-    let theirs = write(dir.path(), "theirs.obj", "root's mesh");
+    let theirs = dir.path().join("theirs.obj");
     let cage = dir.path().join("cage.obj");
     let run_as_nobody = || {
         std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
@@ -296,8 +296,31 @@ fn a_file_its_user_may_not_write_is_refused() {
             .uid(65534)
             .gid(65534)
             .output()
-            .unwrap()
     };
+    // The binary and the folder must be within that user's reach.
+    match run_as_nobody() {
+        Ok(output) if output.status.success() => {}
+        Ok(output) => {
+            eprintln!(
+                "not run: nobody cannot write a new file here: {}",
+                stderr(&output)
+            );
+            return;
+        }
+        Err(error) => {
+            eprintln!(
+                "not run: nobody cannot run {}: {error}",
+                env!("CARGO_BIN_EXE_pmvc")
+            );
+            return;
+        }
+    }
+    // Now root's, with the usual mode 0644.
+    std::fs::remove_file(&cage).unwrap();
+    std::fs::remove_file(&theirs).unwrap();
+    std::fs::write(&theirs, "root's mesh").unwrap();
+    std::fs::set_permissions(&theirs, std::fs::Permissions::from_mode(0o644)).unwrap();
+    let run_as_nobody = || run_as_nobody().unwrap();
     let output = run_as_nobody();
     assert_clean_failure(&output, "theirs.obj", "may not write");
     assert_eq!(std::fs::read_to_string(&theirs).unwrap(), "root's mesh");
