@@ -202,3 +202,201 @@ fn a_bind_in_blocks_of_rows_writes_what_the_whole_bind_writes() {
         assert!(whole == blocks, "{method}: the weights differ");
     }
 }
+
+/// pmvc's temporary files (and kept earlier versions) left in `dir`.
+fn leftovers(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.starts_with(".pmvc-"))
+        .collect()
+}
+
+fn read_only(path: &Path) {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o444)).unwrap();
+}
+
+#[test]
+fn a_read_only_output_is_refused_and_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = comb_scene(dir.path(), 20);
+    let weights = write(dir.path(), "w.npy", "old weights");
+    read_only(&weights);
+    assert_clean_failure(&bind(&mesh, &cage, &weights), "w.npy", "read-only");
+    assert_eq!(std::fs::read_to_string(&weights).unwrap(), "old weights");
+    // Through a link, the file it names decides.
+    let link = dir.path().join("latest.npy");
+    std::os::unix::fs::symlink("w.npy", &link).unwrap();
+    assert_clean_failure(&bind(&mesh, &cage, &link), "latest.npy", "read-only");
+    assert_eq!(std::fs::read_to_string(&weights).unwrap(), "old weights");
+
+    let cage_out = write(dir.path(), "new-cage.obj", "old cage");
+    read_only(&cage_out);
+    let output = pmvc(&[
+        "cage",
+        "--mesh",
+        path_str(&mesh),
+        "--vertices",
+        "8",
+        "--out",
+        path_str(&cage_out),
+    ]);
+    assert_clean_failure(&output, "new-cage.obj", "read-only");
+    assert_eq!(std::fs::read_to_string(&cage_out).unwrap(), "old cage");
+
+    let generated = write(dir.path(), "bar.obj", "old mesh");
+    read_only(&generated);
+    let bar_cage = dir.path().join("bar-cage.obj");
+    let output = pmvc(&[
+        "generate",
+        "twisted-bar",
+        "--mesh",
+        path_str(&generated),
+        "--cage",
+        path_str(&bar_cage),
+    ]);
+    assert_clean_failure(&output, "bar.obj", "read-only");
+    assert_eq!(std::fs::read_to_string(&generated).unwrap(), "old mesh");
+    assert!(!bar_cage.exists());
+    assert!(
+        leftovers(dir.path()).is_empty(),
+        "{:?}",
+        leftovers(dir.path())
+    );
+
+    // A file its user may write is replaced as before.
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&weights, std::fs::Permissions::from_mode(0o644)).unwrap();
+    let output = bind(&mesh, &cage, &weights);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(std::fs::read(&weights).unwrap().starts_with(NPY_MAGIC));
+}
+
+/// Run as root, a normal user (`nobody`) is tried: a file it may not write, in a
+/// folder it may write, would be replaced by a rename.
+#[test]
+fn a_file_its_user_may_not_write_is_refused() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    use std::os::unix::process::CommandExt;
+    if std::fs::metadata("/proc/self").map(|m| m.uid()).ok() != Some(0) {
+        // As a normal user, a read-only file of one's own is the same case
+        // (a_read_only_output_is_refused_and_kept).
+        eprintln!("not run: needs root to run pmvc as another user");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o777)).unwrap();
+    let theirs = dir.path().join("theirs.obj");
+    let cage = dir.path().join("cage.obj");
+    let run_as_nobody = || {
+        std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
+            .args(["generate", "twisted-bar", "--mesh"])
+            .args([&theirs, Path::new("--cage"), &cage])
+            .uid(65534)
+            .gid(65534)
+            .output()
+    };
+    // The binary and the folder must be within that user's reach.
+    match run_as_nobody() {
+        Ok(output) if output.status.success() => {}
+        Ok(output) => {
+            eprintln!(
+                "not run: nobody cannot write a new file here: {}",
+                stderr(&output)
+            );
+            return;
+        }
+        Err(error) => {
+            eprintln!(
+                "not run: nobody cannot run {}: {error}",
+                env!("CARGO_BIN_EXE_pmvc")
+            );
+            return;
+        }
+    }
+    // Now root's, with the usual mode 0644.
+    std::fs::remove_file(&cage).unwrap();
+    std::fs::remove_file(&theirs).unwrap();
+    std::fs::write(&theirs, "root's mesh").unwrap();
+    std::fs::set_permissions(&theirs, std::fs::Permissions::from_mode(0o644)).unwrap();
+    let run_as_nobody = || run_as_nobody().unwrap();
+    let output = run_as_nobody();
+    assert_clean_failure(&output, "theirs.obj", "may not write");
+    assert_eq!(std::fs::read_to_string(&theirs).unwrap(), "root's mesh");
+    assert!(!cage.exists() && leftovers(dir.path()).is_empty());
+    // Once it may write it, it is replaced.
+    std::fs::set_permissions(&theirs, std::fs::Permissions::from_mode(0o666)).unwrap();
+    let output = run_as_nobody();
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(std::fs::read_to_string(&theirs).unwrap().starts_with("# "));
+}
+
+fn generate(mesh: &Path, cage: &Path) -> Output {
+    pmvc(&[
+        "generate",
+        "twisted-bar",
+        "--mesh",
+        path_str(mesh),
+        "--cage",
+        path_str(cage),
+    ])
+}
+
+#[test]
+fn two_outputs_naming_one_file_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let same = dir.path().join("same.obj");
+    // A new name, spelled the same and differently.
+    assert_clean_failure(&generate(&same, &same), "same.obj", "same file");
+    let other_spelling = sub.join("..").join(".").join("same.obj");
+    assert_clean_failure(&generate(&same, &other_spelling), "same.obj", "same file");
+    assert!(!same.exists() && leftovers(dir.path()).is_empty());
+    // An existing file, through a symbolic link and a hard link.
+    std::fs::write(&same, "old").unwrap();
+    let link = dir.path().join("link.obj");
+    std::os::unix::fs::symlink("same.obj", &link).unwrap();
+    assert_clean_failure(&generate(&link, &same), "same.obj", "same file");
+    let hard = dir.path().join("hard.obj");
+    std::fs::hard_link(&same, &hard).unwrap();
+    assert_clean_failure(&generate(&same, &hard), "hard.obj", "same file");
+    assert_eq!(std::fs::read_to_string(&same).unwrap(), "old");
+    // Two links to a device are no file to lose.
+    let output = generate(Path::new("/dev/null"), Path::new("/dev/null"));
+    assert!(output.status.success(), "{}", stderr(&output));
+}
+
+#[test]
+fn a_generate_that_fails_on_the_cage_keeps_the_old_pair() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "bar.obj", "old mesh");
+    // The disk holding the cage is full.
+    let kept = || std::fs::read_to_string(&mesh).unwrap() == "old mesh";
+    let output = generate(&mesh, Path::new("/dev/full"));
+    assert_clean_failure(&output, "/dev/full", "cannot write");
+    assert!(kept(), "the mesh was replaced, its cage was not");
+    // The cage's folder does not exist.
+    let output = generate(&mesh, &dir.path().join("missing/bar-cage.obj"));
+    assert_clean_failure(&output, "bar-cage.obj", "cannot write");
+    assert!(kept(), "the mesh was replaced, its cage was not");
+    assert!(
+        leftovers(dir.path()).is_empty(),
+        "{:?}",
+        leftovers(dir.path())
+    );
+    // Both written when both can be.
+    let cage = write(dir.path(), "bar-cage.obj", "old cage");
+    let output = generate(&mesh, &cage);
+    assert!(output.status.success(), "{}", stderr(&output));
+    for written in [&mesh, &cage] {
+        let text = std::fs::read_to_string(written).unwrap();
+        assert!(text.contains("\nv ") && text.contains("\nf "), "{text}");
+    }
+    assert!(
+        leftovers(dir.path()).is_empty(),
+        "{:?}",
+        leftovers(dir.path())
+    );
+}

@@ -3,9 +3,9 @@
 //! stdout and optionally as JSON.
 
 use crate::coords::{BindOptions, BindProgress, Method};
-use crate::geometry::{self, classify_points, procedural, Cage};
+use crate::geometry::{self, classify_points, procedural, shown_path, Cage};
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
-use anyhow::Result;
+use anyhow::{bail, Result};
 use glam::DVec3;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -13,9 +13,9 @@ use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
-    /// Timed runs per row; the median is reported.
-    #[arg(long, default_value_t = 3)]
-    pub runs: usize,
+    /// Timed runs per row (1–1000); the median is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    pub runs: u16,
     /// Also write the results as JSON.
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
@@ -25,7 +25,8 @@ pub struct BenchArgs {
     /// Skip the shared evaluation data.
     #[arg(long)]
     pub no_data: bool,
-    /// Only these scenes (Table 1 names, "table2", or shared-data model names).
+    /// Only these scenes (Table 1 names, "table2", or shared-data model names);
+    /// an unknown name is an error that lists the known ones.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Also time a software GPU adapter (lavapipe/llvmpipe); by default GPU rows
@@ -33,6 +34,9 @@ pub struct BenchArgs {
     #[arg(long)]
     pub software_gpu: bool,
 }
+
+/// The `--scenes` name of the paper's Table 2 rows.
+const TABLE2: &str = "table2";
 
 /// One timed configuration.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -97,6 +101,19 @@ struct Timed {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
+    let shared = shared_models(args);
+    check_scenes(&args.scenes, &shared, args)?;
+    // Opened before the work, so that an output that cannot be written is
+    // reported now, not after the whole benchmark.
+    let json_output = match &args.json {
+        Some(path) => {
+            if let Some(warning) = geometry::extension_warning(path, &["json"], "JSON") {
+                warn_line!("pmvc: {warning}");
+            }
+            Some(geometry::PendingOutput::create(path)?)
+        }
+        None => None,
+    };
     let threads = rayon::current_num_threads();
     let mut backends = vec![Timed {
         name: format!("cpu ({threads} threads)"),
@@ -140,11 +157,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 &scene.points,
                 &table1,
                 &backends,
-                args.runs,
+                usize::from(args.runs),
             )?);
         }
     }
-    if wanted("table2") {
+    if wanted(TABLE2) {
         // The paper's Table 2: one 24,795-vertex point set in ever finer spherical cages.
         let finest = procedural::uv_sphere(1.0, 40, 39);
         let points = procedural::points_inside(&finest, 24_795, 2, 1e-3);
@@ -157,22 +174,66 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 &points,
                 &[(Method::Pmvc, 32)],
                 &backends,
-                args.runs,
+                usize::from(args.runs),
             )?);
         }
     }
-    if !args.no_data {
-        rows.extend(bench_shared_data(args, &wanted, &backends)?);
-    }
+    let shared: Vec<String> = shared.into_iter().filter(|name| wanted(name)).collect();
+    rows.extend(bench_shared_data(args, &shared, &backends)?);
     say!("{}", markdown(&rows));
-    if let Some(path) = &args.json {
-        if let Some(warning) = geometry::extension_warning(path, &["json"], "JSON") {
-            warn_line!("pmvc: {warning}");
-        }
+    if let Some(output) = json_output {
         let json = to_json(&rows, threads, &adapter);
-        geometry::write_atomically(path, |out| out.write_all(json.as_bytes()))?;
+        output.finish(|out| out.write_all(json.as_bytes()))?;
     }
     Ok(())
+}
+
+/// The shared-data models in `--data` (X.obj beside X_Cage.obj), sorted; none
+/// with `--no-data` or when the folder cannot be read.
+fn shared_models(args: &BenchArgs) -> Vec<String> {
+    if args.no_data {
+        return Vec::new();
+    }
+    let Ok(entries) = std::fs::read_dir(&args.data) else {
+        warn_line!(
+            "pmvc bench: {} not found; shared-data rows not run",
+            shown_path(&args.data)
+        );
+        return Vec::new();
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(|entry| entry.ok()?.file_name().into_string().ok())
+        .filter_map(|name| name.strip_suffix("_Cage.obj").map(str::to_owned))
+        .collect();
+    names.sort();
+    names
+}
+
+/// `--scenes`: every name must be a scene this run knows, or nothing would be
+/// timed for it.
+fn check_scenes(scenes: &[String], shared: &[String], args: &BenchArgs) -> Result<()> {
+    let mut known: Vec<&str> = procedural::table1_scene_names().to_vec();
+    known.push(TABLE2);
+    let unknown: Vec<&str> = scenes
+        .iter()
+        .map(String::as_str)
+        .filter(|name| !known.contains(name) && !shared.iter().any(|s| s == name))
+        .collect();
+    if unknown.is_empty() {
+        return Ok(());
+    }
+    let data = if args.no_data {
+        "shared-data models are skipped with --no-data".to_owned()
+    } else if shared.is_empty() {
+        format!("no shared-data models in {}", shown_path(&args.data))
+    } else {
+        format!("from {}: {}", shown_path(&args.data), shared.join(", "))
+    };
+    bail!(
+        "--scenes: unknown scene {}; the scenes are {} ({data})",
+        unknown.join(", "),
+        known.join(", ")
+    )
 }
 
 fn bench_scene(
@@ -207,7 +268,7 @@ fn bench_scene(
             let mut times = Vec::with_capacity(runs);
             let mut waits = Vec::with_capacity(runs);
             let mut last = None;
-            for _ in 0..runs.max(1) {
+            for _ in 0..runs {
                 // Wall time of the whole bind: uploads and readbacks included.
                 let start = Instant::now();
                 let output = binder.bind_blocking(&input, &BindProgress::default())?;
@@ -254,34 +315,21 @@ fn bench_scene(
 
 fn bench_shared_data(
     args: &BenchArgs,
-    wanted: &dyn Fn(&str) -> bool,
+    names: &[String],
     backends: &[Timed],
 ) -> Result<Vec<BenchRow>> {
-    let Ok(entries) = std::fs::read_dir(&args.data) else {
-        warn_line!(
-            "pmvc bench: {} not found; shared-data rows not run",
-            args.data.display()
-        );
-        return Ok(Vec::new());
-    };
-    let mut names: Vec<String> = entries
-        .filter_map(|entry| entry.ok()?.file_name().into_string().ok())
-        .filter_map(|name| name.strip_suffix("_Cage.obj").map(str::to_owned))
-        .filter(|name| wanted(name))
-        .collect();
-    names.sort();
     let mut rows = Vec::new();
     for name in names {
         let mesh = geometry::load_mesh(&args.data.join(format!("{name}.obj")))?;
         let (cage, _) = geometry::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
         let configurations = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)];
         rows.extend(bench_scene(
-            &name,
+            name,
             &cage,
             &mesh.mesh.positions,
             &configurations,
             backends,
-            args.runs,
+            usize::from(args.runs),
         )?);
     }
     Ok(rows)

@@ -6,8 +6,8 @@ use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values, write_n
 use crate::coords::npz::{npz_payload_bytes, write_npz_to};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{
-    self, classify_points, extension_warning, human_bytes, refuse_same_file, Cage, MeshFile,
-    PendingOutput, PointClasses,
+    self, classify_points, extension_warning, human_bytes, refuse_same_file, shown_path, Cage,
+    MeshFile, OutputSet, PendingOutput, PointClasses,
 };
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Context, Result};
@@ -42,7 +42,7 @@ pub(super) fn load_input(
     let rows = resident_rows(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
     for message in report.messages() {
-        warn_line!("pmvc: {}: {message}", input.cage.display());
+        warn_line!("pmvc: {}: {message}", shown_path(&input.cage));
     }
     let classes = classify_points(&cage, &mesh.mesh.positions);
     if !classes.outside.is_empty() {
@@ -50,8 +50,8 @@ pub(super) fn load_input(
         if strict {
             bail!(
                 "{}: {summary} of {} (--strict)",
-                input.mesh.display(),
-                input.cage.display()
+                shown_path(&input.mesh),
+                shown_path(&input.cage)
             );
         }
         let policy = if choice.method == Method::Green {
@@ -61,8 +61,8 @@ pub(super) fn load_input(
         };
         warn_line!(
             "pmvc: {}: warning: {summary} of {}; {policy}",
-            input.mesh.display(),
-            input.cage.display(),
+            shown_path(&input.mesh),
+            shown_path(&input.cage),
         );
     }
     Ok(BoundInput {
@@ -238,7 +238,7 @@ fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result
         if bytes > available {
             bail!(
                 "{}: its weights would take {} ({rows} vertices × {cols} cage vertices × 4 bytes), but only {} of memory is available; bind the mesh in parts, or use a coarser cage",
-                mesh.display(),
+                shown_path(mesh),
                 human_bytes(bytes),
                 human_bytes(available)
             );
@@ -289,7 +289,7 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     };
     summary(format_args!(
         "wrote {}: {shape} ({}, {device}) in {:.2} s; {}",
-        args.out.display(),
+        shown_path(&args.out),
         method_label(&args.method),
         started.elapsed().as_secs_f64(),
         outside_note(&input)
@@ -500,6 +500,8 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
     use geometry::procedural::{sculpt_size_scene, table1_scene, SCULPT_SIZE};
     check_output(&args.mesh, &[], &["obj"], "an OBJ mesh")?;
     check_output(&args.cage, &[], &["obj"], "an OBJ cage")?;
+    // Opened before the work: a mesh is never written without its cage.
+    let outputs = OutputSet::create(&[&args.mesh, &args.cage])?;
     let (mesh, cage) = if args.scene == SCULPT_SIZE {
         sculpt_size_scene()
     } else if args.scene == geometry::twisted_bar::TWISTED_BAR {
@@ -513,19 +515,16 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
         };
         (points, scene.cage)
     };
-    let cage = geometry::TriMesh {
-        positions: cage.positions().to_vec(),
-        triangles: cage.triangles().to_vec(),
-        ..Default::default()
-    };
-    geometry::write_obj(&args.mesh, &mesh)?;
-    geometry::write_obj(&args.cage, &cage)?;
+    outputs.finish(|index, out| match index {
+        0 => geometry::write_obj_to(out, &mesh.positions, &mesh.triangles),
+        _ => geometry::write_obj_to(out, cage.positions(), cage.triangles()),
+    })?;
     say!(
         "{}: {} mesh vertices ({} triangles) in a {}-vertex cage",
         args.scene,
         mesh.positions.len(),
         mesh.triangles.len(),
-        cage.positions.len()
+        cage.vertex_count()
     );
     Ok(())
 }

@@ -8,26 +8,26 @@ use std::path::PathBuf;
 /// fields count from 1 in file order, as OBJ and the user do; indices are as written.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
-    #[error("{path}: cannot read: {source}", path = path.display())]
+    #[error("{path}: cannot read: {source}", path = shown_path(path))]
     Io {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: the file is empty", path = path.display())]
+    #[error("{path}: the file is empty", path = shown_path(path))]
     Empty { path: PathBuf },
-    #[error("{path}: not a text mesh file (binary data near byte {offset})", path = path.display())]
+    #[error("{path}: not a text mesh file (binary data near byte {offset})", path = shown_path(path))]
     Binary { path: PathBuf, offset: usize },
-    #[error("{path}: unknown mesh format (expected a .obj or .off file)", path = path.display())]
+    #[error("{path}: unknown mesh format (expected a .obj or .off file)", path = shown_path(path))]
     UnknownFormat { path: PathBuf },
-    #[error("{path}:{line}: {message}", path = path.display())]
+    #[error("{path}:{line}: {message}", path = shown_path(path))]
     Parse {
         path: PathBuf,
         line: usize,
         message: String,
     },
-    #[error("{path}: the file has no vertices", path = path.display())]
+    #[error("{path}: the file has no vertices", path = shown_path(path))]
     NoVertices { path: PathBuf },
-    #[error("{path}:{line}: vertex {vertex} has a non-finite coordinate", path = path.display())]
+    #[error("{path}:{line}: vertex {vertex} has a non-finite coordinate", path = shown_path(path))]
     NonFinite {
         path: PathBuf,
         line: usize,
@@ -35,7 +35,7 @@ pub enum LoadError {
     },
     #[error(
         "{path}:{line}: face {face} refers to vertex {index}, but the file has {count} vertices",
-        path = path.display()
+        path = shown_path(path)
     )]
     IndexOutOfRange {
         path: PathBuf,
@@ -44,9 +44,9 @@ pub enum LoadError {
         index: i64,
         count: usize,
     },
-    #[error("{path}: {message}", path = path.display())]
+    #[error("{path}: {message}", path = shown_path(path))]
     Obj { path: PathBuf, message: String },
-    #[error("{path}: {count} vertices is more than the {limit} this tool supports", path = path.display())]
+    #[error("{path}: {count} vertices is more than the {limit} this tool supports", path = shown_path(path))]
     TooLarge {
         path: PathBuf,
         count: usize,
@@ -105,13 +105,13 @@ pub enum CageError {
 pub enum CageLoadError {
     #[error(transparent)]
     Load(#[from] LoadError),
-    #[error("{path}: {source}", path = path.display())]
+    #[error("{path}: {source}", path = shown_path(path))]
     Invalid { path: PathBuf, source: CageError },
 }
 
 /// An output file could not be written. Any existing file at `path` is untouched.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: cannot write: {source}", path = path.display())]
+#[error("{path}: cannot write: {source}", path = shown_path(path))]
 pub struct WriteError {
     pub path: PathBuf,
     pub source: std::io::Error,

@@ -2,17 +2,27 @@
 //!
 //! - A regular file (or a new name) is written through a temporary sibling that is
 //!   renamed over it only once complete, so a failure leaves the old file whole.
+//! - An existing file that its user may not write (read-only, or someone else's)
+//!   is refused, as `cp` refuses it, although a rename could replace it
+//!   ([`protect`] has the rule).
 //! - A symbolic link is followed: its target is replaced the same way, and the
 //!   link stays a link.
 //! - A character device or a named pipe (`/dev/null`, `/dev/stdout`, a FIFO) is
 //!   written directly: renaming over it would replace the node itself.
 //! - A directory, a block device or a socket is refused.
 //! - An output that is the same file as an input is refused ([`refuse_same_file`]).
+//! - Outputs that belong together (a mesh and its cage) are replaced together or
+//!   not at all ([`OutputSet`]); two of them naming one file are refused.
 //!
 //! While a temporary file is being written it is listed, so that a process ended
 //! by a signal can remove it ([`remove_unfinished_outputs`]).
 
-use super::error::WriteError;
+mod protect;
+mod set;
+
+pub use set::OutputSet;
+
+use super::error::{shown_path, WriteError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -109,7 +119,7 @@ pub fn refuse_same_file(output: &Path, inputs: &[&Path]) -> Result<(), WriteErro
                 path: output.to_owned(),
                 source: invalid(format!(
                     "it is the input {}, which pmvc never overwrites; choose another output",
-                    input.display()
+                    shown_path(input)
                 )),
             });
         }
@@ -152,7 +162,7 @@ pub fn extension_warning(path: &Path, expected: &[&str], what: &str) -> Option<S
     let wanted: Vec<String> = expected.iter().map(|e| format!(".{e}")).collect();
     Some(format!(
         "{}: warning: this file will hold {what}, but its name does not end in {}",
-        path.display(),
+        shown_path(path),
         wanted.join(" or ")
     ))
 }
@@ -213,7 +223,8 @@ enum Pending {
 }
 
 impl PendingOutput {
-    /// Resolve `path` by the module's rules and create its temporary file.
+    /// Resolve `path` by the module's rules, refuse a file its user may not
+    /// write, and create its temporary file.
     pub fn create(path: &Path) -> Result<PendingOutput, WriteError> {
         let wrap = |source| WriteError {
             path: path.to_owned(),
@@ -228,6 +239,7 @@ impl PendingOutput {
             }
             OutputTarget::File(target) => target,
         };
+        protect::refuse_protected(path, &target)?;
         let mut builder = tempfile::Builder::new();
         builder.prefix(".pmvc-").suffix(".tmp");
         // Temporary files are private; the result should have the permissions of
@@ -241,7 +253,17 @@ impl PendingOutput {
             });
         #[cfg(unix)]
         builder.permissions(permissions);
-        let temporary = builder.tempfile_in(folder_of(&target)).map_err(wrap)?;
+        let folder = folder_of(&target);
+        let temporary = builder.tempfile_in(folder).map_err(|error| {
+            // tempfile names its random file in the error; the user's folder matters.
+            match error.kind() {
+                std::io::ErrorKind::NotFound => wrap(std::io::Error::new(
+                    error.kind(),
+                    format!("its folder {} does not exist", shown_path(folder)),
+                )),
+                _ => wrap(error),
+            }
+        })?;
         let listed = Listed::new(temporary.path());
         Ok(PendingOutput {
             path: path.to_owned(),
@@ -297,6 +319,16 @@ impl PendingOutput {
         seeks: bool,
         write: impl FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
     ) -> Result<(), WriteError> {
+        self.write(seeks, write)?.commit()
+    }
+
+    /// Write the output: a file's temporary file completely (made durable), a
+    /// device or pipe in place.
+    fn write(
+        self,
+        seeks: bool,
+        write: impl FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
+    ) -> Result<Written, WriteError> {
         let path = self.path;
         let wrap = |source| WriteError {
             path: path.clone(),
@@ -317,7 +349,8 @@ impl PendingOutput {
                 } else {
                     write(&mut buffered).map_err(wrap)?;
                 }
-                buffered.flush().map_err(wrap)
+                buffered.flush().map_err(wrap)?;
+                Ok(Written::Stream)
             }
             Pending::File {
                 mut temporary,
@@ -329,22 +362,64 @@ impl PendingOutput {
                     write(&mut buffered).map_err(wrap)?;
                     buffered.flush().map_err(wrap)?;
                 }
-                persist(temporary, &target).map_err(wrap)
+                temporary.as_file().sync_all().map_err(wrap)?;
+                Ok(Written::File(Finished {
+                    path,
+                    temporary,
+                    target,
+                    _listed,
+                }))
             }
         }
+    }
+}
+
+/// An output whose bytes are all written.
+enum Written {
+    /// A device or pipe: nothing left to do.
+    Stream,
+    /// A file: its temporary file waits to be renamed over the target.
+    File(Finished),
+}
+
+impl Written {
+    fn commit(self) -> Result<(), WriteError> {
+        match self {
+            Written::Stream => Ok(()),
+            Written::File(finished) => finished.commit(),
+        }
+    }
+}
+
+/// A complete temporary file and the file it replaces.
+struct Finished {
+    path: PathBuf,
+    // Field order matters: the file is deleted before it leaves the list.
+    temporary: tempfile::NamedTempFile,
+    target: PathBuf,
+    _listed: Listed,
+}
+
+impl Finished {
+    /// Rename the temporary file over the target.
+    fn commit(self) -> Result<(), WriteError> {
+        let Finished {
+            path,
+            temporary,
+            target,
+            _listed,
+        } = self;
+        temporary.persist(&target).map_err(|error| WriteError {
+            path,
+            source: error.error,
+        })?;
+        Ok(())
     }
 }
 
 /// A writer that can also seek (an archive's central directory needs it).
 pub trait WriteSeek: Write + std::io::Seek {}
 impl<T: Write + std::io::Seek> WriteSeek for T {}
-
-/// Make a finished temporary file durable and rename it over `target`.
-fn persist(temporary: tempfile::NamedTempFile, target: &Path) -> std::io::Result<()> {
-    temporary.as_file().sync_all()?;
-    temporary.persist(target).map_err(|error| error.error)?;
-    Ok(())
-}
 
 /// Write an output by the rules in the module documentation.
 pub fn write_atomically(
@@ -389,82 +464,4 @@ pub fn human_bytes(bytes: u64) -> String {
 }
 
 #[cfg(all(test, unix))]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn links_are_followed_to_the_file_they_name() {
-        let dir = tempfile::tempdir().unwrap();
-        let file = dir.path().join("real.npy");
-        std::fs::write(&file, "old").unwrap();
-        let link = dir.path().join("link.npy");
-        std::os::unix::fs::symlink("real.npy", &link).unwrap();
-        assert_eq!(
-            resolve_output(&link).unwrap(),
-            OutputTarget::File(dir.path().join("real.npy"))
-        );
-        let dangling = dir.path().join("dangling.npy");
-        std::os::unix::fs::symlink(dir.path().join("new.npy"), &dangling).unwrap();
-        assert_eq!(
-            resolve_output(&dangling).unwrap(),
-            OutputTarget::File(dir.path().join("new.npy"))
-        );
-        let looped = dir.path().join("loop");
-        std::os::unix::fs::symlink("loop", &looped).unwrap();
-        let error = resolve_output(&looped).unwrap_err();
-        assert!(error.to_string().contains("symbolic links"), "{error}");
-    }
-
-    #[test]
-    fn devices_are_streams_and_directories_are_refused() {
-        assert_eq!(
-            resolve_output(Path::new("/dev/null")).unwrap(),
-            OutputTarget::Stream("/dev/null".into())
-        );
-        let dir = tempfile::tempdir().unwrap();
-        let error = resolve_output(dir.path()).unwrap_err();
-        assert!(error.to_string().contains("directory"), "{error}");
-    }
-
-    #[test]
-    fn a_pending_output_is_listed_until_it_is_finished_or_dropped() {
-        let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("w.npy");
-        let pending = PendingOutput::create(&out).unwrap();
-        let temporaries = || {
-            std::fs::read_dir(dir.path())
-                .unwrap()
-                .filter(|e| {
-                    e.as_ref()
-                        .unwrap()
-                        .file_name()
-                        .to_string_lossy()
-                        .ends_with(".tmp")
-                })
-                .count()
-        };
-        assert_eq!(temporaries(), 1);
-        assert!(pending.check_space(u64::MAX).is_err());
-        pending.check_space(1).unwrap();
-        pending.finish(|w| w.write_all(b"done")).unwrap();
-        assert_eq!(
-            (temporaries(), std::fs::read(&out).unwrap()),
-            (0, b"done".to_vec())
-        );
-        assert_eq!(human_bytes(3 << 29), "1.5 GiB");
-    }
-
-    #[test]
-    fn extension_warning_names_what_is_expected() {
-        let warning = extension_warning(Path::new("mesh.obj"), &["npy"], "weights").unwrap();
-        assert!(warning.contains("mesh.obj") && warning.contains(".npy"));
-        assert_eq!(
-            extension_warning(Path::new("W.NPY"), &["npy"], "weights"),
-            None
-        );
-        assert_eq!(
-            extension_warning(Path::new("/dev/null"), &["npy"], "weights"),
-            None
-        );
-    }
-}
+mod tests;
