@@ -154,7 +154,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-5 of the row's total magnitude).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh.

@@ -106,7 +106,11 @@ pub fn read_npz(
         let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
         read_array_header(&mut entry, present, &at(name), expected)?;
     }
-    let mut weights = allocate(&at(PHI), rows, cage_vertices + cage_triangles)?;
+    let whole = ArrayAt {
+        path: path.to_owned(),
+        array: None,
+    };
+    let mut weights = allocate(&whole, rows, cage_vertices + cage_triangles)?;
     for (name, expected, first_column) in arrays {
         let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
         let mut entry = std::io::BufReader::new(&mut entry);
