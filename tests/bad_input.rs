@@ -236,3 +236,180 @@ fn strict_rejects_vertices_outside_the_cage() {
     assert_clean_failure(&output, path_str(&mesh), "lie outside the cage");
     assert!(!out.exists());
 }
+
+/// A `.npy` of float32 values under the header NumPy would write for `shape`.
+fn npy_bytes(shape: &str, values: &[f32]) -> Vec<u8> {
+    let header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}\n");
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+    bytes
+}
+
+/// A `.npz` as `numpy.savez` writes it: stored entries `phi.npy` and `psi.npy`.
+fn npz_bytes(phi: &[u8], psi: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (name, bytes) in [("phi.npy", phi), ("psi.npy", psi)] {
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored);
+        zip.start_file(name, options).unwrap();
+        zip.write_all(bytes).unwrap();
+    }
+    zip.finish().unwrap().into_inner()
+}
+
+/// `pmvc deform` of two points inside the tetrahedron, three of its corners moved,
+/// with the weights file `name` holding `bytes`: its output, the weights' path
+/// and whether the deformed mesh was written.
+fn deform_with_weights(name: &str, bytes: &[u8]) -> (std::process::Output, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "mesh.obj", "v 0.1 0.1 0.1\nv 0.2 0.3 0.1\n");
+    let cage = write(dir.path(), "cage.obj", TETRA);
+    let pose = write(dir.path(), "pose.obj", &TETRA.replace("v 0 ", "v 2 "));
+    let weights = dir.path().join(name);
+    std::fs::write(&weights, bytes).unwrap();
+    let out = dir.path().join("out.obj");
+    let output = pmvc(&[
+        "deform",
+        "--mesh",
+        path_str(&mesh),
+        "--cage",
+        path_str(&cage),
+        "--deformed-cage",
+        path_str(&pose),
+        "--weights",
+        path_str(&weights),
+        "--out",
+        path_str(&out),
+    ]);
+    (output, weights.display().to_string(), out.exists())
+}
+
+/// Weights of the two points in [`deform_with_weights`]: rows that sum to 1.
+const GOOD_ROWS: [f32; 8] = [0.7, 0.1, 0.1, 0.1, 0.4, 0.1, 0.4, 0.1];
+
+#[test]
+fn weights_as_written_deform_the_mesh() {
+    let (output, _, written) = deform_with_weights("w.npy", &npy_bytes("(2, 4)", &GOOD_ROWS));
+    assert!(output.status.success() && written, "{}", stderr(&output));
+    let psi = npy_bytes("(2, 4)", &[0.0; 8]);
+    let (output, _, written) =
+        deform_with_weights("w.npz", &npz_bytes(&npy_bytes("(2, 4)", &GOOD_ROWS), &psi));
+    assert!(output.status.success() && written, "{}", stderr(&output));
+}
+
+#[test]
+fn npz_declaring_huge_shapes_is_refused_naming_the_array() {
+    // 2^32 × 2^32 in a file of a few hundred bytes; this used to panic (exit 101)
+    // slicing rows that were not there.
+    let huge = npy_bytes("(4294967296, 4294967296)", &[]);
+    let bytes = npz_bytes(&huge, &huge);
+    assert!(bytes.len() < 600, "{}", bytes.len());
+    let (output, weights, written) = deform_with_weights("w.npz", &bytes);
+    assert_clean_failure(
+        &output,
+        &weights,
+        "array 'phi': declares shape (4294967296, 4294967296), but the mesh has 2 vertices and the cage 4 vertices, so it must be (2, 4)",
+    );
+    assert!(!written);
+}
+
+#[test]
+fn npz_declaring_a_trillion_rows_is_refused_before_reading() {
+    // (10^12, 0) used to be read row by row for about 17 minutes before its shape
+    // was compared with the mesh.
+    let empty = npy_bytes("(1000000000000, 0)", &[]);
+    let (output, weights, _) = deform_with_weights("w.npz", &npz_bytes(&empty, &empty));
+    assert_clean_failure(&output, &weights, "declares shape (1000000000000, 0)");
+    // The right shape with too few bytes is truncated, whatever the archive says.
+    let short = npy_bytes("(2, 4)", &GOOD_ROWS[..5]);
+    let (output, weights, _) = deform_with_weights("w.npz", &npz_bytes(&short, &short));
+    assert_clean_failure(
+        &output,
+        &weights,
+        "array 'phi': truncated: its shape (2, 4) needs 32 bytes of float32 values, but the file holds 20",
+    );
+}
+
+#[test]
+fn truncated_npy_is_reported_as_truncated() {
+    let mut bytes = npy_bytes("(2, 4)", &GOOD_ROWS);
+    bytes.truncate(bytes.len() - 13);
+    let (output, weights, _) = deform_with_weights("w.npy", &bytes);
+    assert_clean_failure(
+        &output,
+        &weights,
+        "truncated: its shape (2, 4) needs 32 bytes of float32 values, but the file holds 19",
+    );
+}
+
+#[test]
+fn non_finite_weights_are_refused_by_row_and_column() {
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let mut rows = GOOD_ROWS;
+        rows[6] = bad;
+        let (output, weights, written) = deform_with_weights("w.npy", &npy_bytes("(2, 4)", &rows));
+        assert_clean_failure(&output, &weights, "row 2, column 3 is");
+        assert!(
+            stderr(&output).contains("must be finite"),
+            "{}",
+            stderr(&output)
+        );
+        assert!(!written);
+    }
+    let mut psi = [0.0f32; 8];
+    psi[1] = f32::INFINITY;
+    let bytes = npz_bytes(&npy_bytes("(2, 4)", &GOOD_ROWS), &npy_bytes("(2, 4)", &psi));
+    let (output, weights, _) = deform_with_weights("w.npz", &bytes);
+    assert_clean_failure(&output, &weights, "array 'psi': row 1, column 2 is inf");
+}
+
+#[test]
+fn rows_that_do_not_sum_to_one_are_refused() {
+    // All zeros used to give back the undeformed mesh.
+    let (output, weights, written) = deform_with_weights("w.npy", &npy_bytes("(2, 4)", &[0.0; 8]));
+    assert_clean_failure(
+        &output,
+        &weights,
+        "row 1's weights sum to 0, not 1 (allowed: ±1.0e-4)",
+    );
+    assert!(!written);
+    let mut rows = GOOD_ROWS;
+    rows[5] += 1e-3;
+    let psi = npy_bytes("(2, 4)", &[0.0; 8]);
+    let bytes = npz_bytes(&npy_bytes("(2, 4)", &rows), &psi);
+    let (output, weights, _) = deform_with_weights("w.npz", &bytes);
+    assert_clean_failure(
+        &output,
+        &weights,
+        "array 'phi': row 2's weights sum to 1.001",
+    );
+}
+
+#[test]
+fn a_compressed_npz_is_refused_with_advice() {
+    let psi = npy_bytes("(2, 4)", &[0.0; 8]);
+    let mut bytes = npz_bytes(&npy_bytes("(2, 4)", &GOOD_ROWS), &psi);
+    // Mark both entries deflated (method 8), as numpy.savez_compressed writes them:
+    // the local headers' method at offset 8, the central directory's at 10.
+    for (signature, offset) in [(b"PK\x03\x04", 8), (b"PK\x01\x02", 10)] {
+        let starts: Vec<usize> = bytes
+            .windows(4)
+            .enumerate()
+            .filter(|(_, window)| window == signature)
+            .map(|(at, _)| at)
+            .collect();
+        assert_eq!(starts.len(), 2);
+        for start in starts {
+            bytes[start + offset] = 8;
+        }
+    }
+    let (output, weights, _) = deform_with_weights("w.npz", &bytes);
+    assert_clean_failure(
+        &output,
+        &weights,
+        "array 'phi': is compressed (the file was written with numpy.savez_compressed); write it with numpy.savez",
+    );
+}

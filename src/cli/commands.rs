@@ -379,13 +379,16 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         Some(path) => read_weights_for(path, &input, args.method.method)?,
         None => (compute_weights(&input, &args.method)?, args.method.method),
     };
-    // Displacement form: exact at rest for any weights, and no cancellation of
-    // large absolute positions far from the origin.
+    // Displacement form, p + Σλ(c̃ − c): the same as Σλc̃ for weights that
+    // reproduce their points at rest (every family pmvc binds), and better in f32:
+    // Σλc̃ carries each weight's rounding times the cage's distance from the
+    // origin, this form only times how far the cage moved. Rows were checked to
+    // sum to 1 when read, so a translation of the cage moves every vertex with it.
     let moves = method.column_displacements(&input.cage, &pose.mesh.positions);
     let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
     geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     let source = match &args.weights {
-        Some(path) => format!("weights from {}", path.display()),
+        Some(path) => format!("weights from {}", geometry::shown_path(path)),
         None => format!("{} weights", method_label(&args.method)),
     };
     summary(format_args!(

@@ -51,7 +51,7 @@ pub enum Command {
     Edit(EditArgs),
     /// Compute the weights of every mesh vertex with respect to the cage and write them as .npy.
     Bind(BindArgs),
-    /// Move every mesh vertex to Σ λᵢ c̃ᵢ for a deformed cage and write the mesh as OBJ.
+    /// Move every mesh vertex p by Σ λᵢ (c̃ᵢ − cᵢ), the weighted moves of the cage vertices (Σ λᵢ c̃ᵢ for weights that reproduce p at rest, with less rounding), and write the mesh as OBJ.
     Deform(DeformArgs),
     /// Validate a mesh and its cage and print statistics.
     Check(CheckArgs),
@@ -154,7 +154,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh.

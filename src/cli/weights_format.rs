@@ -5,9 +5,10 @@
 use super::commands::BoundInput;
 use super::BindArgs;
 use crate::coords::family::ColumnLayout;
-use crate::coords::npy::read_npy;
+use crate::coords::npy::{read_npy, ExpectedArray};
 use crate::coords::npz::read_npz;
 use crate::coords::{Method, Weights};
+use crate::geometry::shown_path;
 use anyhow::{bail, Result};
 
 /// Whether `method`'s weights are written as two arrays in a `.npz` (φ and ψ)
@@ -43,7 +44,9 @@ pub(super) fn check_weights_format(args: &BindArgs) -> Result<()> {
 
 /// Weights from a file and the family they apply as: a `.npz` holds Green
 /// coordinates (φ and ψ), a `.npy` one weight per cage vertex, whatever `--method`
-/// says, except that Green coordinates cannot come from a `.npy`.
+/// says, except that Green coordinates cannot come from a `.npy`. The file's
+/// arrays must have this mesh's and cage's shape, finite values, and rows of
+/// cage-vertex weights that sum to 1 (checked as they are read).
 pub(super) fn read_weights_for(
     path: &std::path::Path,
     input: &BoundInput,
@@ -55,34 +58,16 @@ pub(super) fn read_weights_for(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     if is_npz {
-        let (weights, phi_columns) = read_npz(path)?;
-        let psi_columns = weights.cols - phi_columns;
-        if (weights.rows, phi_columns, psi_columns) != (rows, vertices, triangles) {
-            bail!(
-                "{}: phi has shape ({}, {phi_columns}) and psi ({}, {psi_columns}), but the mesh has {rows} vertices and the cage {vertices} vertices and {triangles} triangles",
-                path.display(),
-                weights.rows,
-                weights.rows
-            );
-        }
-        return Ok((weights, Method::Green));
+        return Ok((read_npz(path, rows, vertices, triangles)?, Method::Green));
     }
     if writes_npz(asked) {
         bail!(
             "{}: {} coordinates are read from a .npz with arrays phi and psi (what `pmvc bind --method {}` writes), not from a .npy",
-            path.display(),
+            shown_path(path),
             asked.name(),
             asked.id()
         );
     }
-    let weights = read_npy(path)?;
-    if (weights.rows, weights.cols) != (rows, vertices) {
-        bail!(
-            "{}: weights have shape ({}, {}), but the mesh has {rows} vertices and the cage {vertices}",
-            path.display(),
-            weights.rows,
-            weights.cols
-        );
-    }
+    let weights = read_npy(path, ExpectedArray::cage_vertices(rows, vertices))?;
     Ok((weights, asked))
 }

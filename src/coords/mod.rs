@@ -25,6 +25,7 @@ pub mod green;
 pub mod harmonic;
 pub mod mvc;
 pub mod npy;
+pub mod npy_header;
 pub mod npz;
 pub mod pmvc;
 pub mod quality;

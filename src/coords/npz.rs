@@ -5,10 +5,13 @@
 //! Entries are stored uncompressed, as `numpy.savez` writes them; `np.load` reads
 //! the file. In memory the two are one [`Weights`] matrix, φ columns then ψ.
 
-use super::npy::{npy_preamble, read_npy_from, write_f32_values, NpyError};
+use super::npy::{
+    allocate, npy_preamble, open, read_array_header, read_values, write_f32_values, ArrayAt,
+    ExpectedArray, NpyError,
+};
 use super::Weights;
 use crate::geometry::PendingOutput;
-use std::io::Write as _;
+use std::io::{Read, Seek, Write as _};
 use std::path::Path;
 
 /// The archive's array names.
@@ -63,75 +66,124 @@ pub fn write_npz_to(
     Ok(())
 }
 
-/// Read an archive written by [`write_npz_to`] (or `numpy.savez(path, phi=…,
-/// psi=…)`) into one matrix, φ columns then ψ; also returns φ's column count.
-pub fn read_npz(path: &Path) -> Result<(Weights, usize), NpyError> {
-    let file = std::fs::File::open(path).map_err(|source| NpyError::Read {
-        path: path.to_owned(),
-        source,
-    })?;
+/// Read the Green coordinates of `rows` mesh vertices in a cage of
+/// `cage_vertices` vertices and `cage_triangles` triangles from an archive written
+/// by [`write_npz_to`] (or `numpy.savez(path, phi=…, psi=…)`), as one matrix, φ
+/// columns then ψ. Both arrays' headers are checked against those sizes and the
+/// bytes the archive holds before the matrix is allocated; values must be finite
+/// and each row of φ must sum to 1 (as for [`read_npy`]).
+pub fn read_npz(
+    path: &Path,
+    rows: usize,
+    cage_vertices: usize,
+    cage_triangles: usize,
+) -> Result<Weights, NpyError> {
+    let (file, file_bytes) = open(path)?;
     let mut archive =
         zip::ZipArchive::new(std::io::BufReader::new(file)).map_err(|source| NpyError::NotNpz {
             path: path.to_owned(),
             source,
         })?;
-    let names = archive_names(&archive);
-    let found = if names.is_empty() {
-        "nothing".to_owned()
-    } else {
-        names.join(", ")
+    let arrays = [
+        (PHI, ExpectedArray::cage_vertices(rows, cage_vertices), 0),
+        (
+            PSI,
+            ExpectedArray {
+                rows,
+                cols: cage_triangles,
+                columns: "triangles",
+                rows_sum_to_one: false,
+            },
+            cage_vertices,
+        ),
+    ];
+    let at = |name| ArrayAt {
+        path: path.to_owned(),
+        array: Some(name),
     };
-    let mut read = |name: &'static str| -> Result<Weights, NpyError> {
-        let missing = NpyError::MissingArray {
+    // Both headers before anything is allocated.
+    for (name, expected, _) in arrays {
+        let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
+        read_array_header(&mut entry, present, &at(name), expected)?;
+    }
+    let whole = ArrayAt {
+        path: path.to_owned(),
+        array: None,
+    };
+    let mut weights = allocate(&whole, rows, cage_vertices + cage_triangles)?;
+    for (name, expected, first_column) in arrays {
+        let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
+        let mut entry = std::io::BufReader::new(&mut entry);
+        let data_present = read_array_header(&mut entry, present, &at(name), expected)?;
+        read_values(
+            &mut entry,
+            &at(name),
+            expected,
+            data_present,
+            &mut weights,
+            first_column,
+        )?;
+    }
+    Ok(weights)
+}
+
+/// The entry `name`.npy, stored (not compressed), and the bytes it holds: the
+/// least of its declared sizes and what the archive has after its start.
+fn open_entry<'a, R: Read + Seek>(
+    archive: &'a mut zip::ZipArchive<R>,
+    path: &Path,
+    name: &'static str,
+    file_bytes: Option<u64>,
+) -> Result<(zip::read::ZipFile<'a, R>, Option<u64>), NpyError> {
+    let not_npz = |source| NpyError::NotNpz {
+        path: path.to_owned(),
+        source,
+    };
+    let Some(index) = archive.index_for_name(&format!("{name}.npy")) else {
+        return Err(NpyError::MissingArray {
             path: path.to_owned(),
             name,
-            found: found.clone(),
-        };
-        let entry = match archive.by_name(&format!("{name}.npy")) {
-            Ok(entry) => entry,
-            Err(zip::result::ZipError::FileNotFound) => return Err(missing),
-            Err(source) => {
-                return Err(NpyError::NotNpz {
-                    path: path.to_owned(),
-                    source,
-                })
-            }
-        };
-        read_npy_from(std::io::BufReader::new(entry), &path.join(name))
+            found: archive_names(archive),
+        });
     };
-    let phi = read("phi")?;
-    let psi = read("psi")?;
-    if phi.rows != psi.rows {
-        return Err(NpyError::RowMismatch {
-            path: path.to_owned(),
-            phi_rows: phi.rows,
-            psi_rows: psi.rows,
+    let compression = archive.by_index_raw(index).map_err(not_npz)?.compression();
+    if compression != zip::CompressionMethod::Stored {
+        return Err(NpyError::Compressed {
+            at: ArrayAt {
+                path: path.to_owned(),
+                array: Some(name),
+            },
         });
     }
-    Ok((join_columns(&phi, &psi), phi.cols))
+    let entry = archive.by_index(index).map_err(not_npz)?;
+    let in_archive = file_bytes.map(|bytes| bytes.saturating_sub(entry.data_start()));
+    let present = entry
+        .size()
+        .min(entry.compressed_size())
+        .min(in_archive.unwrap_or(u64::MAX));
+    Ok((entry, Some(present)))
 }
 
-fn archive_names<R: std::io::Read + std::io::Seek>(archive: &zip::ZipArchive<R>) -> Vec<String> {
+/// The archive's entries as a message lists them: escaped, without `.npy`, the
+/// first few.
+fn archive_names<R: Read + Seek>(archive: &zip::ZipArchive<R>) -> String {
+    const SHOWN: usize = 8;
     let mut names: Vec<String> = archive
         .file_names()
-        .map(|name| name.strip_suffix(".npy").unwrap_or(name).to_owned())
+        .map(|name| {
+            let name = name.strip_suffix(".npy").unwrap_or(name);
+            name.chars()
+                .take(64)
+                .collect::<String>()
+                .escape_debug()
+                .to_string()
+        })
         .collect();
     names.sort();
-    names
-}
-
-/// Rows of `left` followed by the same rows of `right`.
-fn join_columns(left: &Weights, right: &Weights) -> Weights {
-    let cols = left.cols + right.cols;
-    let mut values = Vec::with_capacity(left.rows * cols);
-    for row in 0..left.rows {
-        values.extend_from_slice(left.row(row));
-        values.extend_from_slice(right.row(row));
-    }
-    Weights {
-        rows: left.rows,
-        cols,
-        values,
+    match names.len() {
+        0 => "nothing".to_owned(),
+        n if n > SHOWN => format!("{} and {} more", names[..SHOWN].join(", "), n - SHOWN),
+        _ => names.join(", "),
     }
 }
 
@@ -146,7 +198,7 @@ mod tests {
         let weights = Weights {
             rows: 2,
             cols: 5,
-            values: (0..10).map(|v| v as f32 * 0.5 - 1.0).collect(),
+            values: vec![0.25, 0.25, 0.5, 7.0, -3.0, 1.5, -1.0, 0.5, 0.125, 2.0],
         };
         write_npz_to(
             PendingOutput::create(&path).expect("output"),
@@ -155,14 +207,7 @@ mod tests {
             3,
         )
         .expect("written");
-        let (read, vertex_columns) = read_npz(&path).expect("read back");
-        assert_eq!((read.clone(), vertex_columns), (weights, 3));
-        // Each array on its own, as NumPy sees it.
-        let file = std::fs::File::open(&path).expect("open");
-        let mut archive = zip::ZipArchive::new(file).expect("a zip");
-        let psi = read_npy_from(archive.by_name("psi.npy").expect("psi"), &path).expect("npy");
-        assert_eq!((psi.rows, psi.cols), (2, 2));
-        assert_eq!(psi.values, [0.5, 1.0, 3.0, 3.5]);
+        assert_eq!(read_npz(&path, 2, 3, 2).expect("read back"), weights);
     }
 
     #[test]
@@ -179,7 +224,7 @@ mod tests {
         zip.start_file("weights.npy", zip::write::SimpleFileOptions::default())
             .expect("entry");
         zip.finish().expect("finish");
-        let message = read_npz(&path).expect_err("no psi").to_string();
+        let message = read_npz(&path, 1, 1, 1).expect_err("no psi").to_string();
         assert!(
             message.contains("no array 'psi'") && message.contains("phi, weights"),
             "{message}"
@@ -191,7 +236,7 @@ mod tests {
         let folder = tempfile::tempdir().expect("temporary folder");
         let path = folder.path().join("w.npz");
         std::fs::write(&path, b"\x93NUMPY not a zip").expect("write");
-        let message = read_npz(&path).expect_err("not a zip").to_string();
+        let message = read_npz(&path, 1, 4, 4).expect_err("not a zip").to_string();
         assert!(
             message.contains("w.npz") && message.contains("not a .npz archive"),
             "{message}"
