@@ -416,7 +416,8 @@ pub fn points_f32(points: &[DVec3], w: f32) -> Vec<[f32; 4]> {
 /// What a readback returns per mesh vertex, exactly as the shaders compute it.
 #[derive(Clone, Debug, Default)]
 pub struct ReadBack {
-    /// In scene coordinates ([`SceneGpu::origin`]).
+    /// In scene coordinates ([`SceneGpu::origin`]) as the renderer reads them;
+    /// the editor's read-backs turn them into world coordinates.
     pub positions: Vec<glam::Vec3>,
     /// The colouring value (0 when shaded).
     pub values: Vec<f32>,
