@@ -145,7 +145,7 @@ fn value_colour(value: f32, outside_cage: bool) -> vec3<f32> {
 
 struct MeshVarying {
     @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
+    @location(0) scene_position: vec3<f32>,
     @location(1) outside: f32,
     @location(2) value: f32,
     // 1 for a vertex outside the cage, whether or not it is highlighted.
@@ -163,14 +163,15 @@ fn mesh_vertex(vertex: u32) -> MeshVarying {
     return mesh_vertex_at(vertex, deformed_position(vertex));
 }
 
-// Everything but the blend, for a vertex deformed to `world`.
-fn mesh_vertex_at(vertex: u32, world: vec3<f32>) -> MeshVarying {
+// Everything but the blend, for a vertex deformed to `scene_position` (relative to
+// the scene origin, as every position uploaded).
+fn mesh_vertex_at(vertex: u32, scene_position: vec3<f32>) -> MeshVarying {
     var out: MeshVarying;
-    out.clip = frame.view_projection * vec4<f32>(world, 1.0);
-    out.world = world;
+    out.clip = frame.view_projection * vec4<f32>(scene_position, 1.0);
+    out.scene_position = scene_position;
     out.outside = rest[vertex].w * f32(frame.highlight_outside);
     if COLOURED {
-        out.value = vertex_value(vertex, world);
+        out.value = vertex_value(vertex, scene_position);
     }
     out.outside_cage = rest[vertex].w;
     if frame.smooth_shading == 1u && frame.weights_bound == 1u {
@@ -196,10 +197,10 @@ fn pulled_forward(surface: MeshVarying) -> MeshVarying {
 // texel (i mod width, i / width) of a float image, carrying its deformed position.
 struct ProbeVarying {
     @builtin(position) clip: vec4<f32>,
-    @location(0) @interpolate(flat) world: vec3<f32>,
+    @location(0) @interpolate(flat) scene_position: vec3<f32>,
 }
 
-fn probe_vertex(vertex: u32, world: vec3<f32>) -> ProbeVarying {
+fn probe_vertex(vertex: u32, scene_position: vec3<f32>) -> ProbeVarying {
     let width = frame.probe_width;
     let height = (frame.vertex_count + width - 1u) / width;
     let texel = vec2<f32>(f32(vertex % width), f32(vertex / width)) + 0.5;
@@ -210,7 +211,7 @@ fn probe_vertex(vertex: u32, world: vec3<f32>) -> ProbeVarying {
         0.0,
         1.0,
     );
-    out.world = world;
+    out.scene_position = scene_position;
     return out;
 }
 
@@ -221,7 +222,7 @@ fn vs_probe(@builtin(vertex_index) vertex: u32) -> ProbeVarying {
 
 @fragment
 fn fs_probe(in: ProbeVarying) -> @location(0) vec4<f32> {
-    return vec4<f32>(in.world, 1.0);
+    return vec4<f32>(in.scene_position, 1.0);
 }
 
 @fragment
@@ -231,11 +232,11 @@ fn fs_wire(in: MeshVarying) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
-    var normal = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    var normal = normalize(cross(dpdx(in.scene_position), dpdy(in.scene_position)));
     if frame.smooth_shading == 1u && length(in.normal) > 0.5 {
         normal = normalize(in.normal);
     }
-    let to_eye = normalize(frame.eye - in.world);
+    let to_eye = normalize(frame.eye - in.scene_position);
     // Two-sided: light whichever side faces the camera.
     if dot(normal, to_eye) < 0.0 {
         normal = -normal;

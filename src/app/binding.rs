@@ -211,8 +211,7 @@ impl EditorApp {
         };
         let method = options.method;
         let uploaded = self.with_renderer(|renderer, device, queue| {
-            let rest = super::editor::to_f32(&self.document.mesh().positions);
-            renderer.set_outside(queue, &rest, &outcome.outside);
+            renderer.set_outside(queue, &self.document.mesh().positions, &outcome.outside);
             renderer.set_weights(
                 device,
                 method,

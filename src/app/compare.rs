@@ -344,13 +344,18 @@ pub fn cage_size(cage: &[DVec3]) -> f64 {
     (hi - lo).length().max(1e-12)
 }
 
-/// Mesh positions `rest` moved by `weights` and the columns' displacements, in f32
-/// as drawn.
-pub fn deform(weights: &Weights, rest: &[DVec3], moves: &[DVec3]) -> Vec<Vec3> {
+/// Mesh positions `rest` moved by `weights` and the columns' displacements, in
+/// f32 scene coordinates (relative to `origin`) as drawn.
+pub fn deform(
+    weights: &Weights,
+    rest: &[DVec3],
+    moves: &[DVec3],
+    origin: crate::render::SceneOrigin,
+) -> Vec<Vec3> {
     weights
         .apply_displacements(rest, moves)
         .iter()
-        .map(|p| p.as_vec3())
+        .map(|&p| origin.to_scene(p))
         .collect()
 }
 

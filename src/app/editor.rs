@@ -27,9 +27,9 @@ use crate::coords::{BindOptions, Method};
 use crate::geometry::TriMesh;
 use crate::gpu::{Backend, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
-use crate::render::{OrbitCamera, ReadBack, RenderError, SceneUpload, Shading, ViewportRenderer};
+use crate::render::{OrbitCamera, SceneOrigin, SceneUpload, ViewportRenderer};
 use eframe::egui_wgpu;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -240,12 +240,13 @@ impl EditorApp {
         &mut self.view
     }
 
-    /// The camera of the first view, and of every view while they are locked.
+    /// The camera of the first view, and of every view while they are locked;
+    /// its target is in scene coordinates ([`Self::scene_origin`]).
     pub fn camera(&self) -> OrbitCamera {
         self.viewport.camera_of(0, self.view.cameras_locked)
     }
 
-    /// The camera view `pane` is drawn with.
+    /// The camera view `pane` is drawn with (in scene coordinates).
     pub fn camera_of(&self, pane: usize) -> OrbitCamera {
         self.viewport.camera_of(pane, self.view.cameras_locked)
     }
@@ -355,10 +356,18 @@ impl EditorApp {
         self.view.heat_triangle = (self.view.heat_triangle)
             .map(|triangle| triangle.min(cage_triangles.saturating_sub(1)));
         self.binding_paused = false;
+        // Before framing: the cameras are relative to the new document's origin.
+        self.viewport.set_origin(self.document_origin());
         if frame {
             self.frame_scene();
         }
         self.sync_gpu();
+    }
+
+    /// What the viewport draws this document relative to: positions on the GPU,
+    /// cameras and projections are taken from there ([`SceneOrigin::of_cage`]).
+    fn document_origin(&self) -> SceneOrigin {
+        SceneOrigin::of_cage(self.document.cage().positions())
     }
 
     /// Show a document back from the scene history with the weights it had,
@@ -367,7 +376,7 @@ impl EditorApp {
         self.document.mark_all_changed();
         let same_mesh = Arc::ptr_eq(mesh_before, self.document.mesh());
         self.document_swapped(!same_mesh);
-        let rest = to_f32(&self.document.mesh().positions);
+        let rest = self.document.mesh().positions.clone();
         let outside = self.document.outside().to_vec();
         let sets: Vec<_> = Method::ALL
             .iter()
@@ -393,16 +402,18 @@ impl EditorApp {
     pub fn sync_gpu(&mut self) {
         let changes = self.document.take_changes();
         if changes.scene {
-            let rest = to_f32(&self.document.mesh().positions);
-            let triangles = self.document.mesh().triangles.clone();
-            let cage = self.document.cage().clone();
+            let origin = self.document_origin();
+            self.viewport.set_origin(origin);
+            let mesh = Arc::clone(self.document.mesh());
+            let cage = Arc::clone(self.document.cage());
             self.with_renderer(|renderer, device, _| {
                 renderer.upload_scene(
                     device,
                     &SceneUpload {
-                        rest_positions: &rest,
-                        triangles: &triangles,
+                        rest_positions: &mesh.positions,
+                        triangles: &mesh.triangles,
                         cage: &cage,
+                        origin,
                     },
                 )
             });
@@ -484,7 +495,7 @@ impl EditorApp {
 
     pub fn frame_scene(&mut self) {
         let (centre, radius) = self.document.bounding_sphere();
-        self.viewport.frame(centre.as_vec3(), radius as f32);
+        self.viewport.frame(centre, radius);
     }
 
     /// Frame the selected handles (F), or the whole scene when none is selected.
@@ -498,8 +509,12 @@ impl EditorApp {
         }
         let (lo, hi) = crate::geometry::bounds_of(&selected);
         let radius = ((hi - lo).length() / 2.0).max(0.1 * self.document.cage().diagonal());
-        self.viewport
-            .frame(((lo + hi) / 2.0).as_vec3(), radius as f32);
+        self.viewport.frame((lo + hi) / 2.0, radius);
+    }
+
+    /// The views drawn last frame and their screen rectangles.
+    pub fn pane_rects(&self) -> Vec<(Pane, egui::Rect)> {
+        self.viewport.pane_rects()
     }
 
     /// Lock all views to one camera (the first view's) or give each its own.
@@ -509,68 +524,6 @@ impl EditorApp {
             self.viewport.unify_cameras();
         }
     }
-
-    // ---- GPU read-back, for tests and checks ---------------------------------
-
-    /// Deformed mesh positions of the active method as the vertex shader computes
-    /// them, read back from the GPU.
-    pub fn read_back_deformed(&self) -> Option<Result<Vec<Vec3>, RenderError>> {
-        let shading = Shading {
-            method: self.active_method(),
-            ..Default::default()
-        };
-        self.read_back(&shading)
-            .map(|result| result.map(|read_back| read_back.positions))
-    }
-
-    /// Smooth shading's vertex normals of `method`'s deformation as the GPU last
-    /// computed them; `None` before a smooth-shaded view of it was drawn.
-    pub fn read_back_normals(&self, method: crate::coords::Method) -> Option<Vec<Vec3>> {
-        self.with_renderer(|renderer, device, queue| {
-            renderer.read_back_normals(device, queue, method)
-        })
-        .flatten()
-        .and_then(Result::ok)
-    }
-
-    /// `method`'s deformed positions as the vertex shader draws them.
-    pub fn read_back_drawn(
-        &self,
-        method: crate::coords::Method,
-    ) -> Option<Result<Vec<Vec3>, RenderError>> {
-        self.with_renderer(|renderer, device, queue| {
-            renderer.read_back_drawn(device, queue, method)
-        })
-    }
-
-    /// Why smooth shading cannot be shown for this scene on this GPU, if it
-    /// cannot (the mesh is then lit per face).
-    pub fn smooth_shading_refusal(&self) -> Option<String> {
-        self.with_renderer(|renderer, device, _| renderer.smooth_shading_refusal(device))
-            .flatten()
-    }
-
-    /// The weights columns of `method` drawn from vertex attributes; `None`
-    /// when the viewport reads them all from storage.
-    pub fn attribute_columns(&self, method: crate::coords::Method) -> Option<u32> {
-        self.with_renderer(|renderer, _, _| renderer.attribute_columns(method))
-            .flatten()
-    }
-
-    /// Positions, colouring values and colours as the shaders compute them.
-    pub fn read_back(&self, shading: &Shading) -> Option<Result<ReadBack, RenderError>> {
-        self.with_renderer(|renderer, device, queue| renderer.read_back(device, queue, shading))
-    }
-
-    /// The views drawn last frame and their screen rectangles.
-    pub fn pane_rects(&self) -> Vec<(Pane, egui::Rect)> {
-        self.viewport.pane_rects()
-    }
-}
-
-/// Points in the renderer's f32.
-pub(super) fn to_f32(points: &[DVec3]) -> Vec<Vec3> {
-    points.iter().map(|p| p.as_vec3()).collect()
 }
 
 /// With [`BindOn::Auto`], bind on the editor's own device when it is a hardware

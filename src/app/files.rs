@@ -69,11 +69,8 @@ impl EditorApp {
         let settings = opened.settings;
         self.bind_options = settings.bind_options;
         self.view = settings.view;
-        let mut cameras = self.viewport.cameras();
-        for (slot, camera) in cameras.iter_mut().zip(settings.cameras) {
-            *slot = camera;
-        }
-        self.viewport.set_cameras(cameras);
+        // Session files hold the cameras in world coordinates.
+        self.viewport.set_world_cameras(&settings.cameras);
         self.mark_pose_saved();
         self.session_path = Some(path.to_owned());
         self.remember(RecentEntry::Session(path.to_owned()));
@@ -101,7 +98,7 @@ impl EditorApp {
         let settings = SessionSettings {
             bind_options: self.bind_options,
             view: self.view,
-            cameras: self.viewport.cameras().to_vec(),
+            cameras: self.viewport.world_cameras(),
         };
         match session::save_session(path, &self.document, &settings) {
             Ok(()) => {

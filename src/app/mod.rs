@@ -6,7 +6,7 @@
 //!   private state whose mutators report every change.
 //! - [`bind_queue`]: binding in the background, one job at a time.
 //! - [`editor`]: the [`EditorApp`] that ties them to the viewport; `binding`,
-//!   `files` and `readouts` add its actions.
+//!   `files` and `readouts` add its actions, `gpu_readback` what the GPU drew.
 //! - `viewport`: panes, input and picking; `ui`: menu, toolbar, side panel,
 //!   quality table, notices and statistics.
 //! - [`cage_generation`]: File > Generate cage…, a cage generated in the
@@ -24,6 +24,7 @@ mod exports;
 mod files;
 mod focus;
 mod frame;
+mod gpu_readback;
 pub mod history;
 mod offscreen;
 pub mod pose_tools;

@@ -65,6 +65,7 @@ impl EditorApp {
             weights,
             &self.document.mesh().positions,
             &moves,
+            self.viewport.origin(),
         ));
         self.readouts
             .deformed

@@ -1,8 +1,10 @@
 //! An orbit camera (Blender conventions: orbit around a target, pan moves the
 //! target in the view plane, zoom moves towards the cursor) and the projections
-//! the editor needs for picking and dragging.
+//! the editor needs for picking and dragging. Cameras live in scene coordinates
+//! (relative to the document's [`SceneOrigin`]), as the positions the GPU draws.
 
-use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
+use super::scene_origin::SceneOrigin;
+use glam::{DVec3, Mat4, Vec2, Vec3, Vec4Swizzles};
 
 /// Vertical field of view.
 const FOV_Y: f32 = 40.0 * std::f32::consts::PI / 180.0;
@@ -19,6 +21,7 @@ fn fov_y(aspect: f32) -> f32 {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitCamera {
+    /// In scene coordinates, except in session files, which hold world ones.
     pub target: Vec3,
     pub distance: f32,
     /// Rotation about the world y axis, radians.
@@ -50,7 +53,7 @@ impl OrbitCamera {
         self.target + self.backward() * self.distance
     }
 
-    /// Camera right and up vectors in world space.
+    /// Camera right and up vectors (world and scene axes are the same).
     pub fn right_up(&self) -> (Vec3, Vec3) {
         let forward = -self.backward();
         let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
@@ -111,17 +114,26 @@ impl OrbitCamera {
     }
 }
 
-/// A projection from world space to a viewport rectangle in points.
+/// A projection from scene space to a viewport rectangle in points.
 #[derive(Clone, Copy, Debug)]
 pub struct ScreenProjection {
+    /// From scene coordinates to clip space.
     pub view_projection: Mat4,
     /// Viewport origin and size, in egui points.
     pub origin: Vec2,
     pub size: Vec2,
+    /// Where the scene coordinates are measured from.
+    pub scene_origin: SceneOrigin,
 }
 
 impl ScreenProjection {
-    /// Screen position of `point`, or `None` behind the camera.
+    /// Screen position of the world position `point`, or `None` behind the
+    /// camera; taken relative to the scene origin in f64 first.
+    pub fn project_world(&self, point: DVec3) -> Option<Vec2> {
+        self.project(self.scene_origin.to_scene(point))
+    }
+
+    /// Screen position of `point` in scene coordinates, or `None` behind the camera.
     pub fn project(&self, point: Vec3) -> Option<Vec2> {
         let clip = self.view_projection * point.extend(1.0);
         if clip.w <= 1e-6 {
@@ -149,6 +161,7 @@ mod tests {
             view_projection: camera.view_projection(2.0),
             origin: Vec2::new(10.0, 20.0),
             size: Vec2::new(200.0, 100.0),
+            scene_origin: SceneOrigin::default(),
         };
         let centre = projection.project(camera.target).unwrap();
         assert!((centre - Vec2::new(110.0, 70.0)).length() < 1e-3);

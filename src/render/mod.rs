@@ -14,6 +14,8 @@
 //! - [`viewport`]: the orchestrator and the paint callback;
 //! - [`shading`]: what a view shows, as plain values (no GPU);
 //! - [`camera`]: the orbit camera and screen projection (no GPU);
+//! - [`scene_origin`]: the point the f32 scene coordinates are measured from
+//!   (no GPU);
 //! - [`colormap`]: the heatmaps' colour maps, CPU twins of the shader's (no GPU).
 //!
 //! Each renderer is paired with its WGSL file in `shaders/render_*.wgsl`.
@@ -28,6 +30,7 @@ pub mod mesh;
 pub mod normals;
 pub mod readback;
 pub mod scene_gpu;
+pub mod scene_origin;
 pub mod shading;
 pub mod viewport;
 pub mod weight_attributes;
@@ -36,6 +39,7 @@ pub mod weight_chunks;
 pub use callback::ViewportCallback;
 pub use camera::{OrbitCamera, ScreenProjection};
 pub use scene_gpu::{FrameUniform, ReadBack};
+pub use scene_origin::SceneOrigin;
 pub use viewport::{
     check_adapter, Colouring, FrameParams, RenderError, SceneUpload, Shading, ViewportRenderer,
     MAX_VIEWS,

@@ -4,6 +4,7 @@
 //! never on the orchestrator ([`super::viewport`]), as re_renderer's renderers
 //! depend on its global bindings.
 
+use super::scene_origin::SceneOrigin;
 use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use super::weight_chunks::{
     ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
@@ -11,7 +12,7 @@ use super::weight_chunks::{
 use crate::coords::Method;
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use std::collections::{BTreeMap, HashMap};
 
 pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -198,9 +199,11 @@ pub struct SceneGpu {
     pub cage_edges: wgpu::Buffer,
     pub cage_edge_index_count: u32,
     pub cage_vertex_count: u32,
-    /// xyz: rest position; w: 1 for a vertex outside the cage.
+    /// Where every position uploaded is measured from (scene coordinates).
+    pub origin: SceneOrigin,
+    /// xyz: rest position (scene coordinates); w: 1 for a vertex outside the cage.
     pub rest: wgpu::Buffer,
-    /// The posed cage, for drawing its edges and handles.
+    /// The posed cage (scene coordinates), for drawing its edges and handles.
     pub cage: wgpu::Buffer,
     pub handle_state: wgpu::Buffer,
     /// Bound where a view's family has no weights yet.
@@ -219,19 +222,19 @@ pub struct SceneGpu {
 }
 
 impl SceneGpu {
+    /// `rest_positions` are the mesh's in world coordinates, uploaded relative
+    /// to `origin`.
     pub fn new(
         device: &wgpu::Device,
-        rest_positions: &[Vec3],
+        rest_positions: &[DVec3],
         triangles: &[[u32; 3]],
         rest_cage: &Cage,
         cage_edges: &[[u32; 2]],
+        origin: SceneOrigin,
         chunk_limits: ChunkLimits,
     ) -> Self {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-        let rest: Vec<[f32; 4]> = rest_positions
-            .iter()
-            .map(|p| [p.x, p.y, p.z, 0.0])
-            .collect();
+        let rest = origin.points_to_scene(rest_positions, 0.0);
         let indices = draw_order(triangles, rest_positions.len());
         let edges = unique_edges(triangles);
         let adjacency = super::normals::Adjacency::of(rest_positions.len(), triangles);
@@ -259,8 +262,14 @@ impl SceneGpu {
             cage_edges: buffer_with(device, "cage edges", cage_edges, wgpu::BufferUsages::INDEX),
             cage_edge_index_count: cage_edges.len() as u32 * 2,
             cage_vertex_count: pose.len() as u32,
+            origin,
             rest: buffer_with(device, "rest positions", &rest, storage),
-            cage: buffer_with(device, "cage pose", &points_f32(&pose, 1.0), storage),
+            cage: buffer_with(
+                device,
+                "cage pose",
+                &origin.points_to_scene(&pose, 1.0),
+                storage,
+            ),
             handle_state: buffer_with(device, "handle states", &states, storage),
             placeholder: buffer_with(device, "no weights", &[0f32; 4], storage),
             uniform_placeholder: uniform_displacements_buffer(device, &[]),
@@ -395,7 +404,8 @@ pub fn uniform_displacements_buffer(
     )
 }
 
-/// Points as the shaders' `vec4<f32>`, with `w` as given.
+/// Vectors (displacements, not positions) as the shaders' `vec4<f32>`, with `w`
+/// as given.
 pub fn points_f32(points: &[DVec3], w: f32) -> Vec<[f32; 4]> {
     points
         .iter()
@@ -406,7 +416,9 @@ pub fn points_f32(points: &[DVec3], w: f32) -> Vec<[f32; 4]> {
 /// What a readback returns per mesh vertex, exactly as the shaders compute it.
 #[derive(Clone, Debug, Default)]
 pub struct ReadBack {
-    pub positions: Vec<Vec3>,
+    /// In scene coordinates ([`SceneGpu::origin`]) as the renderer reads them;
+    /// the editor's read-backs turn them into world coordinates.
+    pub positions: Vec<glam::Vec3>,
     /// The colouring value (0 when shaded).
     pub values: Vec<f32>,
     /// The unshaded colour of each value.

@@ -136,11 +136,7 @@ impl EditorApp {
             .cage
             .positions()
             .iter()
-            .map(|p| {
-                projection
-                    .project(p.as_vec3())
-                    .map(|at| Pos2::new(at.x, at.y))
-            })
+            .map(|p| projection.project_world(*p).map(|at| Pos2::new(at.x, at.y)))
             .collect();
         let stroke = Stroke::new(1.5, PROPOSAL_GREEN);
         for [a, b] in &proposal.edges {

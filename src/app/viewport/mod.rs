@@ -13,19 +13,30 @@ use super::editor::EditorApp;
 use super::widgets::{draw_colour_bar, BarNote};
 use crate::coords::Method;
 use crate::render::{
-    Colouring, FrameParams, OrbitCamera, ScreenProjection, ViewportCallback, MAX_VIEWS,
+    Colouring, FrameParams, OrbitCamera, SceneOrigin, ScreenProjection, ViewportCallback, MAX_VIEWS,
 };
 use eframe::egui_wgpu;
 use egui::{Color32, Pos2, Rect, Sense, Stroke};
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec2};
 pub(super) use input::Drag;
 
 /// Gap between side-by-side views, in points.
 const PANE_GAP: f32 = 2.0;
 
+/// Every view's camera, with the scene origin they are relative to, kept
+/// across a change of document.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewCameras {
+    origin: SceneOrigin,
+    cameras: [OrbitCamera; MAX_VIEWS],
+}
+
 /// What the viewport keeps between frames.
 #[derive(Default)]
 pub struct ViewportState {
+    /// What the cameras, the projections and the GPU's positions are relative
+    /// to: the document's [`SceneOrigin`].
+    origin: SceneOrigin,
     /// Index 0: the first view's camera, and every view's while they are locked.
     cameras: [OrbitCamera; MAX_VIEWS],
     /// The views drawn last frame, each with its screen rectangle and projection.
@@ -57,10 +68,25 @@ impl ViewportState {
         }
     }
 
-    /// Every camera looks at a sphere of `radius` around `centre`.
-    pub fn frame(&mut self, centre: Vec3, radius: f32) {
-        self.cameras[0].frame(centre, radius);
+    /// Every camera looks at a sphere of `radius` around `centre` (world coordinates).
+    pub fn frame(&mut self, centre: DVec3, radius: f64) {
+        self.cameras[0].frame(self.origin.to_scene(centre), radius as f32);
         self.unify_cameras();
+    }
+
+    /// The scene origin of the document shown.
+    pub fn origin(&self) -> SceneOrigin {
+        self.origin
+    }
+
+    /// Measure from `origin` from now on; the cameras keep looking at the same
+    /// place in the world.
+    pub fn set_origin(&mut self, origin: SceneOrigin) {
+        if origin != self.origin {
+            let saved = self.cameras();
+            self.origin = origin;
+            self.set_cameras(saved);
+        }
     }
 
     /// Every view takes the first view's camera.
@@ -68,12 +94,42 @@ impl ViewportState {
         self.cameras = [self.cameras[0]; MAX_VIEWS];
     }
 
-    pub fn cameras(&self) -> [OrbitCamera; MAX_VIEWS] {
-        self.cameras
+    pub fn cameras(&self) -> ViewCameras {
+        ViewCameras {
+            origin: self.origin,
+            cameras: self.cameras,
+        }
     }
 
-    pub fn set_cameras(&mut self, cameras: [OrbitCamera; MAX_VIEWS]) {
-        self.cameras = cameras;
+    /// Cameras saved by [`Self::cameras`], moved to the current origin.
+    pub fn set_cameras(&mut self, saved: ViewCameras) {
+        self.cameras = saved.cameras.map(|camera| OrbitCamera {
+            target: self.origin.rebased_point(saved.origin, camera.target),
+            ..camera
+        });
+    }
+
+    /// The cameras with their targets in world coordinates (as session files
+    /// hold them).
+    pub fn world_cameras(&self) -> Vec<OrbitCamera> {
+        let world = SceneOrigin::default();
+        self.cameras
+            .map(|camera| OrbitCamera {
+                target: world.rebased_point(self.origin, camera.target),
+                ..camera
+            })
+            .to_vec()
+    }
+
+    /// Take the first `cameras`, whose targets are in world coordinates.
+    pub fn set_world_cameras(&mut self, cameras: &[OrbitCamera]) {
+        let world = SceneOrigin::default();
+        for (slot, camera) in self.cameras.iter_mut().zip(cameras) {
+            *slot = OrbitCamera {
+                target: self.origin.rebased_point(world, camera.target),
+                ..*camera
+            };
+        }
     }
 
     /// A new document: no drag, no hover.
@@ -130,7 +186,7 @@ impl EditorApp {
         let screen = self
             .viewport
             .projection(pane)?
-            .project(self.document.pose().get(handle)?.as_vec3())?;
+            .project_world(*self.document.pose().get(handle)?)?;
         Some(Pos2::new(screen.x, screen.y))
     }
 
@@ -140,6 +196,7 @@ impl EditorApp {
             view_projection: self.camera_of(pane).view_projection(aspect),
             origin: Vec2::new(rect.min.x, rect.min.y),
             size: Vec2::new(rect.width(), rect.height()),
+            scene_origin: self.viewport.origin,
         }
     }
 
@@ -376,13 +433,14 @@ impl EditorApp {
     ) -> DVec3 {
         let camera = self.camera_of(pane);
         let short_side = rect.height().min(rect.width());
-        let scale = camera.units_per_pixel(camera.depth_of(centre.as_vec3()), short_side);
+        let depth = camera.depth_of(self.viewport.origin.to_scene(centre));
+        let scale = camera.units_per_pixel(depth, short_side);
         let (right, up) = camera.right_up();
         let in_plane = (right * motion.x - up * motion.y) * scale;
         match (axis, self.viewport.projection(pane)) {
             (Some(axis), Some(projection)) => {
-                let from = projection.project(centre.as_vec3());
-                let to = projection.project((centre + axis).as_vec3());
+                let from = projection.project_world(centre);
+                let to = projection.project_world(centre + axis);
                 match (from, to) {
                     (Some(from), Some(to)) if (to - from).length_squared() > 1e-6 => {
                         let screen_axis = to - from;

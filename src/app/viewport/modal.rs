@@ -113,6 +113,11 @@ impl EditorApp {
         }
     }
 
+    /// The 3D cursor, in world coordinates.
+    pub fn cursor(&self) -> DVec3 {
+        self.pose_tools.cursor
+    }
+
     /// Handles with no mirror partner under the symmetry in use.
     pub fn handles_without_partner(&self) -> usize {
         let Some(axis) = self.pose_tools.symmetry else {
@@ -258,7 +263,7 @@ impl EditorApp {
         let axis = modal.axis.map(|a| DVec3::AXES[a]);
         let projection = self.viewport.pane(modal.pane).map(|(_, p)| p);
         let pivot_screen = projection
-            .and_then(|p| p.project(modal.pivot.as_vec3()))
+            .and_then(|p| p.project_world(modal.pivot))
             .map(|s| Pos2::new(s.x, s.y))
             .unwrap_or(modal.start_pointer);
         let from = modal.start_pointer - pivot_screen;
@@ -317,7 +322,7 @@ impl EditorApp {
         let Some(modal) = &self.viewport.modal else {
             if self.pose_tools.pivot == Pivot::Cursor {
                 if let Some((_, projection)) = self.viewport.pane(pane) {
-                    if let Some(at) = projection.project(self.pose_tools.cursor.as_vec3()) {
+                    if let Some(at) = projection.project_world(self.pose_tools.cursor) {
                         let at = Pos2::new(at.x, at.y);
                         painter.circle_stroke(
                             at,
@@ -334,7 +339,7 @@ impl EditorApp {
             return;
         }
         if let Some((_, projection)) = self.viewport.pane(pane) {
-            if let Some(pivot) = projection.project(modal.pivot.as_vec3()) {
+            if let Some(pivot) = projection.project_world(modal.pivot) {
                 let pivot = Pos2::new(pivot.x, pivot.y);
                 painter.line_segment(
                     [pivot, modal.pointer],
@@ -388,7 +393,9 @@ impl EditorApp {
             Vec2::new(pointer.x, pointer.y),
             12.0,
         )?;
-        positions.get(vertex).map(|p| p.as_dvec3())
+        // The CPU's positions are in scene coordinates, as the view draws them.
+        let at = positions.get(vertex)?;
+        Some(projection.scene_origin.to_world(*at))
     }
 
     /// Shift+right click: the 3D cursor goes to the handle or mesh vertex under

@@ -29,7 +29,7 @@ impl EditorApp {
             .iter()
             .enumerate()
             .filter_map(|(i, p)| {
-                let screen = projection.project(p.as_vec3())?;
+                let screen = projection.project_world(*p)?;
                 let distance = screen.distance(pointer);
                 (distance <= radius).then_some((i, distance))
             })
@@ -53,7 +53,7 @@ impl EditorApp {
             .enumerate()
             .filter(|(_, p)| {
                 projection
-                    .project(p.as_vec3())
+                    .project_world(**p)
                     .is_some_and(|screen| band.contains(Pos2::new(screen.x, screen.y)))
             })
             .map(|(i, _)| i)

@@ -16,15 +16,18 @@ use super::mesh::{MeshPipelineKey, MeshRenderer};
 use super::normals::NormalsPass;
 use super::readback::Readback;
 use super::scene_gpu::{
-    buffer_with, points_f32, scene_layout, uniform_displacements_buffer, FrameUniform, ReadBack,
-    SceneGpu, WeightSlot, FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
+    buffer_with, scene_layout, uniform_displacements_buffer, FrameUniform, SceneGpu, WeightSlot,
+    FRAME_SLOT_BYTES, STORAGE_BUFFERS_PER_STAGE,
 };
+use super::scene_origin::SceneOrigin;
 pub use super::shading::{Colouring, FrameParams, Shading};
 use super::weight_attributes::AttributeBlend;
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
+
+mod readbacks;
 use crate::coords::{Method, Weights};
 use crate::geometry::Cage;
-use glam::{DVec3, Mat4, Vec3};
+use glam::{DVec3, Vec3};
 
 /// Multisampling smooths the one-pixel cage lines and the mesh silhouette. It
 /// costs about 16 ms a frame on lavapipe, so software adapters default to 1.
@@ -79,10 +82,14 @@ pub fn check_adapter(adapter: &wgpu::Adapter, device: &wgpu::Device) -> Result<(
 
 /// What the viewport draws, uploaded when the scene changes.
 pub struct SceneUpload<'a> {
-    pub rest_positions: &'a [Vec3],
+    /// The mesh at rest, in world coordinates.
+    pub rest_positions: &'a [DVec3],
     pub triangles: &'a [[u32; 3]],
     /// The rest cage; weights columns follow its vertices (and faces).
     pub cage: &'a Cage,
+    /// What every position is uploaded relative to; the cameras that draw the
+    /// scene must be relative to it too.
+    pub origin: SceneOrigin,
 }
 
 /// All GPU state of the viewport; lives in egui_wgpu's callback resources.
@@ -159,7 +166,9 @@ impl ViewportRenderer {
 
     /// Replace the scene. Weights start unbound: the mesh shows at rest.
     pub fn upload_scene(&mut self, device: &wgpu::Device, scene: &SceneUpload<'_>) {
-        let cage_rest: Vec<Vec3> = scene.cage.positions().iter().map(|p| p.as_vec3()).collect();
+        let cage_rest: Vec<Vec3> = (scene.cage.positions().iter())
+            .map(|&p| scene.origin.to_scene(p))
+            .collect();
         let edges = super::cage::feature_edges(&cage_rest, scene.cage.triangles());
         self.scene = Some(SceneGpu::new(
             device,
@@ -167,8 +176,15 @@ impl ViewportRenderer {
             scene.triangles,
             scene.cage,
             &edges,
+            scene.origin,
             self.chunk_limits,
         ));
+    }
+
+    /// What the scene on the GPU is drawn relative to: the positions read back
+    /// are in its coordinates. `None` before a scene is uploaded.
+    pub fn scene_origin(&self) -> Option<SceneOrigin> {
+        self.scene.as_ref().map(|scene| scene.origin)
     }
 
     /// Bind one family's weights (or unbind them with `None`, showing the mesh at
@@ -235,13 +251,11 @@ impl ViewportRenderer {
         Ok(())
     }
 
-    /// Mark the mesh vertices outside the cage (drawn red when highlighted).
-    pub fn set_outside(&mut self, queue: &wgpu::Queue, rest_positions: &[Vec3], outside: &[u32]) {
+    /// Mark the mesh vertices outside the cage (drawn red when highlighted);
+    /// `rest_positions` in world coordinates, as uploaded with the scene.
+    pub fn set_outside(&mut self, queue: &wgpu::Queue, rest_positions: &[DVec3], outside: &[u32]) {
         let Some(scene) = &self.scene else { return };
-        let mut rest: Vec<[f32; 4]> = rest_positions
-            .iter()
-            .map(|p| [p.x, p.y, p.z, 0.0])
-            .collect();
+        let mut rest = scene.origin.points_to_scene(rest_positions, 0.0);
         for &i in outside {
             if let Some(vertex) = rest.get_mut(i as usize) {
                 vertex[3] = 1.0;
@@ -263,7 +277,8 @@ impl ViewportRenderer {
         }
         scene.pose = pose.to_vec();
         scene.pose_revision += 1;
-        queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&points_f32(pose, 1.0)));
+        let scene_pose = scene.origin.points_to_scene(pose, 1.0);
+        queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&scene_pose));
         for (&method, slot) in &scene.slots {
             let displacements = scene.displacements_of(method);
             queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
@@ -332,91 +347,6 @@ impl ViewportRenderer {
             slot as u64 * FRAME_SLOT_BYTES,
             bytemuck::bytes_of(uniform),
         );
-    }
-
-    /// The deformed mesh positions, colouring values and colours exactly as the
-    /// shaders compute them for `shading`.
-    pub fn read_back(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        shading: &Shading,
-    ) -> Result<ReadBack, RenderError> {
-        let (bind_group, offset) = self.readback_bind_group(device, queue, shading)?;
-        let slots = self.chunk_limits.slots;
-        let readback =
-            (self.readback).get_or_insert_with(|| Readback::new(device, &self.scene_layout, slots));
-        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
-        readback
-            .run(device, queue, scene, &bind_group, offset)
-            .map_err(|_| RenderError::ReadBack)
-    }
-
-    /// `method`'s deformed mesh positions as the vertex shader draws them: read
-    /// as vertex attributes where the viewport reads them so ([`Self::attribute_columns`]).
-    pub fn read_back_drawn(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        method: Method,
-    ) -> Result<Vec<Vec3>, RenderError> {
-        let shading = Shading {
-            method,
-            ..Default::default()
-        };
-        let (bind_group, offset) = self.readback_bind_group(device, queue, &shading)?;
-        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
-        let weights = scene
-            .slots
-            .get(&method)
-            .and_then(WeightSlot::attribute_weights);
-        let slots = self.chunk_limits.slots;
-        let drawn = (self.drawn)
-            .get_or_insert_with(|| DrawnPositions::new(device, &self.scene_layout, slots));
-        drawn
-            .run(device, queue, scene, &bind_group, offset, weights)
-            .map_err(|_| RenderError::ReadBack)
-    }
-
-    /// The weights columns `method`'s rows are drawn with from vertex attributes
-    /// (the rest from storage); `None` when they are all read from storage.
-    pub fn attribute_columns(&self, method: Method) -> Option<u32> {
-        let slot = self.scene.as_ref()?.slots.get(&method)?;
-        Some(slot.attributes?.attribute_columns())
-    }
-
-    /// The readback slot of the frame uniform set for `shading`, and the scene's
-    /// bind group with its offset.
-    fn readback_bind_group(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        shading: &Shading,
-    ) -> Result<(wgpu::BindGroup, u32), RenderError> {
-        let params = FrameParams {
-            view: READBACK_SLOT,
-            shading: *shading,
-            view_projection: Mat4::IDENTITY,
-            eye: Vec3::ZERO,
-            size_px: [1, 1],
-            handle_radius_px: 0.0,
-            highlight_outside: false,
-            show_cage: false,
-            wireframe: false,
-            smooth_shading: false,
-        };
-        let uniform = self.frame_uniform(&params);
-        self.write_frame_slot(queue, READBACK_SLOT, &uniform);
-        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
-        let bind_group = scene.bind_group(
-            device,
-            &self.scene_layout,
-            &self.frame,
-            shading.method,
-            shading.against,
-        );
-        let offset = (READBACK_SLOT as u64 * FRAME_SLOT_BYTES) as u32;
-        Ok((bind_group.clone(), offset))
     }
 
     /// Draw view `params.view` into its offscreen target.
@@ -574,16 +504,6 @@ impl ViewportRenderer {
                 limit as f64 / 1048576.0
             )
         })
-    }
-
-    /// `method`'s smooth-shading normals as last computed (for tests).
-    pub fn read_back_normals(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        method: Method,
-    ) -> Option<Result<Vec<Vec3>, wgpu::BufferAsyncError>> {
-        super::normals::read_back(device, queue, self.scene.as_ref()?, method)
     }
 
     /// Composite view `view`'s image into egui's pass.
