@@ -121,11 +121,17 @@ impl CageReport {
     }
 }
 
-fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+/// Enclosed volume of closed `triangles`, positive when they face outward. The
+/// tetrahedra are taken from the centre of the positions' bounding box, not from
+/// the origin: far from the origin, products of absolute positions would round
+/// away the volume (a 2.34-wide box at 1e7 came out inward).
+pub(crate) fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let (lo, hi) = super::bounds_of(positions);
+    let centre = 0.5 * (lo + hi);
     triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let [a, b, c] = t.map(|i| positions[i as usize] - centre);
             a.dot(b.cross(c))
         })
         .sum::<f64>()

@@ -33,14 +33,15 @@ pub struct PointClasses {
 /// Classify every point against the cage (in parallel).
 pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
     let tolerance = SURFACE_TOLERANCE * cage.diagonal();
-    // Unit normal and offset of each triangle's plane: a point farther than the
+    // Unit normal and a corner of each triangle's plane: a point farther than the
     // tolerance from the plane cannot be on the triangle, which spares most
-    // closest-point computations.
-    let planes: Vec<(DVec3, f64)> = (0..cage.triangles().len())
+    // closest-point computations. The distance is taken from the corner, not as
+    // `n·x − n·a`, whose two terms far from the origin round by more than the
+    // tolerance.
+    let planes: Vec<(DVec3, DVec3)> = (0..cage.triangles().len())
         .map(|t| {
             let [a, b, c] = cage.triangle(t);
-            let normal = (b - a).cross(c - a).normalize_or_zero();
-            (normal, normal.dot(a))
+            ((b - a).cross(c - a).normalize_or_zero(), a)
         })
         .collect();
     let classes: Vec<PointClass> = points
@@ -60,19 +61,19 @@ pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
 
 fn classify_point(
     cage: &Cage,
-    planes: &[(DVec3, f64)],
+    planes: &[(DVec3, DVec3)],
     x: DVec3,
     tolerance: f64,
     corners: &mut Vec<Corner>,
 ) -> PointClass {
     let tolerance_squared = tolerance * tolerance;
-    for (t, &(normal, offset)) in planes.iter().enumerate() {
-        if (normal.dot(x) - offset).abs() > tolerance && normal != DVec3::ZERO {
+    for (t, &(normal, corner)) in planes.iter().enumerate() {
+        if normal.dot(x - corner).abs() > tolerance && normal != DVec3::ZERO {
             continue;
         }
         let [a, b, c] = cage.triangle(t);
-        let (closest, barycentric) = closest_point_on_triangle(x, a, b, c);
-        if closest.distance_squared(x) <= tolerance_squared {
+        let (offset, barycentric) = closest_offset_on_triangle(x, a, b, c);
+        if offset.length_squared() <= tolerance_squared {
             return PointClass::OnSurface {
                 triangle: t as u32,
                 barycentric,
@@ -199,6 +200,16 @@ fn fast_atan2(y: f64, x: f64) -> f64 {
     } else {
         angle.copysign(y)
     }
+}
+
+/// The closest point to `p` on triangle `abc` as an offset from `p`, and its
+/// barycentric coordinates. Built from the corners relative to `p`, so the
+/// distance keeps its precision far from the origin, where the absolute closest
+/// point of [`closest_point_on_triangle`] is rounded to the coordinates' spacing.
+pub fn closest_offset_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, DVec3) {
+    let (_, barycentric) = closest_point_on_triangle(p, a, b, c);
+    let offset = (a - p) * barycentric.x + (b - p) * barycentric.y + (c - p) * barycentric.z;
+    (offset, barycentric)
 }
 
 /// Closest point to `p` on triangle `abc` and its barycentric coordinates

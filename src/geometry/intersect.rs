@@ -145,13 +145,8 @@ pub fn check_shells(positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<Shell
         return None;
     }
     let volume = |shell: &[usize]| -> f64 {
-        shell
-            .iter()
-            .map(|&t| {
-                let [a, b, c] = triangles[t].map(|i| positions[i as usize]);
-                a.dot(b.cross(c))
-            })
-            .sum()
+        let shell_triangles: Vec<[u32; 3]> = shell.iter().map(|&t| triangles[t]).collect();
+        super::cage::signed_volume(positions, &shell_triangles)
     };
     for (s, shell) in shells.iter().enumerate() {
         let probe = positions[triangles[shell[0]][0] as usize];

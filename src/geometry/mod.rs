@@ -21,8 +21,8 @@ pub mod twisted_bar;
 
 pub use cage::{Cage, CageReport};
 pub use classify::{
-    classify_points, closest_point_on_triangle, generalized_winding_number, PointClass,
-    PointClasses,
+    classify_points, closest_offset_on_triangle, closest_point_on_triangle,
+    generalized_winding_number, PointClass, PointClasses,
 };
 pub use error::{shown_path, CageError, CageLoadError, LoadError, WriteError};
 pub use io::{

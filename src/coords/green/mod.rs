@@ -21,7 +21,7 @@ mod triangle;
 mod paper;
 
 use super::{BindProgress, Cancelled, Weights};
-use crate::geometry::{closest_point_on_triangle, Cage};
+use crate::geometry::{closest_offset_on_triangle, Cage};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -202,7 +202,7 @@ impl GreenCage {
                 .iter()
                 .map(|frame| {
                     let [a, b, c] = frame.corners;
-                    closest_point_on_triangle(x, a, b, c).0.distance(x)
+                    closest_offset_on_triangle(x, a, b, c).0.length()
                 })
                 .collect();
             let nearest = distances.iter().copied().fold(f64::INFINITY, f64::min);

@@ -13,7 +13,7 @@
 //! Unlike the paper's per-corner division by `N·v`, nothing here divides by h, so
 //! points on or near the triangle's plane lose no accuracy.
 
-use crate::geometry::closest_point_on_triangle;
+use crate::geometry::closest_offset_on_triangle;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -68,11 +68,12 @@ impl TriangleFrame {
     /// `x = Σ λₖ cornerₖ + t n` and `Σ λₖ = 1`, the λ not clamped to the triangle.
     pub fn affine_frame(&self, x: DVec3) -> ([f64; 3], f64) {
         let height = self.height_of(x);
-        let foot = x - height * self.normal;
+        // Corners relative to x's foot, from differences with x: the foot itself
+        // would be rounded to the coordinates' spacing far from the origin.
         let barycentric = std::array::from_fn(|k| {
             let opposite = (k + 1) % 3;
-            self.edge_normals[opposite].dot(self.corners[opposite] - foot) * self.lengths[opposite]
-                / self.doubled_area
+            let from_foot = (self.corners[opposite] - x) + height * self.normal;
+            self.edge_normals[opposite].dot(from_foot) * self.lengths[opposite] / self.doubled_area
         });
         (barycentric, height)
     }
@@ -85,8 +86,8 @@ impl TriangleFrame {
             return None;
         }
         let [a, b, c] = self.corners;
-        let (closest, barycentric) = closest_point_on_triangle(x, a, b, c);
-        if closest.distance(x) > tolerance {
+        let (offset, barycentric) = closest_offset_on_triangle(x, a, b, c);
+        if offset.length() > tolerance {
             return None;
         }
         // Distance from the closest point to the edge opposite each corner.

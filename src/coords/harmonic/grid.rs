@@ -9,7 +9,7 @@
 //! weights are non-negative and sum to one), and a linear function is reproduced
 //! exactly at every node: its two arms' terms cancel whatever θ is.
 
-use crate::geometry::{closest_point_on_triangle, Cage};
+use crate::geometry::{closest_offset_on_triangle, Cage};
 use glam::DVec3;
 
 /// No unknown here: the node is outside the cage, or the arm is cut.
@@ -266,8 +266,8 @@ pub(super) fn closest_hat_values(cage: &Cage, x: DVec3) -> (u32, [f64; 3]) {
     let mut best = (f64::INFINITY, 0, [1.0, 0.0, 0.0]);
     for t in 0..cage.triangle_count() {
         let [a, b, c] = cage.triangle(t);
-        let (point, barycentric) = closest_point_on_triangle(x, a, b, c);
-        let distance = point.distance_squared(x);
+        let (offset, barycentric) = closest_offset_on_triangle(x, a, b, c);
+        let distance = offset.length_squared();
         if distance < best.0 {
             best = (distance, t as u32, barycentric.to_array());
         }

@@ -47,7 +47,7 @@ pub enum HarmonicError {
     #[error("the harmonic grid needs at least {MIN_GRID} cells along the cage's longest side, not {grid}")]
     GridTooSmall { grid: u32 },
     #[error("a harmonic grid of {grid} cells has {nodes} nodes, more than this tool supports; use a smaller --grid")]
-    GridTooLarge { grid: u32, nodes: u64 },
+    GridTooLarge { grid: u32, nodes: u128 },
     #[error(
         "a harmonic bind at grid {grid} needs about {needed_mib} MiB, but only {available_mib} MiB of memory is available; use a smaller --grid (grid {suggested} needs about {suggested_mib} MiB)"
     )]
@@ -103,18 +103,24 @@ fn frame_for(cage: &Cage, grid: u32) -> Result<(Frame, usize), HarmonicError> {
     // A margin of about 0.7 cells keeps the cage off the outermost nodes, and
     // unequal fractions per axis keep grid lines off the cage's vertices and edges.
     let margin = DVec3::new(0.7137, 0.7291, 0.7413);
-    let cells = (extent / h + 2.0 * margin).ceil().as_uvec3().to_array();
-    let smallest = *cells.iter().min().unwrap_or(&1) as usize;
+    // Counted in u64 per axis and u128 in all: a grid of u32::MAX cells has about
+    // 2³² nodes per side, whose product overflows 64 bits.
+    let cells = (extent / h + 2.0 * margin)
+        .ceil()
+        .to_array()
+        .map(|c| c as u64);
+    let smallest = *cells.iter().min().unwrap_or(&1);
     let mut coarsenings = 0;
     while coarsenings < 7 && smallest >> (coarsenings + 1) >= 2 {
         coarsenings += 1;
     }
-    let step = 1usize << coarsenings;
-    let dims = cells.map(|c| (c as usize).div_ceil(step) * step + 1);
-    let nodes = dims.iter().map(|&n| n as u64).product::<u64>();
-    if nodes >= u64::from(u32::MAX) / 2 {
+    let step = 1u64 << coarsenings;
+    let dims = cells.map(|c| c.div_ceil(step) * step + 1);
+    let nodes = dims.iter().map(|&n| u128::from(n)).product::<u128>();
+    if nodes >= u128::from(u32::MAX / 2) {
         return Err(HarmonicError::GridTooLarge { grid, nodes });
     }
+    let dims = dims.map(|n| n as usize);
     let frame = Frame {
         origin: lo - margin * h,
         h,

@@ -13,6 +13,10 @@
 //! parameter `t = det[a,b,c] / D`. A shared edge yields exactly negated values in
 //! its two triangles, so no ray slips between them; a texel is covered where no edge
 //! value has its sign bit set, so a ray exactly along that edge goes to one of them.
+//! Rays that still slip through, at a cage vertex whose triangles round their edge
+//! values each their own way, or along a face that x sees edge on (skipped), are
+//! cast again with a little slack ([`catch_missed_texels`]): a lost ray would cost
+//! linear precision.
 //!
 //! The resolve needs only which triangle won each texel: the texel's weight times
 //! the hit's barycentrics, `Ω/r · Eₖ/D = Eₖ·(Ω·d̂)/det`, is linear in `Ω·d̂`, so the
@@ -239,6 +243,7 @@ fn pmvc_weights_with<const CULL: bool>(
 
     let mut total_weight = 0.0;
     let mut missed = 0.0;
+    let most_missed = MAX_MISSED_SHARE * (6 * resolution * resolution) as f64;
     for (f, frame) in FACE_FRAMES.iter().enumerate() {
         scratch.nearest.fill(0.0);
         scratch.drawn.clear();
@@ -320,12 +325,25 @@ fn pmvc_weights_with<const CULL: bool>(
                 total_weight += weight;
             }
         }
+        let mut face_missed = 0.0;
         for bank in &mut scratch.sums[0] {
-            missed += bank[3];
+            face_missed += bank[3];
             *bank = [0.0; 4];
         }
+        if face_missed > 0.0 && face_missed <= most_missed {
+            face_missed -= catch_missed_texels(
+                &scratch.nearest[..texels],
+                code_mask,
+                table,
+                &scratch.drawn,
+                &scratch.triangles,
+                out,
+                &mut total_weight,
+            );
+        }
+        missed += face_missed;
     }
-    if missed > MAX_MISSED_SHARE * (6 * resolution * resolution) as f64 || total_weight <= 0.0 {
+    if missed > most_missed || total_weight <= 0.0 {
         return false;
     }
     let inverse_total = 1.0 / total_weight;
@@ -333,4 +351,62 @@ fn pmvc_weights_with<const CULL: bool>(
         *value *= inverse_total;
     }
     true
+}
+
+/// Edge values this far below zero, relative to the edge normal and the ray, still
+/// count as on the edge when a missed texel is cast again: far above the rounding
+/// of the edge values (about 1e-16), far below a texel's width.
+const EDGE_SLACK: f64 = 1e-12;
+
+/// Texels that no triangle covered although x is enclosed: rays through a cage
+/// vertex, where the triangles around it round their edge values independently,
+/// and rays along a face that x is in the plane of (skipped), which only its
+/// neighbour can catch. A lost texel takes its `Ω·d̂` out of the sum that gives
+/// linear precision, so each is cast again against the face's triangles with
+/// [`EDGE_SLACK`], and the nearest one it reaches gets its weight as the resolve
+/// would have given it. Returns how many texels were caught.
+fn catch_missed_texels(
+    nearest: &[f64],
+    code_mask: usize,
+    table: &TexelTable,
+    drawn: &[(u32, [DVec3; 3])],
+    triangles: &[TriangleSetup],
+    out: &mut [f64],
+    total_weight: &mut f64,
+) -> f64 {
+    let mut caught = 0.0;
+    for (key, direction) in nearest.iter().zip(&table.texel_directions) {
+        // A hit, or the padding (no weight).
+        if key.to_bits() as usize & code_mask != 0 || direction[3] == 0.0 {
+            continue;
+        }
+        let ray = DVec3::new(direction[0], direction[1], direction[2]);
+        let mut nearest_hit: Option<(f64, usize, [f64; 3])> = None;
+        for &(t, edges) in drawn {
+            let values = edges.map(|edge| edge.dot(ray));
+            let on_triangle = values
+                .iter()
+                .zip(&edges)
+                .all(|(&value, edge)| value >= -EDGE_SLACK * edge.length() * ray.length());
+            let setup = &triangles[t as usize];
+            // Proportional to 1/t, as the depth test's key.
+            let inverse_depth = values.iter().sum::<f64>() / setup.det.abs();
+            if on_triangle
+                && inverse_depth > 0.0
+                && nearest_hit.is_none_or(|(nearest, _, _)| inverse_depth > nearest)
+            {
+                nearest_hit = Some((inverse_depth, t as usize, values));
+            }
+        }
+        if let Some((_, t, values)) = nearest_hit {
+            let setup = &triangles[t];
+            for (&corner, value) in setup.vertices.iter().zip(values) {
+                let weight = value.max(0.0) / setup.det.abs();
+                out[corner as usize] += weight;
+                *total_weight += weight;
+            }
+            caught += 1.0;
+        }
+    }
+    caught
 }
