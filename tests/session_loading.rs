@@ -233,3 +233,51 @@ fn a_session_naming_a_device_as_its_mesh_is_refused() {
     assert!(error.contains("zero.obj"), "{error}");
     assert!(error.contains("binary data near byte 0"), "{error}");
 }
+
+/// A scene a million units from the origin: the camera's target comes back from
+/// the file, and goes back to it, as it was (f32 world coordinates there are
+/// 0.0625 apart).
+#[test]
+fn a_camera_far_from_the_origin_keeps_its_target_through_open_and_save() {
+    use pmvc::app::session::save_session;
+    use pmvc::render::SceneOrigin;
+    let dir = tempfile::tempdir().unwrap();
+    let offset = 1.0e6;
+    let mut cage = String::new();
+    for corner in 0..8 {
+        let at = |bit: usize| offset + if corner & bit != 0 { 1.0 } else { -1.0 };
+        cage += &format!("v {} {} {}\n", at(4), at(2), at(1));
+    }
+    cage += "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
+    write(dir.path(), "cage.obj", &cage);
+    let mesh = format!("v {offset} {offset} {offset}\nv {} {offset} {offset}\n", offset + 0.5);
+    write(dir.path(), "mesh.obj", &mesh);
+    let target = [offset + 0.123456, offset + 0.5, offset - 0.25];
+    let pose: Vec<[f64; 3]> = (0..8)
+        .map(|corner| {
+            let at = |bit: usize| offset + if corner & bit != 0 { 1.0 } else { -1.0 };
+            [at(4), at(2), at(1)]
+        })
+        .collect();
+    let session = json!({
+        "pmvc_session": 1,
+        "title": "far",
+        "mesh": {"file": "mesh.obj"},
+        "cage": {"file": "cage.obj"},
+        "pose": pose,
+        "method": "mvc",
+        "cameras": [{"target": target, "distance": 6.0, "yaw": 0.3, "pitch": 0.2}],
+    });
+    let opened = open(dir.path(), "far.json", &session).unwrap();
+    let origin = SceneOrigin::of_cage(opened.document.cage().positions());
+    let world = origin.to_world(opened.settings.cameras[0].target);
+    let error = (world - glam::DVec3::from_array(target)).length();
+    assert!(error < 1e-6, "opened {world:?} for {target:?}: {error:e} off");
+
+    let saved = dir.path().join("saved.json");
+    save_session(&saved, &opened.document, &opened.settings).unwrap();
+    let written: Value = serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
+    let back: Vec<f64> = serde_json::from_value(written["cameras"][0]["target"].clone()).unwrap();
+    let error = (glam::DVec3::from_slice(&back) - glam::DVec3::from_array(target)).length();
+    assert!(error < 1e-6, "saved {back:?} for {target:?}: {error:e} off");
+}

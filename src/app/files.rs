@@ -69,8 +69,8 @@ impl EditorApp {
         let settings = opened.settings;
         self.bind_options = settings.bind_options;
         self.view = settings.view;
-        // Session files hold the cameras in world coordinates.
-        self.viewport.set_world_cameras(&settings.cameras);
+        // The session's cameras are relative to the origin `replace_document` set.
+        self.viewport.set_first_cameras(&settings.cameras);
         self.mark_pose_saved();
         self.session_path = Some(path.to_owned());
         self.remember(RecentEntry::Session(path.to_owned()));
@@ -98,7 +98,7 @@ impl EditorApp {
         let settings = SessionSettings {
             bind_options: self.bind_options,
             view: self.view,
-            cameras: self.viewport.world_cameras(),
+            cameras: self.viewport.camera_list(),
         };
         match session::save_session(path, &self.document, &settings) {
             Ok(()) => {

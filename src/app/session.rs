@@ -19,7 +19,7 @@ use crate::geometry::{
     load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
     write_obj, Cage, CageLoadError, LoadError, MeshFile, TriMesh, WriteError,
 };
-use crate::render::OrbitCamera;
+use crate::render::{OrbitCamera, SceneOrigin};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -59,7 +59,8 @@ pub struct NamedPoseEntry {
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CameraEntry {
-    pub target: [f32; 3],
+    /// World coordinates, in f64: a scene far from the origin keeps its view.
+    pub target: [f64; 3],
     pub distance: f32,
     pub yaw: f32,
     pub pitch: f32,
@@ -148,6 +149,8 @@ pub enum SessionError {
 pub struct SessionSettings {
     pub bind_options: BindOptions,
     pub view: ViewSettings,
+    /// In the scene coordinates the editor draws the document in
+    /// ([`SceneOrigin::of_cage`] of its rest cage); files hold world ones.
     pub cameras: Vec<OrbitCamera>,
 }
 
@@ -242,6 +245,7 @@ pub fn save_session(
     let folder = folder_of(path);
     let mesh = mesh_source(path, &folder, document)?;
     let cage = cage_source(&folder, document);
+    let origin = SceneOrigin::of_cage(document.cage().positions());
     let session = SessionFile {
         pmvc_session: SESSION_VERSION,
         title: document.title().to_owned(),
@@ -266,7 +270,7 @@ pub fn save_session(
             .cameras
             .iter()
             .map(|camera| CameraEntry {
-                target: camera.target.to_array(),
+                target: origin.to_world(camera.target).to_array(),
                 distance: camera.distance,
                 yaw: camera.yaw,
                 pitch: camera.pitch,
@@ -437,6 +441,7 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         }
     };
     let reach = Reach::of(cage.positions());
+    let origin = SceneOrigin::of_cage(cage.positions());
     let check = |what: String, points: &[[f64; 3]]| {
         checked_pose(path, what, points, cage.vertex_count(), &reach)
     };
@@ -463,7 +468,7 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         .cameras
         .iter()
         .enumerate()
-        .map(|(index, entry)| camera_in_range(entry, index, &reach, &mut view_notes))
+        .map(|(index, entry)| camera_in_range(entry, index, &reach, origin, &mut view_notes))
         .collect();
     view_notes.into_iter().for_each(&mut note);
 

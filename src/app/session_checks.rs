@@ -7,8 +7,8 @@
 use super::compare::{ViewSettings, DIFFERENCE_LIMITS, HANDLE_SIZES};
 use super::session::{to_points, CameraEntry, SessionError};
 use crate::geometry::{bounds_of, CageError};
-use crate::render::OrbitCamera;
-use glam::{DVec3, Vec3};
+use crate::render::{OrbitCamera, SceneOrigin};
+use glam::DVec3;
 use std::ops::RangeInclusive;
 use std::path::Path;
 
@@ -191,11 +191,12 @@ pub fn camera_in_range(
     entry: &CameraEntry,
     index: usize,
     reach: &Reach,
+    origin: SceneOrigin,
     notes: &mut Vec<String>,
 ) -> OrbitCamera {
     let key = |field: &str| format!("cameras[{index}].{field}");
-    let mut target = Vec3::from_array(entry.target);
-    let offset = target.as_dvec3().distance(reach.centre);
+    let mut target = DVec3::from_array(entry.target);
+    let offset = target.distance(reach.centre);
     if !offset.is_finite() || offset > reach.limit() {
         notes.push(format!(
             "{} is {} from the cage's centre, more than {REACH_DIAGONALS} cage diagonals; \
@@ -203,7 +204,7 @@ pub fn camera_in_range(
             key("target"),
             shown(offset)
         ));
-        target = reach.centre.as_vec3();
+        target = reach.centre;
     }
     let farthest = reach.limit() as f32;
     let distance = into_range(
@@ -225,7 +226,7 @@ pub fn camera_in_range(
         0.0
     };
     OrbitCamera {
-        target,
+        target: origin.to_scene(target),
         distance,
         yaw,
         pitch,

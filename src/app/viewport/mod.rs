@@ -109,26 +109,15 @@ impl ViewportState {
         });
     }
 
-    /// The cameras with their targets in world coordinates (as session files
-    /// hold them).
-    pub fn world_cameras(&self) -> Vec<OrbitCamera> {
-        let world = SceneOrigin::default();
-        self.cameras
-            .map(|camera| OrbitCamera {
-                target: world.rebased_point(self.origin, camera.target),
-                ..camera
-            })
-            .to_vec()
+    /// The cameras, as many as a session file keeps.
+    pub fn camera_list(&self) -> Vec<OrbitCamera> {
+        self.cameras.to_vec()
     }
 
-    /// Take the first `cameras`, whose targets are in world coordinates.
-    pub fn set_world_cameras(&mut self, cameras: &[OrbitCamera]) {
-        let world = SceneOrigin::default();
+    /// Take the first `cameras`, in this document's scene coordinates.
+    pub fn set_first_cameras(&mut self, cameras: &[OrbitCamera]) {
         for (slot, camera) in self.cameras.iter_mut().zip(cameras) {
-            *slot = OrbitCamera {
-                target: self.origin.rebased_point(world, camera.target),
-                ..*camera
-            };
+            *slot = *camera;
         }
     }
 
