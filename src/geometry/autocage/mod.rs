@@ -168,8 +168,8 @@ pub enum AutoCageError {
     #[error("the generated cage leaves {outside} mesh vertices outside (first: vertex {}); please report this with the mesh", .first + 1)]
     NotEnclosing { outside: usize, first: usize },
     #[error(
-        "a clearance of {clearance} of the diagonal needs {points} surface samples ({}), more than the {} besides the mesh's vertices that a cage is built with; a clearance of {suggested} of the diagonal or more would fit",
-        human_bytes(*.bytes), MAX_SURFACE_SAMPLES
+        "a clearance of {clearance} of the diagonal needs {} surface samples ({}), more than the {} besides the mesh's vertices that a cage is built with; a clearance of {suggested} of the diagonal or more would fit",
+        count_text(*.points), human_bytes(*.bytes), MAX_SURFACE_SAMPLES
     )]
     TooManySamples {
         clearance: f64,
@@ -190,6 +190,15 @@ pub enum AutoCageError {
     },
     #[error("{limit}; {advice}")]
     NotEnoughMemory { limit: TooLarge, advice: String },
+}
+
+/// A count that may have saturated: past a trillion, only its order.
+fn count_text(count: u64) -> String {
+    match count {
+        u64::MAX => format!("over {:.1e}", u64::MAX as f64),
+        n if n >= 1_000_000_000_000 => format!("{:.1e}", n as f64),
+        n => n.to_string(),
+    }
 }
 
 /// Finest voxel size, as a fraction of the diagonal: parts about 2.5 % of the
@@ -381,8 +390,13 @@ impl Context<'_> {
         plan::check_grid(mesh, dims, cell, self.clearance, 0)?;
         let margin = clearance_cells + MARGIN_CELLS;
         let (mut voxels, winding_volume) =
-            voxels::voxelise(mesh, self.tree, (cell, margin, dims), self.open, progress)
-                .ok_or(AutoCageError::Cancelled)?;
+            voxels::voxelise(mesh, self.tree, (cell, margin, dims), self.open, &|f| {
+                progress(0.6 * f)
+            })
+            .ok_or(AutoCageError::Cancelled)?;
+        // The grid-wide passes below each take a share of the bar: on a fine
+        // grid each takes seconds.
+        let step = |f: f32| progress(f).then_some(()).ok_or(AutoCageError::Cancelled);
         let envelope = voxels::Envelope {
             origin: voxels.origin,
             cell,
@@ -390,9 +404,13 @@ impl Context<'_> {
             distance: voxels::distance_from_set(&voxels),
             limit: (clearance_cells + 2) as u16,
         };
+        step(0.7)?;
         voxels::dilate(&mut voxels, clearance_cells);
+        step(0.8)?;
         voxels::fill_cavities(&mut voxels);
+        step(0.9)?;
         voxels::make_well_composed(&mut voxels);
+        step(1.0)?;
         let faces = surface::boundary_face_count(&voxels);
         plan::check_surface(faces as u64, cell, mesh.diagonal())?;
         Ok(VoxelSurface {

@@ -101,13 +101,22 @@ fn mark_surface(mesh: &TriMesh, voxels: &mut Voxels) {
         voxels.inside[index] = true;
     }
     let marks: Vec<AtomicBool> = voxels.inside.iter().map(|&b| AtomicBool::new(b)).collect();
+    let [nx, ny, nz] = voxels.dims;
+    // In cell units from the origin, where truncation is the floor (clamped
+    // to the grid): `floor` is a library call, and this runs per sample.
+    let to_cells = |p: DVec3| (p - voxels.origin) / voxels.cell;
+    let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
     mesh.triangles.par_iter().for_each(|t| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
         let n = lattice_divisions([a, b, c], step).max(1.0) as usize;
+        let a = to_cells(a);
+        let (step_b, step_c) = ((to_cells(b) - a) / n as f64, (to_cells(c) - a) / n as f64);
         for i in 0..=n {
+            let row = a + step_b * i as f64;
             for j in 0..=n - i {
-                let p = a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64);
-                marks[cell_of(voxels, p)].store(true, Ordering::Relaxed);
+                let p = row + step_c * j as f64;
+                let index = clamp(p.x, nx) + nx * (clamp(p.y, ny) + ny * clamp(p.z, nz));
+                marks[index].store(true, Ordering::Relaxed);
             }
         }
     });
@@ -172,6 +181,8 @@ fn classify_empty_cells(
     const SAMPLES: usize = 24;
     let mut region = vec![u32::MAX; voxels.inside.len()];
     let mut regions: Vec<Vec<usize>> = Vec::new();
+    let total = voxels.inside.len().max(1);
+    let mut labelled = 0usize;
     for start in 0..voxels.inside.len() {
         if voxels.inside[start] || region[start] != u32::MAX {
             continue;
@@ -183,6 +194,13 @@ fn classify_empty_cells(
         while next < cells.len() {
             let index = cells[next];
             next += 1;
+            // Filling a fine grid's outside takes long: report it by the
+            // percent of cells, as the first half of this stage.
+            if next.is_multiple_of(1 << 20)
+                && !progress(0.5 * (labelled + next) as f32 / total as f32)
+            {
+                return None;
+            }
             for n in voxels.neighbours(index) {
                 if !voxels.inside[n] && region[n] == u32::MAX {
                     region[n] = id;
@@ -190,16 +208,16 @@ fn classify_empty_cells(
                 }
             }
         }
+        labelled += cells.len();
         regions.push(cells);
     }
-    let total = voxels.inside.len().max(1);
     let (mut done, mut reported) = (0usize, 0usize);
     for cells in regions {
         done += cells.len();
         // Reported by the percent: pockets between faces can be many.
         if done * 100 / total > reported {
             reported = done * 100 / total;
-            if !progress(done as f32 / total as f32) {
+            if !progress(0.5 + 0.5 * done as f32 / total as f32) {
                 return None;
             }
         }
