@@ -190,3 +190,216 @@ fn a_mesh_without_triangles_fails_naming_the_file() {
     );
     assert!(!out.exists());
 }
+
+/// An icosphere of radius `radius` around `centre`, written as OBJ.
+fn sphere_obj(dir: &Path, name: &str, radius: f64, centre: glam::DVec3) -> PathBuf {
+    let sphere = procedural::icosphere(1.0, 3);
+    let moved: Vec<glam::DVec3> = sphere
+        .positions()
+        .iter()
+        .map(|p| *p * radius + centre)
+        .collect();
+    write(dir, name, &triangles_obj(&moved, sphere.triangles()))
+}
+
+/// `pmvc cage` with `args` in a shell whose address space is capped at
+/// `kib`: an allocation past it aborts the process instead of failing slowly.
+fn cage_capped(kib: u64, args: &[&str]) -> Output {
+    let mut command = format!(
+        "ulimit -v {kib}; exec '{}' cage",
+        env!("CARGO_BIN_EXE_pmvc")
+    );
+    for arg in args {
+        command.push_str(&format!(" '{arg}'"));
+    }
+    std::process::Command::new("sh")
+        .args(["-c", &command])
+        .output()
+        .expect("run sh")
+}
+
+/// Temporary outputs left in `dir`.
+fn leftovers(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.starts_with(".pmvc-") || name.ends_with(".tmp"))
+        .collect()
+}
+
+const ONE_GIB_IN_KIB: u64 = 1 << 20;
+
+/// A clearance so fine that its surface samples would need gigabytes is
+/// refused with their size and a clearance that fits, before the output's
+/// temporary file exists; it used to abort (status 134) and leave one.
+#[test]
+fn a_clearance_too_fine_for_memory_is_refused_with_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = sphere_obj(dir.path(), "sphere.obj", 1.0, glam::DVec3::ZERO);
+    let out = dir.path().join("cage.obj");
+    for clearance in ["1e-4", "1e-12"] {
+        let output = cage_capped(
+            ONE_GIB_IN_KIB,
+            &[
+                "--mesh",
+                path_str(&mesh),
+                "--vertices",
+                "64",
+                "--clearance",
+                clearance,
+                "--out",
+                path_str(&out),
+            ],
+        );
+        assert_clean_failure(&output, "sphere.obj", "surface samples");
+        let text = stderr(&output);
+        assert!(text.contains("iB"), "no size: {text}");
+        assert!(
+            text.contains("a clearance of"),
+            "no clearance that fits: {text}"
+        );
+        assert!(!out.exists());
+        assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+    }
+}
+
+/// Fine voxels with a wide clearance need a grid with wide margins: under a
+/// 1 GiB cap it is refused with its size and a coarser voxel size that fits.
+#[test]
+fn a_grid_past_the_memory_left_is_refused_with_a_voxel_size_that_fits() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = sphere_obj(dir.path(), "sphere.obj", 1.0, glam::DVec3::ZERO);
+    let out = dir.path().join("cage.obj");
+    let output = cage_capped(
+        ONE_GIB_IN_KIB,
+        &[
+            "--mesh",
+            path_str(&mesh),
+            "--vertices",
+            "64",
+            "--clearance",
+            "0.45",
+            "--cell-size",
+            "0.004",
+            "--out",
+            path_str(&out),
+        ],
+    );
+    assert_clean_failure(&output, "sphere.obj", "voxel grid");
+    let text = stderr(&output);
+    assert!(text.contains("iB"), "no size: {text}");
+    assert!(!out.exists());
+    assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+    let suggested: f64 = text
+        .split("a voxel size of ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|value| value.parse().ok())
+        .unwrap_or_else(|| panic!("no voxel size that fits: {text}"));
+    assert!(suggested > 0.004 && suggested < 0.25, "{text}");
+}
+
+/// Random triangles across a box, 30,000 vertices: their surface samples at
+/// the default clearance would need tens of gigabytes. Refused at once with
+/// the size, where it used to grow until the system killed it.
+#[test]
+fn a_noise_mesh_is_refused_with_sizes_under_a_memory_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut random = pmvc::geometry::procedural::SplitMix64(11);
+    let count = 30_000u64;
+    let mut obj = String::new();
+    for _ in 0..count {
+        let [x, y, z] = [random.unit(), random.unit(), random.unit()];
+        obj.push_str(&format!("v {x} {y} {z}\n"));
+    }
+    for _ in 0..2 * count {
+        let [a, b, c] = [0; 3].map(|_| 1 + random.next_u64() % count);
+        if a != b && b != c && a != c {
+            obj.push_str(&format!("f {a} {b} {c}\n"));
+        }
+    }
+    let mesh = write(dir.path(), "noise.obj", &obj);
+    let out = dir.path().join("cage.obj");
+    let output = cage_capped(
+        2 * ONE_GIB_IN_KIB,
+        &[
+            "--mesh",
+            path_str(&mesh),
+            "--vertices",
+            "64",
+            "--out",
+            path_str(&out),
+        ],
+    );
+    assert_clean_failure(&output, "noise.obj", "surface samples");
+    assert!(
+        stderr(&output).contains("a clearance of"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!out.exists());
+    assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+}
+
+/// A sphere a million units from the origin gets a cage as at the origin.
+#[test]
+fn a_mesh_far_from_the_origin_gets_a_cage() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = sphere_obj(dir.path(), "far.obj", 1.0, glam::DVec3::splat(1e6));
+    let out = dir.path().join("cage.obj");
+    let output = generate(&mesh, "64", &out);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let (cage, _) = load_cage(&out).unwrap();
+    assert!(
+        cage.positions()
+            .iter()
+            .all(|p| (*p - glam::DVec3::splat(1e6)).length() < 2.0),
+        "the cage is not around the sphere"
+    );
+}
+
+/// A mesh 1e-8 across: its figures are printed with significant digits,
+/// not as 0.000000.
+#[test]
+fn a_tiny_mesh_prints_its_figures_with_significant_digits() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = sphere_obj(dir.path(), "tiny.obj", 0.5e-8, glam::DVec3::ZERO);
+    let out = dir.path().join("cage.obj");
+    let output = generate(&mesh, "32", &out);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(!text.contains("0.000000"), "{text}");
+    let clearance = text
+        .lines()
+        .find(|line| line.starts_with("minimum clearance: "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(clearance.contains("e-"), "{clearance}");
+}
+
+/// The summary says when the voxel size asked for was finer than the grid
+/// allows and was coarsened, and to what.
+#[test]
+fn a_coarsened_voxel_size_is_reported_as_coarsened() {
+    use pmvc::app::cage_generation::stats_lines;
+    use pmvc::geometry::autocage::{generate_cage, CageOptions};
+    let sphere = procedural::icosphere(1.0, 2);
+    let mesh = pmvc::geometry::TriMesh {
+        positions: sphere.positions().to_vec(),
+        triangles: sphere.triangles().to_vec(),
+        triangle_faces: sphere.triangle_faces().to_vec(),
+    };
+    let generated = generate_cage(&mesh, &CageOptions::new(32), &|_| true).unwrap();
+    let mut stats = generated.stats;
+    stats.cell_size_chosen = false;
+    stats.cell_size_asked = Some(1e-3 * stats.mesh_diagonal);
+    let lines = stats_lines(&stats, false);
+    let voxel = lines
+        .iter()
+        .find(|line| line.starts_with("voxel size: "))
+        .unwrap();
+    assert!(
+        voxel.contains("coarsened from the 0.003464 asked"),
+        "{voxel}"
+    );
+    assert!(!voxel.contains("as asked"), "{voxel}");
+}

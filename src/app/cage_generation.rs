@@ -261,38 +261,46 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         }
     }
     lines.push(format!(
-        "minimum clearance: {:.6} ({:.2}% of the mesh diagonal {:.6})",
-        stats.min_clearance,
+        "minimum clearance: {} ({:.2}% of the mesh diagonal {})",
+        significant(stats.min_clearance),
         100.0 * stats.min_clearance / stats.mesh_diagonal.max(f64::MIN_POSITIVE),
-        stats.mesh_diagonal
+        significant(stats.mesh_diagonal)
     ));
-    let source = if stats.mesh_volume_from_voxels {
-        "mesh volume from voxels, the mesh is not closed"
-    } else {
-        "mesh volume from its closed surface"
-    };
-    lines.push(match stats.volume_ratio() {
-        Some(ratio) => format!(
-            "volume ratio (cage / mesh): {ratio:.3} ({:.6} / {:.6}; {source})",
-            stats.cage_volume, stats.mesh_volume
+    lines.push(match (stats.volume_ratio(), stats.mesh_volume_from_voxels) {
+        (Some(ratio), false) => format!(
+            "volume ratio (cage / mesh): {ratio:.3} ({} / {}; mesh volume from its closed surface)",
+            significant(stats.cage_volume),
+            significant(stats.mesh_volume)
         ),
-        None => "volume ratio (cage / mesh): none, the mesh encloses no volume".to_owned(),
+        (Some(ratio), true) => format!(
+            "volume ratio (cage / mesh): {ratio:.3} ({} / {}; the mesh is open: its volume is where its winding number says inside, within its bounding box)",
+            significant(stats.cage_volume),
+            significant(stats.mesh_volume)
+        ),
+        (None, true) => {
+            "volume ratio (cage / mesh): none, the mesh is open and its winding number encloses no volume"
+                .to_owned()
+        }
+        (None, false) => "volume ratio (cage / mesh): none, the mesh encloses no volume".to_owned(),
     });
     lines.push(format!("minimum angle: {:.1}°", stats.min_angle_degrees));
     let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
+    let how = match (stats.cell_size_chosen, stats.cell_size_asked) {
+        (true, _) => "chosen for the target".to_owned(),
+        (false, None) => "as asked".to_owned(),
+        (false, Some(asked)) => format!(
+            "coarsened from the {} asked, finer than the grid's 512 cells along the longest side allow",
+            significant(asked)
+        ),
+    };
     lines.push(format!(
-        "voxel size: {:.6} ({:.2}% of the mesh diagonal, {})",
-        stats.cell_size,
+        "voxel size: {} ({:.2}% of the mesh diagonal, {how})",
+        significant(stats.cell_size),
         percent(stats.cell_size),
-        if stats.cell_size_chosen {
-            "chosen for the target"
-        } else {
-            "as asked"
-        }
     ));
     lines.push(format!(
-        "parts of the mesh closer than about {:.6} ({:.1}% of the diagonal) may share one part of the cage{}",
-        stats.merge_distance(),
+        "parts of the mesh closer than about {} ({:.1}% of the diagonal) may share one part of the cage{}",
+        significant(stats.merge_distance()),
         percent(stats.merge_distance()),
         if stats.merge_distance() > 3.0 * stats.cell_size {
             "; to reach the target the cage was allowed half that far from the mesh, and more vertices keep closer parts apart"
@@ -308,6 +316,21 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         lines.push(format!("time: {:.2} s", stats.seconds));
     }
     lines
+}
+
+/// A length or volume with four significant digits, however small or large
+/// the mesh: a fixed number of decimals prints a tiny mesh's figures as 0.
+pub fn significant(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let exponent = value.abs().log10().floor() as i32;
+    if (-3..6).contains(&exponent) {
+        let decimals = (3 - exponent).max(0) as usize;
+        format!("{value:.decimals$}")
+    } else {
+        format!("{value:.3e}")
+    }
 }
 
 /// The vertex counts within ±15 % of `target`, as `CageStats::target_reached`
@@ -455,6 +478,16 @@ pub fn cage_reaches(cage: &Cage, mesh: &TriMesh) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn figures_keep_four_significant_digits_at_any_scale() {
+        assert_eq!(significant(2.7182818e-10), "2.718e-10");
+        assert_eq!(significant(0.00781249), "0.007812");
+        assert_eq!(significant(3.4641016), "3.464");
+        assert_eq!(significant(123456.7), "123457");
+        assert_eq!(significant(3.2e9), "3.200e9");
+        assert_eq!(significant(0.0), "0");
+    }
 
     #[test]
     fn the_target_range_is_fifteen_percent_either_way() {

@@ -2,7 +2,7 @@
 //! as OBJ, then print what was measured on it.
 
 use crate::app::cage_generation::stats_lines;
-use crate::geometry::autocage::{generate_cage, CageOptions};
+use crate::geometry::autocage::{generate_cage, plan_cage, CageOptions};
 use crate::geometry::{self, PendingOutput};
 use anyhow::{anyhow, Result};
 use std::path::PathBuf;
@@ -33,14 +33,16 @@ pub struct CageArgs {
 pub(super) fn cage(args: &CageArgs) -> Result<()> {
     super::commands::check_output(&args.out, &[&args.mesh], &["obj"], "an OBJ cage")?;
     let mesh = geometry::load_mesh(&args.mesh)?;
-    // Opened before the work, so that an unwritable folder is reported now and
-    // a signal while generating removes the temporary file.
-    let output = PendingOutput::create(&args.out)?;
     let options = CageOptions {
         clearance: args.clearance,
         cell_size: args.cell_size,
         ..CageOptions::new(args.vertices)
     };
+    // Options and the memory they need are checked before any file is made.
+    plan_cage(&mesh.mesh, &options).map_err(|error| anyhow!("{}: {error}", args.mesh.display()))?;
+    // Opened before the work, so that an unwritable folder is reported now and
+    // a signal while generating removes the temporary file.
+    let output = PendingOutput::create(&args.out)?;
     let bar = progress_bar();
     let generated = generate_cage(&mesh.mesh, &options, &|fraction| {
         bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);

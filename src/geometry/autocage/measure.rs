@@ -114,22 +114,23 @@ pub(super) fn is_flat(mesh: &TriMesh) -> bool {
 
 /// Points on the mesh that the cage must keep inside: every vertex, and points
 /// on each face at most `spacing` apart, so that a cage face kept `2 · spacing`
-/// from all of them cannot pass through the surface between them.
+/// from all of them cannot pass through the surface between them. Their number
+/// is [`super::plan::sample_count`], checked before this is called, and they
+/// are allocated once at that size.
 pub(super) fn surface_samples(mesh: &TriMesh, spacing: f64) -> Vec<DVec3> {
-    let mut points = mesh.positions.clone();
-    points.par_extend(mesh.triangles.par_iter().flat_map_iter(|t| {
+    let mut points = Vec::with_capacity(super::plan::sample_count(mesh, spacing) as usize);
+    points.extend_from_slice(&mesh.positions);
+    for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-        let n = (longest / spacing).ceil() as usize;
+        let n = super::plan::lattice_divisions([a, b, c], spacing) as usize;
         // A face no longer than the spacing is covered by its corners, which
         // are vertices already; larger ones get their interior lattice points.
-        (1..n)
-            .flat_map(move |i| {
-                (0..=n - i).map(move |j| {
-                    a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64)
-                })
-            })
-            .chain((1..n).map(move |j| a + (c - a) * (j as f64 / n as f64)))
-    }));
+        for i in 1..n {
+            for j in 0..=n - i {
+                points.push(a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64));
+            }
+        }
+        points.extend((1..n).map(|j| a + (c - a) * (j as f64 / n as f64)));
+    }
     points
 }

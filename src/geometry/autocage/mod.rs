@@ -30,6 +30,7 @@
 mod checks;
 mod guard;
 mod measure;
+mod plan;
 mod points;
 mod shrink;
 mod simplify;
@@ -37,7 +38,11 @@ mod surface;
 mod voxels;
 mod winding;
 
+use super::output::human_bytes;
 use super::{Cage, CageError, TriMesh};
+use crate::geometry::budget::TooLarge;
+use glam::DVec3;
+pub use plan::{plan_cage, CagePlan, MAX_GRID_CELLS, MAX_SURFACE_SAMPLES};
 use std::time::Instant;
 use winding::TriangleTree;
 
@@ -93,8 +98,9 @@ pub struct CageStats {
     /// Always 0 for a returned cage; kept so reports can say so.
     pub outside_vertices: usize,
     pub cage_volume: f64,
-    /// The mesh's volume: its own when it is closed, otherwise the volume of its
-    /// inside as voxelised by winding number.
+    /// The mesh's volume: its own when it is closed, otherwise the volume of the
+    /// voxels whose centre has a winding number over one half (0 for sheets
+    /// that enclose nothing).
     pub mesh_volume: f64,
     pub mesh_volume_from_voxels: bool,
     /// Smallest angle of any cage triangle, in degrees.
@@ -103,6 +109,9 @@ pub struct CageStats {
     pub cell_size: f64,
     /// Whether the voxel size was chosen by the generator rather than asked for.
     pub cell_size_chosen: bool,
+    /// The voxel size asked for, when it was finer than the grid allows
+    /// (1/512 of the longest side) and was coarsened to `cell_size`.
+    pub cell_size_asked: Option<f64>,
     /// How far from the mesh's voxels the cage was allowed to go in the end
     /// (the envelope, widened when no collapse was left).
     pub reach: f64,
@@ -158,6 +167,38 @@ pub enum AutoCageError {
     Invalid(CageError),
     #[error("the generated cage leaves {outside} mesh vertices outside (first: vertex {}); please report this with the mesh", .first + 1)]
     NotEnclosing { outside: usize, first: usize },
+    #[error(
+        "a clearance of {clearance} of the diagonal needs {} surface samples ({}), more than the {} besides the mesh's vertices that a cage is built with; a clearance of {suggested} of the diagonal or more would fit",
+        count_text(*.points), human_bytes(*.bytes), MAX_SURFACE_SAMPLES
+    )]
+    TooManySamples {
+        clearance: f64,
+        points: u64,
+        bytes: u64,
+        /// The smallest clearance that fits (a fraction of the diagonal).
+        suggested: f64,
+    },
+    #[error(
+        "the voxel grid ({} × {} × {} cells) would need {}, more than the {} cells a cage is built in; a voxel size of {suggested} of the diagonal or more would fit",
+        .dims[0], .dims[1], .dims[2], human_bytes(*.bytes), MAX_GRID_CELLS
+    )]
+    GridTooLarge {
+        dims: [usize; 3],
+        bytes: u64,
+        /// A voxel size that fits (a fraction of the diagonal).
+        suggested: f64,
+    },
+    #[error("{limit}; {advice}")]
+    NotEnoughMemory { limit: TooLarge, advice: String },
+}
+
+/// A count that may have saturated: past a trillion, only its order.
+fn count_text(count: u64) -> String {
+    match count {
+        u64::MAX => format!("over {:.1e}", u64::MAX as f64),
+        n if n >= 1_000_000_000_000 => format!("{:.1e}", n as f64),
+        n => n.to_string(),
+    }
 }
 
 /// Finest voxel size, as a fraction of the diagonal: parts about 2.5 % of the
@@ -167,9 +208,6 @@ pub const DEFAULT_CELL_SIZE: f64 = 1.0 / 128.0;
 /// Gap between the mesh and the cage when none is asked for, as a fraction of
 /// the diagonal.
 pub const DEFAULT_CLEARANCE: f64 = 1.0 / 128.0;
-/// The most voxels along the longest side, so that a tiny requested cell size
-/// cannot exhaust memory.
-const MAX_CELLS_PER_SIDE: f64 = 512.0;
 /// The coarsest voxel size chosen without being asked, as a fraction of the
 /// diagonal.
 const MAX_CHOSEN_CELL_SIZE: f64 = 1.0 / 12.0;
@@ -189,7 +227,7 @@ const RETRIES: usize = 3;
 /// the mesh. Each retry raises it by half.
 const MAX_REACH: f64 = 0.08;
 /// Empty cells around the mesh's bounds: how far the cage may ever be from it.
-const MARGIN_CELLS: usize = 12;
+pub(super) const MARGIN_CELLS: usize = 12;
 
 /// Generate a cage around `mesh`. `progress` is called with the fraction done
 /// (0 to 1) and returns `false` to cancel.
@@ -206,17 +244,29 @@ pub fn generate_cage(
     progress: &dyn Fn(f32) -> bool,
 ) -> Result<GeneratedCage, AutoCageError> {
     let started = Instant::now();
-    check_options(mesh, options)?;
-    let diagonal = mesh.diagonal();
-    let (lo, hi) = mesh.bounds();
-    let finest = (hi - lo).max_element() / MAX_CELLS_PER_SIDE;
-    let clearance = options.clearance.unwrap_or(DEFAULT_CLEARANCE) * diagonal;
+    let plan = plan_cage(mesh, options)?;
+    // Everything is computed relative to the mesh's bounding-box centre, so a
+    // mesh far from the origin keeps its precision; the cage moves back at the end.
+    let centred = TriMesh {
+        positions: mesh.positions.iter().map(|p| *p - plan.centre).collect(),
+        triangles: mesh.triangles.clone(),
+        triangle_faces: mesh.triangle_faces.clone(),
+    };
+    let mesh = &centred;
+    let (diagonal, clearance) = (plan.diagonal, plan.clearance);
+    let closed_volume = measure::closed_volume(mesh);
     let tree = TriangleTree::new(&mesh.positions, &mesh.triangles);
     let target = options.target_vertices;
     let mesh_points = points::PointTree::new(measure::surface_samples(mesh, 0.5 * clearance));
+    let context = Context {
+        mesh,
+        tree: &tree,
+        clearance,
+        open: closed_volume.is_none(),
+    };
 
-    let mut cell = (options.cell_size.unwrap_or(DEFAULT_CELL_SIZE) * diagonal).max(finest);
-    let mut surface = voxel_surface(mesh, &tree, cell, clearance, &|f| progress(0.05 * f))?;
+    let mut cell = plan.cell_size;
+    let mut surface = context.voxel_surface(cell, &|f| progress(0.05 * f))?;
     let chosen = options.cell_size.is_none();
     let coarsest = MAX_CHOSEN_CELL_SIZE * diagonal;
     if chosen {
@@ -228,7 +278,8 @@ pub fn generate_cage(
         let wanted = (cell * for_time.max(for_target)).min(coarsest);
         if wanted > 1.05 * cell {
             cell = wanted;
-            surface = voxel_surface(mesh, &tree, cell, clearance, &|f| progress(0.05 + 0.05 * f))?;
+            drop(surface);
+            surface = context.voxel_surface(cell, &|f| progress(0.05 + 0.05 * f))?;
         }
     }
     let attempts = if chosen { 1 + RETRIES } else { 1 };
@@ -241,7 +292,7 @@ pub fn generate_cage(
         let span = move |f: f32| progress(from + (to - from) * f);
         let surface = match next_surface.take() {
             Some(surface) => surface,
-            None => voxel_surface(mesh, &tree, cell, clearance, &|f| span(0.1 * f))?,
+            None => context.voxel_surface(cell, &|f| span(0.1 * f))?,
         };
         // Each retry may also stand further off the mesh.
         let reach = MAX_REACH * diagonal * 1.5f64.powi(attempt as i32);
@@ -271,7 +322,42 @@ pub fn generate_cage(
     let Some(best) = best else {
         return Err(AutoCageError::Cancelled);
     };
-    finish(mesh, best, target, chosen, started, progress)
+    let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
+    let request = Request {
+        target_vertices: target,
+        cell_size_chosen: chosen,
+        cell_size_asked: plan.cell_size_asked,
+        centre: plan.centre,
+        volume,
+    };
+    finish(mesh, best, &request, started, progress)
+}
+
+/// What every voxelisation of one generation shares.
+struct Context<'a> {
+    mesh: &'a TriMesh,
+    tree: &'a TriangleTree,
+    clearance: f64,
+    /// The mesh has edges with other than two faces: its volume is measured
+    /// by winding number.
+    open: bool,
+}
+
+/// The mesh's volume, for the volume ratio.
+enum MeshVolume {
+    Closed(f64),
+    /// Of an open mesh: by winding number, inside its bounding box.
+    Winding(f64),
+}
+
+/// What was asked, and what finishing needs besides the attempt.
+struct Request {
+    target_vertices: usize,
+    cell_size_chosen: bool,
+    cell_size_asked: Option<f64>,
+    /// Where the centred cage goes back to.
+    centre: DVec3,
+    volume: MeshVolume,
 }
 
 /// A closed voxel surface around the mesh, at least `clearance` from it.
@@ -279,7 +365,7 @@ struct VoxelSurface {
     surface: surface::Surface,
     envelope: voxels::Envelope,
     clearance_cells: usize,
-    voxel_volume: f64,
+    winding_volume: f64,
 }
 
 /// The cage of one voxel size, before it is checked.
@@ -288,36 +374,52 @@ struct Attempt {
     cell: f64,
     grid: [usize; 3],
     surface_vertices: usize,
-    voxel_volume: f64,
+    winding_volume: f64,
 }
 
-fn voxel_surface(
-    mesh: &TriMesh,
-    tree: &TriangleTree,
-    cell: f64,
-    clearance: f64,
-    progress: &dyn Fn(f32) -> bool,
-) -> Result<VoxelSurface, AutoCageError> {
-    let clearance_cells = (clearance / cell).ceil().max(1.0) as usize;
-    let mut voxels = voxels::voxelise(mesh, tree, cell, clearance_cells + MARGIN_CELLS, progress)
-        .ok_or(AutoCageError::Cancelled)?;
-    let voxel_volume = voxels.count() as f64 * cell.powi(3);
-    let envelope = voxels::Envelope {
-        origin: voxels.origin,
-        cell,
-        dims: voxels.dims,
-        distance: voxels::distance_from_set(&voxels),
-        limit: (clearance_cells + 2) as u16,
-    };
-    voxels::dilate(&mut voxels, clearance_cells);
-    voxels::fill_cavities(&mut voxels);
-    voxels::make_well_composed(&mut voxels);
-    Ok(VoxelSurface {
-        surface: surface::boundary_surface(&voxels),
-        envelope,
-        clearance_cells,
-        voxel_volume,
-    })
+impl Context<'_> {
+    /// The voxel surface at voxel size `cell`, each allocation checked first.
+    fn voxel_surface(
+        &self,
+        cell: f64,
+        progress: &dyn Fn(f32) -> bool,
+    ) -> Result<VoxelSurface, AutoCageError> {
+        let mesh = self.mesh;
+        let clearance_cells = plan::clearance_cells(cell, self.clearance);
+        let dims = plan::grid_dims(mesh, cell, self.clearance);
+        plan::check_grid(mesh, dims, cell, self.clearance, 0)?;
+        let margin = clearance_cells + MARGIN_CELLS;
+        let (mut voxels, winding_volume) =
+            voxels::voxelise(mesh, self.tree, (cell, margin, dims), self.open, &|f| {
+                progress(0.6 * f)
+            })
+            .ok_or(AutoCageError::Cancelled)?;
+        // The grid-wide passes below each take a share of the bar: on a fine
+        // grid each takes seconds.
+        let step = |f: f32| progress(f).then_some(()).ok_or(AutoCageError::Cancelled);
+        let envelope = voxels::Envelope {
+            origin: voxels.origin,
+            cell,
+            dims: voxels.dims,
+            distance: voxels::distance_from_set(&voxels),
+            limit: (clearance_cells + 2) as u16,
+        };
+        step(0.7)?;
+        voxels::dilate(&mut voxels, clearance_cells);
+        step(0.8)?;
+        voxels::fill_cavities(&mut voxels);
+        step(0.9)?;
+        voxels::make_well_composed(&mut voxels);
+        step(1.0)?;
+        let faces = surface::boundary_face_count(&voxels);
+        plan::check_surface(faces as u64, cell, mesh.diagonal())?;
+        Ok(VoxelSurface {
+            surface: surface::boundary_surface(&voxels, faces),
+            envelope,
+            clearance_cells,
+            winding_volume: winding_volume.unwrap_or(0.0),
+        })
+    }
 }
 
 fn simplify_surface(
@@ -329,7 +431,7 @@ fn simplify_surface(
     let VoxelSurface {
         surface,
         envelope,
-        voxel_volume,
+        winding_volume,
         ..
     } = voxel_surface;
     let (cell, grid) = (envelope.cell, envelope.dims);
@@ -348,16 +450,16 @@ fn simplify_surface(
         cell,
         grid,
         surface_vertices,
-        voxel_volume,
+        winding_volume,
     })
 }
 
-/// Check the chosen cage independently and measure it.
+/// Check the chosen cage independently, measure it and move it back from the
+/// mesh's centre.
 fn finish(
     mesh: &TriMesh,
     attempt: Attempt,
-    target_vertices: usize,
-    cell_size_chosen: bool,
+    request: &Request,
     started: Instant,
     progress: &dyn Fn(f32) -> bool,
 ) -> Result<GeneratedCage, AutoCageError> {
@@ -366,7 +468,7 @@ fn finish(
         cell,
         grid,
         surface_vertices,
-        voxel_volume,
+        ..
     } = attempt;
     let reach = f64::from(simplified.envelope_limit) * cell;
     let triangle_faces = (0..simplified.triangles.len() as u32).collect();
@@ -383,15 +485,15 @@ fn finish(
             first,
         });
     }
-    let (mesh_volume, mesh_volume_from_voxels) = match measure::closed_volume(mesh) {
-        Some(volume) => (volume, false),
-        None => (voxel_volume, true),
+    let (mesh_volume, mesh_volume_from_voxels) = match request.volume {
+        MeshVolume::Closed(volume) => (volume, false),
+        MeshVolume::Winding(volume) => (volume, true),
     };
     progress(1.0);
     let stats = CageStats {
         vertices: cage.vertex_count(),
         triangles: cage.triangle_count(),
-        target_vertices,
+        target_vertices: request.target_vertices,
         shells: measure::shell_count(&cage),
         min_clearance: enclosure.min_clearance,
         mesh_diagonal: mesh.diagonal(),
@@ -401,16 +503,27 @@ fn finish(
         mesh_volume_from_voxels,
         min_angle_degrees: measure::min_angle_degrees(&cage),
         cell_size: cell,
-        cell_size_chosen,
+        cell_size_chosen: request.cell_size_chosen,
+        cell_size_asked: request.cell_size_asked,
         reach,
         grid,
         surface_vertices,
         seconds: started.elapsed().as_secs_f64(),
     };
-    Ok(GeneratedCage { cage, stats })
+    // Validated where it was built; a translation changes neither its
+    // topology, its orientation nor whether it crosses itself.
+    let moved = cage
+        .positions()
+        .iter()
+        .map(|p| *p + request.centre)
+        .collect();
+    Ok(GeneratedCage {
+        cage: cage.with_positions(moved),
+        stats,
+    })
 }
 
-fn check_options(mesh: &TriMesh, options: &CageOptions) -> Result<(), AutoCageError> {
+pub(super) fn check_options(mesh: &TriMesh, options: &CageOptions) -> Result<(), AutoCageError> {
     let requested = options.target_vertices;
     if requested < MIN_TARGET_VERTICES {
         return Err(AutoCageError::TooFewVertices { requested });

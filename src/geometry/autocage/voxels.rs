@@ -3,11 +3,13 @@
 //! the clearance, with cavities filled and made well-composed so that the
 //! boundary of the cell set is a 2-manifold.
 
+use super::plan::lattice_divisions;
 use super::winding::TriangleTree;
 use crate::geometry::TriMesh;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A box of cells of side `cell` starting at `origin`; `inside` holds one flag
 /// per cell, x fastest.
@@ -31,10 +33,6 @@ impl Voxels {
     pub(super) fn centre(&self, index: usize) -> DVec3 {
         let [x, y, z] = self.coordinates(index);
         self.origin + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell
-    }
-
-    pub(super) fn count(&self) -> usize {
-        self.inside.iter().filter(|&&b| b).count()
     }
 
     /// The 6 face neighbours of a cell that lie in the grid.
@@ -63,21 +61,18 @@ impl Voxels {
 }
 
 /// Voxelise the inside of `mesh` in a grid of `cell`-sized cells with `margin`
-/// empty cells around its bounds. `progress` gets fractions of this stage.
+/// empty cells around its bounds (`dims`, predicted and checked by the caller).
+/// `progress` gets fractions of this stage. For an `open` mesh, also returns
+/// its winding-number volume inside its bounding box.
 pub(super) fn voxelise(
     mesh: &TriMesh,
     tree: &TriangleTree,
-    cell: f64,
-    margin: usize,
+    (cell, margin, dims): (f64, usize, [usize; 3]),
+    open: bool,
     progress: &dyn Fn(f32) -> bool,
-) -> Option<Voxels> {
-    let (lo, hi) = mesh.bounds();
+) -> Option<(Voxels, Option<f64>)> {
+    let (lo, _) = mesh.bounds();
     let origin = lo - DVec3::splat(margin as f64 * cell);
-    let dims = ((hi - lo) / cell)
-        .ceil()
-        .as_uvec3()
-        .to_array()
-        .map(|n| n.max(1) as usize + 2 * margin);
     let mut voxels = Voxels {
         origin,
         cell,
@@ -88,13 +83,16 @@ pub(super) fn voxelise(
     if !progress(0.3) {
         return None;
     }
-    classify_empty_cells(&mut voxels, tree);
-    progress(1.0).then_some(voxels)
+    let surface = open.then(|| voxels.inside.clone());
+    classify_empty_cells(&mut voxels, tree, &|f| progress(0.3 + 0.6 * f))?;
+    let volume = surface.map(|surface| winding_volume(mesh, &voxels, &surface, tree));
+    progress(1.0).then_some((voxels, volume))
 }
 
 /// Mark every cell the surface passes through, by sampling each triangle at a
 /// third of a cell. A cell missed at a corner is within a cell of a marked
-/// one, so the dilation that follows still covers it.
+/// one, so the dilation that follows still covers it. The marks go straight
+/// into the grid, so memory does not grow with the faces' sizes.
 fn mark_surface(mesh: &TriMesh, voxels: &mut Voxels) {
     let step = voxels.cell / 3.0;
     // Points no face uses are enclosed too.
@@ -102,28 +100,62 @@ fn mark_surface(mesh: &TriMesh, voxels: &mut Voxels) {
         let index = cell_of(voxels, p);
         voxels.inside[index] = true;
     }
-    let cells: Vec<usize> = mesh
-        .triangles
-        .par_iter()
-        .flat_map_iter(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-            let n = (longest / step).ceil().max(1.0) as usize;
-            let mut cells = Vec::with_capacity((n + 1) * (n + 2) / 2);
-            for i in 0..=n {
-                for j in 0..=n - i {
-                    let p = a + (b - a) * (i as f64 / n as f64) + (c - a) * (j as f64 / n as f64);
-                    cells.push(cell_of(voxels, p));
-                }
+    let marks: Vec<AtomicBool> = voxels.inside.iter().map(|&b| AtomicBool::new(b)).collect();
+    let [nx, ny, nz] = voxels.dims;
+    // In cell units from the origin, where truncation is the floor (clamped
+    // to the grid): `floor` is a library call, and this runs per sample.
+    let to_cells = |p: DVec3| (p - voxels.origin) / voxels.cell;
+    let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
+    mesh.triangles.par_iter().for_each(|t| {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let n = lattice_divisions([a, b, c], step).max(1.0) as usize;
+        let a = to_cells(a);
+        let (step_b, step_c) = ((to_cells(b) - a) / n as f64, (to_cells(c) - a) / n as f64);
+        for i in 0..=n {
+            let row = a + step_b * i as f64;
+            for j in 0..=n - i {
+                let p = row + step_c * j as f64;
+                let index = clamp(p.x, nx) + nx * (clamp(p.y, ny) + ny * clamp(p.z, nz));
+                marks[index].store(true, Ordering::Relaxed);
             }
-            cells.sort_unstable();
-            cells.dedup();
-            cells
-        })
-        .collect();
-    for index in cells {
-        voxels.inside[index] = true;
+        }
+    });
+    for (inside, mark) in voxels.inside.iter_mut().zip(marks) {
+        *inside = mark.into_inner();
     }
+}
+
+/// Samples of the winding number over the cells the surface passes through,
+/// for the volume of an open mesh: enough for a percent or so.
+const VOLUME_SAMPLES: usize = 1024;
+
+/// The volume inside an open mesh's bounding box where its winding number is
+/// over one half: the decided empty cells, and the surface cells in the
+/// proportion a strided sample of them is inside. An open mesh has no volume
+/// of its own, and stacked sheets none at all; this one never exceeds the box.
+fn winding_volume(mesh: &TriMesh, voxels: &Voxels, surface: &[bool], tree: &TriangleTree) -> f64 {
+    let (lo, hi) = mesh.bounds();
+    let in_box = |i: usize| {
+        let c = voxels.centre(i);
+        c.cmpge(lo).all() && c.cmple(hi).all()
+    };
+    let empty_inside = (0..surface.len())
+        .filter(|&i| !surface[i] && voxels.inside[i] && in_box(i))
+        .count();
+    let surface_cells = (0..surface.len())
+        .filter(|&i| surface[i] && in_box(i))
+        .count();
+    let stride = (surface_cells / VOLUME_SAMPLES).max(1);
+    let sampled: Vec<usize> = (0..surface.len())
+        .filter(|&i| surface[i] && in_box(i))
+        .step_by(stride)
+        .collect();
+    let inside = sampled
+        .par_iter()
+        .filter(|&&i| tree.winding_number(voxels.centre(i)).abs() > 0.5)
+        .count();
+    let fraction = inside as f64 / sampled.len().max(1) as f64;
+    (empty_inside as f64 + fraction * surface_cells as f64) * voxels.cell.powi(3)
 }
 
 fn cell_of(voxels: &Voxels, p: DVec3) -> usize {
@@ -141,10 +173,16 @@ fn cell_of(voxels: &Voxels, p: DVec3) -> usize {
 /// inside or all outside, so a few samples decide it. A region whose samples
 /// disagree (an open mesh's inside leaking through a hole) is decided cell by
 /// cell.
-fn classify_empty_cells(voxels: &mut Voxels, tree: &TriangleTree) {
+fn classify_empty_cells(
+    voxels: &mut Voxels,
+    tree: &TriangleTree,
+    progress: &dyn Fn(f32) -> bool,
+) -> Option<()> {
     const SAMPLES: usize = 24;
     let mut region = vec![u32::MAX; voxels.inside.len()];
     let mut regions: Vec<Vec<usize>> = Vec::new();
+    let total = voxels.inside.len().max(1);
+    let mut labelled = 0usize;
     for start in 0..voxels.inside.len() {
         if voxels.inside[start] || region[start] != u32::MAX {
             continue;
@@ -156,6 +194,13 @@ fn classify_empty_cells(voxels: &mut Voxels, tree: &TriangleTree) {
         while next < cells.len() {
             let index = cells[next];
             next += 1;
+            // Filling a fine grid's outside takes long: report it by the
+            // percent of cells, as the first half of this stage.
+            if next.is_multiple_of(1 << 20)
+                && !progress(0.5 * (labelled + next) as f32 / total as f32)
+            {
+                return None;
+            }
             for n in voxels.neighbours(index) {
                 if !voxels.inside[n] && region[n] == u32::MAX {
                     region[n] = id;
@@ -163,9 +208,19 @@ fn classify_empty_cells(voxels: &mut Voxels, tree: &TriangleTree) {
                 }
             }
         }
+        labelled += cells.len();
         regions.push(cells);
     }
+    let (mut done, mut reported) = (0usize, 0usize);
     for cells in regions {
+        done += cells.len();
+        // Reported by the percent: pockets between faces can be many.
+        if done * 100 / total > reported {
+            reported = done * 100 / total;
+            if !progress(0.5 + 0.5 * done as f32 / total as f32) {
+                return None;
+            }
+        }
         let stride = (cells.len() / SAMPLES).max(1);
         let samples: Vec<f64> = cells
             .par_iter()
@@ -189,6 +244,7 @@ fn classify_empty_cells(voxels: &mut Voxels, tree: &TriangleTree) {
             voxels.inside[index] = true;
         }
     }
+    Some(())
 }
 
 /// Grow the set by `radius` cells in every direction (a cube, so that every
