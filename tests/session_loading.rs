@@ -250,7 +250,10 @@ fn a_camera_far_from_the_origin_keeps_its_target_through_open_and_save() {
     }
     cage += "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
     write(dir.path(), "cage.obj", &cage);
-    let mesh = format!("v {offset} {offset} {offset}\nv {} {offset} {offset}\n", offset + 0.5);
+    let mesh = format!(
+        "v {offset} {offset} {offset}\nv {} {offset} {offset}\n",
+        offset + 0.5
+    );
     write(dir.path(), "mesh.obj", &mesh);
     let target = [offset + 0.123456, offset + 0.5, offset - 0.25];
     let pose: Vec<[f64; 3]> = (0..8)
@@ -272,7 +275,10 @@ fn a_camera_far_from_the_origin_keeps_its_target_through_open_and_save() {
     let origin = SceneOrigin::of_cage(opened.document.cage().positions());
     let world = origin.to_world(opened.settings.cameras[0].target);
     let error = (world - glam::DVec3::from_array(target)).length();
-    assert!(error < 1e-6, "opened {world:?} for {target:?}: {error:e} off");
+    assert!(
+        error < 1e-6,
+        "opened {world:?} for {target:?}: {error:e} off"
+    );
 
     let saved = dir.path().join("saved.json");
     save_session(&saved, &opened.document, &opened.settings).unwrap();

@@ -139,13 +139,17 @@ impl RowQuality {
     fn of(i: usize, row: &[f32], x: DVec3, columns: &[DVec3], vertex_columns: usize) -> Self {
         let mut quality = Self::default();
         let mut sum = 0.0;
-        let mut position = DVec3::ZERO;
+        // Σλ(c − x), not Σλc − x: the latter adds (Σλ − 1)·x, which grows with the
+        // scene's distance from the origin (f32 rows far away would read as 1e-2
+        // wrong) and is the partition error, measured on its own.
+        let mut offset = DVec3::ZERO;
         for (j, (&w, &c)) in row.iter().zip(columns).enumerate() {
             let w = f64::from(w);
-            position += w * c;
             if j >= vertex_columns {
+                offset += w * c; // a rest vector, not a position
                 continue;
             }
+            offset += w * (c - x);
             sum += w;
             if w < quality.min {
                 quality.min = w;
@@ -154,7 +158,7 @@ impl RowQuality {
         }
         quality.negative_rows = usize::from(quality.min < -NEGATIVE_TOLERANCE);
         quality.partition_error = (sum - 1.0).abs();
-        quality.linear_error = (position - x).length();
+        quality.linear_error = offset.length();
         quality
     }
 
@@ -254,7 +258,7 @@ mod tests {
         let rows: [[f32; 4]; 5] = [
             [0.25, 0.25, 0.25, 0.25], // exact
             [1.5, -0.5, 0.0, 0.0],    // negative; off by 0.6 in z
-            [0.5, 0.0, 0.0, 0.25],    // sums to 0.75, yet reproduces its point
+            [0.5, 0.0, 0.0, 0.25],    // sums to 0.75; Σλc is its point, Σλ(c − x) is not
             [1.0, 0.0, -1e-8, 0.0],   // negative only within tolerance
             [0.5, 0.5, -0.5, 0.5],    // as negative as row 1, later: not the reported one
         ];
@@ -304,6 +308,21 @@ mod tests {
         assert_eq!(quality, WeightQuality::default());
         let empty = WeightQuality::measure(&Weights::zeros(0, 2), &[], &cage, &[]);
         assert_eq!(empty, WeightQuality::default());
+    }
+
+    #[test]
+    fn linear_precision_reads_the_same_far_from_the_origin() {
+        let cage = procedural::cube_cage(1.0);
+        let points = procedural::points_inside(&cage, 300, 7, 1e-3);
+        let weights = mvc_matrix(&cage, &points);
+        let near = WeightQuality::measure(&weights, &points, cage.positions(), &[]);
+        // The same f32 rows, the scene moved a million units away.
+        let shift = DVec3::splat(1e6);
+        let moved = |p: &[DVec3]| p.iter().map(|&p| p + shift).collect::<Vec<_>>();
+        let far = WeightQuality::measure(&weights, &moved(&points), &moved(cage.positions()), &[]);
+        assert!(near.max_linear_precision_error < 1e-6, "{near:?}");
+        let change = (far.max_linear_precision_error - near.max_linear_precision_error).abs();
+        assert!(change < 1e-9, "{near:?} against {far:?}");
     }
 
     #[test]

@@ -25,7 +25,7 @@ const ROWS: [QualityRow; 5] = [
     ("max |Σλ - 1|", |set| {
         format!("{:.1e}", set.quality.max_partition_error)
     }),
-    ("max |Σλc - x| / size", |set| {
+    ("max |Σλ(c - x)| / size", |set| {
         format!("{:.1e}", set.quality.max_linear_precision_error)
     }),
     ("bind time", |set| {
