@@ -282,7 +282,7 @@ fn a_real_model_binds_the_same_far_from_the_origin() {
 mod command_line {
     use super::*;
     use crate::common::*;
-    use pmvc::coords::npy::read_npy;
+    use pmvc::coords::npy::{read_npy, ExpectedArray};
     use pmvc::coords::npz::read_npz;
 
     /// What `pmvc check` says about one scene, the parts that must not move.
@@ -348,7 +348,13 @@ mod command_line {
         }
     }
 
-    fn cli_bind(files: &SceneFiles, dir: &Path, method: Method) -> Weights {
+    fn cli_bind(
+        files: &SceneFiles,
+        dir: &Path,
+        method: Method,
+        cage: &Cage,
+        rows: usize,
+    ) -> Weights {
         let name = method.spec().id;
         let green = method == Method::Green;
         let out = dir.join(format!("{name}.{}", if green { "npz" } else { "npy" }));
@@ -371,9 +377,10 @@ mod command_line {
         ]);
         assert!(output.status.success(), "{name}: {}", stderr(&output));
         if green {
-            read_npz(&out).expect("npz").0
+            read_npz(&out, rows, cage.vertex_count(), cage.triangle_count()).expect("npz")
         } else {
-            read_npy(&out).expect("npy")
+            let expected = ExpectedArray::cage_vertices(rows, cage.vertex_count());
+            read_npy(&out, expected).expect("npy")
         }
     }
 
@@ -420,7 +427,7 @@ mod command_line {
                 .map(|&method| {
                     (
                         method,
-                        cli_bind(&files, dir.path(), method),
+                        cli_bind(&files, dir.path(), method, cage, points.len()),
                         cli_deform(&files, dir.path(), method, offset),
                     )
                 })

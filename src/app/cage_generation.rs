@@ -11,6 +11,7 @@ use crate::geometry::autocage::{
     generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
     DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
+use crate::geometry::shown_path;
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use crate::render::scene_gpu::unique_edges;
 use glam::DVec3;
@@ -449,7 +450,7 @@ impl EditorApp {
         let Some(cage) = loose_box_cage(&file.mesh) else {
             self.error(format!(
                 "{}: the mesh has no extent to put a cage around",
-                path.display()
+                shown_path(&path)
             ));
             return false;
         };
@@ -459,7 +460,7 @@ impl EditorApp {
         self.replace_document(document, format!("open {title}"));
         self.info(format!(
             "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
-            path.display()
+            shown_path(&path)
         ));
         self.open_cage_generation();
         true

@@ -5,6 +5,7 @@
 
 use super::compare::{self, Layout, Pane};
 use super::editor::EditorApp;
+use crate::geometry::shown_path;
 use crate::geometry::{write_atomically, write_coloured_ply, WriteError};
 use crate::render::colormap::{heat_colour, Scale, OUTSIDE};
 use crate::render::Colouring;
@@ -69,7 +70,7 @@ impl EditorApp {
             .ok()
             .and_then(|mut slot| slot.take());
         match finished {
-            Some(Ok(path)) => self.info(format!("saved image {}", path.display())),
+            Some(Ok(path)) => self.info(format!("saved image {}", shown_path(&path))),
             Some(Err(error)) => self.error(error),
             None => {}
         }

@@ -8,6 +8,7 @@ use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
 use super::ui::file_dialog::FileAction;
+use crate::geometry::shown_path;
 use crate::geometry::{
     load_cage, load_mesh, refuse_same_file, write_deformed_mesh, write_mesh_with_normals,
     write_obj, TriMesh,
@@ -74,7 +75,7 @@ impl EditorApp {
         self.mark_pose_saved();
         self.session_path = Some(path.to_owned());
         self.remember(RecentEntry::Session(path.to_owned()));
-        self.info(format!("opened session {}", path.display()));
+        self.info(format!("opened session {}", shown_path(&path)));
         self.start_bind();
         true
     }
@@ -105,7 +106,7 @@ impl EditorApp {
                 self.mark_pose_saved();
                 self.session_path = Some(path.to_owned());
                 self.remember(RecentEntry::Session(path.to_owned()));
-                self.info(format!("saved session {}", path.display()));
+                self.info(format!("saved session {}", shown_path(&path)));
                 true
             }
             Err(error) => {
@@ -234,7 +235,7 @@ impl EditorApp {
             FileRole::Mesh => RecentEntry::Mesh(path.to_owned()),
             FileRole::Cage => RecentEntry::Cage(path.to_owned()),
         });
-        self.info(format!("opened {}", path.display()));
+        self.info(format!("opened {}", shown_path(&path)));
         self.start_bind();
         true
     }
@@ -259,13 +260,13 @@ impl EditorApp {
             Ok(file) if file.mesh.positions.len() == cage_vertices => {
                 self.document.edit_pose(file.mesh.positions);
                 self.mark_pose_saved();
-                self.info(format!("loaded pose {}", path.display()));
+                self.info(format!("loaded pose {}", shown_path(&path)));
                 true
             }
             Ok(file) => {
                 self.error(format!(
                     "{}: the pose has {} vertices but the cage has {cage_vertices}",
-                    path.display(),
+                    shown_path(&path),
                     file.mesh.positions.len(),
                 ));
                 false
@@ -291,7 +292,7 @@ impl EditorApp {
         match write_obj(path, &posed) {
             Ok(()) => {
                 self.mark_pose_saved();
-                self.info(format!("saved pose {}", path.display()));
+                self.info(format!("saved pose {}", shown_path(&path)));
                 true
             }
             Err(error) => {
@@ -338,7 +339,7 @@ impl EditorApp {
     ) -> bool {
         match result {
             Ok(()) => {
-                self.info(format!("exported {}", path.display()));
+                self.info(format!("exported {}", shown_path(&path)));
                 true
             }
             Err(error) => {

@@ -5,6 +5,7 @@
 use super::editor::EditorApp;
 use super::exports::save_png;
 use super::scripted_drag::{ScriptedDrag, DRAG_FRAMES, DRAG_START_FRAME};
+use crate::geometry::shown_path;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -108,7 +109,7 @@ impl EditorApp {
             let repaint = ctx.clone();
             ctx.request_screenshot(move |image| {
                 if let Err(error) = save_png(&path, &image, None) {
-                    let text = format!("cannot save {}: {error}", path.display());
+                    let text = format!("cannot save {}: {error}", shown_path(&path));
                     eprintln!("pmvc editor: {text}");
                     if let Ok(mut failures) = failures.lock() {
                         failures.push(text);

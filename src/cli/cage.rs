@@ -3,6 +3,7 @@
 
 use crate::app::cage_generation::stats_lines;
 use crate::geometry::autocage::{generate_cage, plan_cage, CageOptions};
+use crate::geometry::shown_path;
 use crate::geometry::{self, PendingOutput};
 use anyhow::{anyhow, Result};
 use std::path::PathBuf;
@@ -39,7 +40,8 @@ pub(super) fn cage(args: &CageArgs) -> Result<()> {
         ..CageOptions::new(args.vertices)
     };
     // Options and the memory they need are checked before any file is made.
-    plan_cage(&mesh.mesh, &options).map_err(|error| anyhow!("{}: {error}", args.mesh.display()))?;
+    plan_cage(&mesh.mesh, &options)
+        .map_err(|error| anyhow!("{}: {error}", shown_path(&args.mesh)))?;
     // Opened before the work, so that an unwritable folder is reported now and
     // a signal while generating removes the temporary file.
     let output = PendingOutput::create(&args.out)?;
@@ -49,13 +51,13 @@ pub(super) fn cage(args: &CageArgs) -> Result<()> {
         true
     });
     bar.finish_and_clear();
-    let generated = generated.map_err(|error| anyhow!("{}: {error}", args.mesh.display()))?;
+    let generated = generated.map_err(|error| anyhow!("{}: {error}", shown_path(&args.mesh)))?;
     let cage = &generated.cage;
     output.finish(|out| geometry::write_obj_to(out, cage.positions(), cage.triangles()))?;
     say!(
         "wrote {}: a cage around {} ({} vertices, {} triangles)",
-        args.out.display(),
-        args.mesh.display(),
+        shown_path(&args.out),
+        shown_path(&args.mesh),
         mesh.mesh.positions.len(),
         mesh.mesh.triangles.len()
     );

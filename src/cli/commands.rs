@@ -371,8 +371,8 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     if found != expected {
         bail!(
             "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
-            args.deformed_cage.display(),
-            args.input.cage.display()
+            shown_path(&args.deformed_cage),
+            shown_path(&args.input.cage)
         );
     }
     let (weights, method) = match &args.weights {
@@ -393,7 +393,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     };
     summary(format_args!(
         "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",
-        args.out.display(),
+        shown_path(&args.out),
         deformed.len(),
         started.elapsed().as_secs_f64(),
         outside_note(&input)
@@ -405,7 +405,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
     let mesh = geometry::load_mesh(&args.input.mesh)?;
     say!(
         "mesh  {}: {} vertices, {} triangles{}",
-        args.input.mesh.display(),
+        shown_path(&args.input.mesh),
         mesh.mesh.positions.len(),
         mesh.mesh.triangles.len(),
         if mesh.mesh.triangles.is_empty() {
@@ -417,7 +417,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
     let (cage, report) = geometry::load_cage(&args.input.cage)?;
     say!(
         "cage  {}: {} vertices, {} triangles, closed, edge-manifold, consistently oriented",
-        args.input.cage.display(),
+        shown_path(&args.input.cage),
         cage.vertex_count(),
         cage.triangles().len()
     );

@@ -28,15 +28,15 @@ pub(super) fn check_weights_format(args: &BindArgs) -> Result<()> {
     match (writes_npz(method), extension.as_deref()) {
         (true, Some("npy")) => bail!(
             "{}: {} coordinates are two arrays (phi: mesh vertices × cage vertices, psi: mesh vertices × cage triangles) and are written as .npz; use --out {}",
-            args.out.display(),
+            shown_path(&args.out),
             method.name(),
-            args.out.with_extension("npz").display()
+            shown_path(&args.out.with_extension("npz"))
         ),
         (false, Some("npz")) => bail!(
             "{}: {} weights are one array, written as .npy; use --out {} (only Green coordinates, --method green, are written as .npz)",
-            args.out.display(),
+            shown_path(&args.out),
             method.name(),
-            args.out.with_extension("npy").display()
+            shown_path(&args.out.with_extension("npy"))
         ),
         _ => Ok(()),
     }

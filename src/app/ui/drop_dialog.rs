@@ -4,6 +4,7 @@
 //! `*_Cage_Deformed.obj` is a pose, not a new rest cage.
 
 use crate::app::editor::{EditorApp, FileRole};
+use crate::geometry::shown_path;
 use crate::geometry::{load_mesh, MeshFile};
 use std::path::PathBuf;
 
@@ -134,7 +135,7 @@ impl EditorApp {
                 if dropped.vertex_count() == self.document.pose().len() {
                     self.document.edit_pose(dropped.file.mesh.positions);
                     self.mark_pose_saved();
-                    self.info(format!("loaded pose {}", dropped.path.display()));
+                    self.info(format!("loaded pose {}", shown_path(&dropped.path)));
                 }
             }
             DropChoice::Cage => {

@@ -5,6 +5,7 @@
 //! folders, lists meshes, and takes a typed path for every file action.
 
 use crate::app::editor::{EditorApp, FileRole};
+use crate::geometry::shown_path;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -139,7 +140,7 @@ impl FileBrowser {
         let read = match std::fs::read_dir(&folder) {
             Ok(read) => read,
             Err(error) => {
-                self.problem = Some(format!("cannot open {}: {error}", folder.display()));
+                self.problem = Some(format!("cannot open {}: {error}", shown_path(&folder)));
                 self.folder_text = self.folder.display().to_string();
                 return;
             }
@@ -411,13 +412,13 @@ impl EditorApp {
             return;
         }
         if !action.saves() && !path.is_file() {
-            browser.problem = Some(format!("{} does not exist", path.display()));
+            browser.problem = Some(format!("{} does not exist", shown_path(&path)));
             return;
         }
         if action.saves() && path.exists() && browser.confirm_replace.as_ref() != Some(&path) {
             browser.problem = Some(format!(
                 "{} exists: {} again to replace it",
-                path.display(),
+                shown_path(&path),
                 action.confirm_label()
             ));
             browser.confirm_replace = Some(path);
