@@ -286,3 +286,29 @@ fn skipping_triangles_facing_away_from_inside_points_changes_nothing() {
         );
     }
 }
+
+/// The library checks a parameter as the command line and sessions do: a
+/// resolution past its family's range is refused before anything is allocated.
+#[test]
+fn the_library_refuses_a_parameter_outside_its_range() {
+    let cage = convex();
+    let points = [DVec3::ZERO];
+    let classes = classify_points(&cage, &points);
+    for (method, resolution, grid) in [(Method::Pmvc, 100_000, 64), (Method::Harmonic, 32, 0)] {
+        let options = BindOptions {
+            method,
+            resolution,
+            grid,
+        };
+        let error = bind_cpu(
+            &points,
+            &classes.classes,
+            &cage,
+            options,
+            &BindProgress::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains("out of range"), "{method:?}: {error}");
+    }
+}

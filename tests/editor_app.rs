@@ -285,6 +285,24 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
     assert!(!app.load_pose(&wrong));
     assert!(app.last_error().unwrap().contains("wrong.obj"));
     assert_eq!(app.document().pose(), rest);
+
+    // So is one far beyond the cage, which no session could hold: what is
+    // loaded can be saved and opened again.
+    let far = directory.path().join("far.obj");
+    let mut far_pose = rest.clone();
+    far_pose[0].x = 1e12;
+    let text: String = far_pose
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&far, text).unwrap();
+    assert!(!app.load_pose(&far));
+    let error = app.last_error().unwrap();
+    assert!(
+        error.contains("far.obj") && error.contains("position 1"),
+        "{error}"
+    );
+    assert_eq!(app.document().pose(), rest);
 }
 
 fn button_drag(

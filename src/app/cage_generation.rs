@@ -450,7 +450,7 @@ impl EditorApp {
         let Some(cage) = loose_box_cage(&file.mesh) else {
             self.error(format!(
                 "{}: the mesh has no extent to put a cage around",
-                shown_path(&path)
+                shown_path(path)
             ));
             return false;
         };
@@ -460,7 +460,7 @@ impl EditorApp {
         self.replace_document(document, format!("open {title}"));
         self.info(format!(
             "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
-            shown_path(&path)
+            shown_path(path)
         ));
         self.open_cage_generation();
         true

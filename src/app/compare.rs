@@ -170,6 +170,22 @@ pub const HANDLE_SIZES: std::ops::RangeInclusive<f32> = 1.5..=12.0;
 /// cage diagonal (the toolbar shows them in percent: 0.0001% to 100%).
 pub const DIFFERENCE_LIMITS: std::ops::RangeInclusive<f32> = 1e-6..=1.0;
 
+/// The one check of a difference limit (a fraction of the cage diagonal) given
+/// on the command line; the toolbar's control offers only this range, and a
+/// session's value is brought into it with a notice.
+pub fn check_difference_limit(fraction: f32) -> Result<f32, String> {
+    if DIFFERENCE_LIMITS.contains(&fraction) {
+        Ok(fraction)
+    } else {
+        Err(format!(
+            "{}% is not a difference limit: it must be {}% to {}% of the cage diagonal",
+            100.0 * fraction,
+            100.0 * DIFFERENCE_LIMITS.start(),
+            100.0 * DIFFERENCE_LIMITS.end()
+        ))
+    }
+}
+
 impl From<Vec<Method>> for MethodSet {
     fn from(methods: Vec<Method>) -> Self {
         Self::of(&methods)

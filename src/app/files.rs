@@ -75,7 +75,7 @@ impl EditorApp {
         self.mark_pose_saved();
         self.session_path = Some(path.to_owned());
         self.remember(RecentEntry::Session(path.to_owned()));
-        self.info(format!("opened session {}", shown_path(&path)));
+        self.info(format!("opened session {}", shown_path(path)));
         self.start_bind();
         true
     }
@@ -106,7 +106,7 @@ impl EditorApp {
                 self.mark_pose_saved();
                 self.session_path = Some(path.to_owned());
                 self.remember(RecentEntry::Session(path.to_owned()));
-                self.info(format!("saved session {}", shown_path(&path)));
+                self.info(format!("saved session {}", shown_path(path)));
                 true
             }
             Err(error) => {
@@ -235,7 +235,7 @@ impl EditorApp {
             FileRole::Mesh => RecentEntry::Mesh(path.to_owned()),
             FileRole::Cage => RecentEntry::Cage(path.to_owned()),
         });
-        self.info(format!("opened {}", shown_path(&path)));
+        self.info(format!("opened {}", shown_path(path)));
         self.start_bind();
         true
     }
@@ -255,27 +255,38 @@ impl EditorApp {
 
     /// Load a pose: a cage-shaped OBJ/OFF with one vertex per cage vertex.
     pub fn load_pose(&mut self, path: &Path) -> bool {
-        let cage_vertices = self.document.pose().len();
         match load_mesh(path) {
-            Ok(file) if file.mesh.positions.len() == cage_vertices => {
-                self.document.edit_pose(file.mesh.positions);
-                self.mark_pose_saved();
-                self.info(format!("loaded pose {}", shown_path(&path)));
-                true
-            }
-            Ok(file) => {
-                self.error(format!(
-                    "{}: the pose has {} vertices but the cage has {cage_vertices}",
-                    shown_path(&path),
-                    file.mesh.positions.len(),
-                ));
-                false
-            }
+            Ok(file) => self.take_pose_file(path, file.mesh.positions),
             Err(error) => {
                 self.error(error.to_string());
                 false
             }
         }
+    }
+
+    /// The positions of a pose file (opened or dropped) as the pose, when they
+    /// are one per cage vertex and within the reach a session may hold, so that
+    /// what is saved can be opened again.
+    pub(super) fn take_pose_file(&mut self, path: &Path, positions: Vec<glam::DVec3>) -> bool {
+        let cage_vertices = self.document.pose().len();
+        if positions.len() != cage_vertices {
+            self.error(format!(
+                "{}: the pose has {} vertices but the cage has {cage_vertices}",
+                shown_path(path),
+                positions.len(),
+            ));
+            return false;
+        }
+        let reach = super::session_checks::Reach::of(self.document.cage().positions());
+        if let Some((number, distance)) = reach.first_beyond(&positions) {
+            let problem = reach.describe(number, distance);
+            self.error(format!("{}: {problem}", shown_path(path)));
+            return false;
+        }
+        self.document.edit_pose(positions);
+        self.mark_pose_saved();
+        self.info(format!("loaded pose {}", shown_path(path)));
+        true
     }
 
     /// Write the pose as a cage-shaped OBJ; true when it was written.
@@ -292,7 +303,7 @@ impl EditorApp {
         match write_obj(path, &posed) {
             Ok(()) => {
                 self.mark_pose_saved();
-                self.info(format!("saved pose {}", shown_path(&path)));
+                self.info(format!("saved pose {}", shown_path(path)));
                 true
             }
             Err(error) => {
@@ -339,7 +350,7 @@ impl EditorApp {
     ) -> bool {
         match result {
             Ok(()) => {
-                self.info(format!("exported {}", shown_path(&path)));
+                self.info(format!("exported {}", shown_path(path)));
                 true
             }
             Err(error) => {

@@ -6,11 +6,11 @@ use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values, write_n
 use crate::coords::npz::{npz_payload_bytes, write_npz_to};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{
-    self, classify_points, extension_warning, human_bytes, refuse_same_file, shown_path, Cage,
-    MeshFile, OutputSet, PendingOutput, PointClasses,
+    self, classify_points, extension_warning, refuse_same_file, shown_path, Cage, MeshFile,
+    OutputSet, PendingOutput, PointClasses,
 };
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use glam::DVec3;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -224,6 +224,7 @@ pub(super) fn check_output(
     what: &str,
 ) -> Result<()> {
     refuse_same_file(out, inputs)?;
+    crate::geometry::refuse_unwritable(out)?;
     if let Some(warning) = extension_warning(out, extensions, what) {
         warn_line!("pmvc: {warning}");
     }
@@ -233,18 +234,18 @@ pub(super) fn check_output(
 /// An error before the work starts when a dense `rows` × `cols` weights matrix
 /// cannot fit in the memory left, instead of an abort once it is allocated.
 fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
-    let bytes = 4 * rows as u64 * cols as u64;
-    if let Some(available) = crate::geometry::budget::available_memory() {
-        if bytes > available {
-            bail!(
-                "{}: its weights would take {} ({rows} vertices × {cols} cage vertices × 4 bytes), but only {} of memory is available; bind the mesh in parts, or use a coarser cage",
-                shown_path(mesh),
-                human_bytes(bytes),
-                human_bytes(available)
-            );
-        }
-    }
-    Ok(())
+    use crate::geometry::budget::{bytes_for, check_memory};
+    let bytes = bytes_for(rows as u64, bytes_for(cols as u64, 4));
+    check_memory(
+        || format!("its weights ({rows} vertices × {cols} columns × 4 bytes)"),
+        bytes,
+    )
+    .map_err(|error| {
+        anyhow!(
+            "{}: {error}; bind the mesh in parts, or use a coarser cage",
+            shown_path(mesh)
+        )
+    })
 }
 
 pub(super) fn bind(args: &BindArgs) -> Result<()> {

@@ -26,6 +26,7 @@ mod bench;
 mod cage;
 mod commands;
 mod environment;
+mod parse;
 mod weights_format;
 
 /// Standard output could not be written.
@@ -34,6 +35,7 @@ mod weights_format;
 pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
+use parse::{parse_grid, parse_percent, parse_resolution, parse_view};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -259,52 +261,6 @@ pub enum ViewArg {
     /// The distance between two methods' deformations per mesh vertex, relative
     /// to the cage size.
     Difference,
-}
-
-/// A percentage in (0, 100], with or without the % sign.
-/// `--resolution`, checked by its spec: the one check sessions and the editor use.
-fn parse_resolution(text: &str) -> Result<u32, String> {
-    parse_parameter(crate::coords::Parameter::Resolution, text)
-}
-
-/// `--grid`, checked by its spec.
-fn parse_grid(text: &str) -> Result<u32, String> {
-    parse_parameter(crate::coords::Parameter::Grid, text)
-}
-
-fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
-    let value: u64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a whole number"))?;
-    parameter.validate(value).map_err(|error| error.to_string())
-}
-
-fn parse_percent(text: &str) -> Result<f32, String> {
-    let number = text.trim().trim_end_matches('%');
-    match number.parse::<f32>() {
-        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value),
-        _ => Err(format!(
-            "'{text}' is not a percentage between 0 and 100 (e.g. 0.5 or 0.5%)"
-        )),
-    }
-}
-
-fn parse_view(value: &str) -> Result<ViewArg, String> {
-    match value {
-        "side-by-side" => Ok(ViewArg::SideBySide),
-        "difference" => Ok(ViewArg::Difference),
-        other => crate::coords::Method::from_id(other)
-            .map(ViewArg::Single)
-            .ok_or_else(|| {
-                let methods: Vec<&str> =
-                    crate::coords::Method::ALL.iter().map(|m| m.id()).collect();
-                format!(
-                    "expected side-by-side, difference or a method ({})",
-                    methods.join(", ")
-                )
-            }),
-    }
 }
 
 impl EditArgs {

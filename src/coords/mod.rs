@@ -74,6 +74,15 @@ impl BindOptions {
         }
     }
 
+    /// The one check of the method's parameter ([`ParameterSpec::validate`]),
+    /// for callers of the library as for the command line and the editor.
+    pub fn validate(&self) -> Result<(), ParameterError> {
+        match self.parameter() {
+            Some((spec, value)) => spec.validate(value.into()).map(|_| ()),
+            None => Ok(()),
+        }
+    }
+
     /// The parameter of this method and its value, if it has one.
     pub fn parameter(&self) -> Option<(ParameterSpec, u32)> {
         let spec = self.method.spec().parameter?;
@@ -237,6 +246,10 @@ pub enum BindFailure {
     Cancelled(#[from] Cancelled),
     #[error(transparent)]
     Harmonic(harmonic::HarmonicError),
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    #[error(transparent)]
+    TooLarge(#[from] crate::geometry::budget::TooLarge),
 }
 
 impl From<harmonic::HarmonicError> for BindFailure {
@@ -265,12 +278,18 @@ pub fn bind_cpu(
     options: BindOptions,
     progress: &BindProgress,
 ) -> Result<Weights, BindFailure> {
+    options.validate()?;
     if options.method == Method::Harmonic {
         let (weights, _stats) =
             harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
         return Ok(weights);
     }
-    let mut weights = Weights::zeros(points.len(), options.method.columns(cage));
+    let columns = options.method.columns(cage);
+    crate::geometry::budget::check_memory(
+        || format!("the weights ({} rows × {columns} columns)", points.len()),
+        crate::geometry::budget::bytes_for(points.len() as u64, 4 * columns as u64),
+    )?;
+    let mut weights = Weights::zeros(points.len(), columns);
     let rows: Vec<usize> = (0..points.len()).collect();
     bind_rows(
         points,

@@ -103,6 +103,16 @@ pub fn resolve_output(path: &Path) -> Result<OutputTarget, WriteError> {
     ))))
 }
 
+/// Refuse, before any work, an output that [`PendingOutput::create`] would
+/// refuse by what is there now: a folder, a block device, a file its user may
+/// not write. Nothing is created.
+pub fn refuse_unwritable(path: &Path) -> Result<(), WriteError> {
+    match resolve_output(path)? {
+        OutputTarget::File(target) => protect::refuse_protected(path, &target),
+        OutputTarget::Stream(_) => Ok(()),
+    }
+}
+
 /// Refuse `output` when it is, or links to, the same file as one of `inputs`:
 /// replacing an input with a result computed from it loses the input.
 pub fn refuse_same_file(output: &Path, inputs: &[&Path]) -> Result<(), WriteError> {

@@ -4,7 +4,6 @@
 //! `*_Cage_Deformed.obj` is a pose, not a new rest cage.
 
 use crate::app::editor::{EditorApp, FileRole};
-use crate::geometry::shown_path;
 use crate::geometry::{load_mesh, MeshFile};
 use std::path::PathBuf;
 
@@ -132,11 +131,7 @@ impl EditorApp {
         };
         match choice {
             DropChoice::Pose => {
-                if dropped.vertex_count() == self.document.pose().len() {
-                    self.document.edit_pose(dropped.file.mesh.positions);
-                    self.mark_pose_saved();
-                    self.info(format!("loaded pose {}", shown_path(&dropped.path)));
-                }
+                self.take_pose_file(&dropped.path, dropped.file.mesh.positions);
             }
             DropChoice::Cage => {
                 self.open_file(FileRole::Cage, &dropped.path);

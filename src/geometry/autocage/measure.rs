@@ -44,14 +44,8 @@ pub(super) fn closed_volume(mesh: &TriMesh) -> Option<f64> {
     if edges.values().any(|&n| n != 2) {
         return None;
     }
-    let volume: f64 = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum();
+    // Summed about the mesh's centre (cage.rs), whatever the caller did first.
+    let volume = crate::geometry::cage::signed_volume(&mesh.positions, &mesh.triangles);
     Some(volume.abs())
 }
 

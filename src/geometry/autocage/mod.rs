@@ -168,8 +168,9 @@ pub enum AutoCageError {
     #[error("the generated cage leaves {outside} mesh vertices outside (first: vertex {}); please report this with the mesh", .first + 1)]
     NotEnclosing { outside: usize, first: usize },
     #[error(
-        "a clearance of {clearance} of the diagonal needs {} surface samples ({}), more than the {} besides the mesh's vertices that a cage is built with; a clearance of {suggested} of the diagonal or more would fit",
-        count_text(*.points), human_bytes(*.bytes), MAX_SURFACE_SAMPLES
+        "a clearance of {clearance} of the diagonal needs {} surface samples ({}), more than the {} besides the mesh's vertices that a cage is built with; {}",
+        count_text(*.points), human_bytes(*.bytes), MAX_SURFACE_SAMPLES,
+        suggestion("clearance", *.suggested, MAX_CLEARANCE)
     )]
     TooManySamples {
         clearance: f64,
@@ -179,8 +180,9 @@ pub enum AutoCageError {
         suggested: f64,
     },
     #[error(
-        "the voxel grid ({} × {} × {} cells) would need {}, more than the {} cells a cage is built in; a voxel size of {suggested} of the diagonal or more would fit",
-        .dims[0], .dims[1], .dims[2], human_bytes(*.bytes), MAX_GRID_CELLS
+        "the voxel grid ({} × {} × {} cells) would need {}, more than the {} cells a cage is built in; {}",
+        .dims[0], .dims[1], .dims[2], human_bytes(*.bytes), MAX_GRID_CELLS,
+        suggestion("voxel size", *.suggested, MAX_CELL_SIZE)
     )]
     GridTooLarge {
         dims: [usize; 3],
@@ -190,6 +192,20 @@ pub enum AutoCageError {
     },
     #[error("{limit}; {advice}")]
     NotEnoughMemory { limit: TooLarge, advice: String },
+}
+
+/// Clearances and voxel sizes (fractions of the diagonal) must be below these.
+const MAX_CLEARANCE: f64 = 0.5;
+const MAX_CELL_SIZE: f64 = 0.25;
+
+/// The advice after a refusal: the value that fits, or that none the generator
+/// accepts does.
+fn suggestion(what: &str, suggested: f64, below: f64) -> String {
+    if suggested < below {
+        format!("a {what} of {suggested} of the diagonal or more would fit")
+    } else {
+        format!("no {what} the generator accepts (below {below} of the diagonal) would fit; simplify the mesh first")
+    }
 }
 
 /// A count that may have saturated: past a trillion, only its order.
@@ -535,12 +551,12 @@ pub(super) fn check_options(mesh: &TriMesh, options: &CageOptions) -> Result<(),
         });
     }
     if let Some(value) = options.clearance {
-        if !(value > 0.0 && value < 0.5) {
+        if !(value > 0.0 && value < MAX_CLEARANCE) {
             return Err(AutoCageError::BadClearance { value });
         }
     }
     if let Some(value) = options.cell_size {
-        if !(value > 0.0 && value < 0.25) {
+        if !(value > 0.0 && value < MAX_CELL_SIZE) {
             return Err(AutoCageError::BadCellSize { value });
         }
     }

@@ -255,12 +255,29 @@ fn suggested_clearance(mesh: &TriMesh, from: f64, limit: u64) -> f64 {
     round_up(fraction)
 }
 
+/// `value` rounded up to two significant digits, as the f64 nearest that
+/// decimal, so that it prints as written (0.00076, not 0.0007600000000000001).
 fn round_up(value: f64) -> f64 {
-    let scale = 10f64.powf(value.log10().floor() - 1.0);
-    (value / scale).ceil() * scale
+    let exponent = value.log10().floor() as i32 - 1;
+    let digits = (value / 10f64.powi(exponent)).ceil();
+    format!("{digits}e{exponent}").parse().unwrap_or(value)
 }
 
-/// A fraction with three significant digits.
+/// A fraction rounded up to two significant digits, as a message shows it.
 fn short(value: f64) -> String {
-    format!("{}", round_up(value) as f32)
+    round_up(value).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_up;
+
+    #[test]
+    fn suggestions_are_rounded_up_and_print_as_written() {
+        assert_eq!(round_up(0.000_751).to_string(), "0.00076");
+        assert_eq!(round_up(0.3).to_string(), "0.3");
+        assert_eq!(round_up(0.2901).to_string(), "0.3");
+        assert_eq!(round_up(12.3).to_string(), "13");
+        assert!(round_up(0.1234) >= 0.1234);
+    }
 }

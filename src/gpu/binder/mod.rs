@@ -172,6 +172,8 @@ impl From<coords::BindFailure> for BindError {
         match failure {
             coords::BindFailure::Cancelled(_) => BindError::Cancelled,
             coords::BindFailure::Harmonic(error) => BindError::Harmonic(error),
+            coords::BindFailure::Parameter(error) => BindError::InvalidInput(error.to_string()),
+            coords::BindFailure::TooLarge(error) => BindError::InvalidInput(error.to_string()),
         }
     }
 }
@@ -366,8 +368,8 @@ fn validate(input: &BindInput) -> Result<(), BindError> {
     if on_missing_triangle {
         return invalid("a point is classed on a triangle the cage does not have".into());
     }
-    if let Some((spec, 0)) = input.options.parameter() {
-        return invalid(format!("the {} must be positive", spec.label));
+    if let Err(error) = input.options.validate() {
+        return invalid(error.to_string());
     }
     if let Some(index) = input.points.iter().position(|p| !p.is_finite()) {
         return invalid(format!("point {} is not finite", index + 1));

@@ -1,0 +1,50 @@
+//! The command line's value parsers: each parameter is checked by the one
+//! function its other sources (sessions, the editor's controls) use.
+
+use super::ViewArg;
+
+/// `--resolution`, checked by its spec: the one check sessions and the editor use.
+pub(super) fn parse_resolution(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::Resolution, text)
+}
+
+/// `--grid`, checked by its spec.
+pub(super) fn parse_grid(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::Grid, text)
+}
+
+fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
+    let value: u64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a whole number"))?;
+    parameter.validate(value).map_err(|error| error.to_string())
+}
+
+/// `--difference-limit`: a percentage of the cage diagonal, with or without the
+/// % sign, in the range the toolbar offers and sessions are held to
+/// ([`crate::app::compare::DIFFERENCE_LIMITS`]).
+pub(super) fn parse_percent(text: &str) -> Result<f32, String> {
+    let number = text.trim().trim_end_matches('%');
+    let percent: f32 = number
+        .parse()
+        .map_err(|_| format!("'{text}' is not a percentage (e.g. 0.5 or 0.5%)"))?;
+    crate::app::compare::check_difference_limit(percent / 100.0).map(|_| percent)
+}
+
+pub(super) fn parse_view(value: &str) -> Result<ViewArg, String> {
+    match value {
+        "side-by-side" => Ok(ViewArg::SideBySide),
+        "difference" => Ok(ViewArg::Difference),
+        other => crate::coords::Method::from_id(other)
+            .map(ViewArg::Single)
+            .ok_or_else(|| {
+                let methods: Vec<&str> =
+                    crate::coords::Method::ALL.iter().map(|m| m.id()).collect();
+                format!(
+                    "expected side-by-side, difference or a method ({})",
+                    methods.join(", ")
+                )
+            }),
+    }
+}
