@@ -133,7 +133,7 @@ fn a_bind_that_cannot_fit_in_memory_is_refused_before_the_work() {
     assert_clean_failure(&output, "mesh.obj", "memory");
     let text = stderr(&output);
     assert!(
-        text.contains("76.3 GiB") && text.contains("2000000 vertices × 10242 cage vertices"),
+        text.contains("76.3 GiB") && text.contains("2000000 vertices × 10242 columns"),
         "{text}"
     );
     assert!(!out.exists() && temporary_files(dir.path()).is_empty());
