@@ -8,6 +8,9 @@
 //! (van Oosterom–Strackee solid angles), point–triangle distances, volumes,
 //! angles and connected components are computed in this file.
 
+mod common;
+
+use common::winding_number;
 use glam::DVec3;
 use pmvc::coords::{cubemap::TexelTable, mvc, pmvc as pmvc_ref};
 use pmvc::geometry::autocage::{
@@ -23,24 +26,8 @@ use std::sync::Mutex;
 
 // ---------------------------------------------------------------- measurements
 
-/// Generalised winding number of `x` with respect to a triangle soup, as the sum
-/// of the triangles' signed solid angles (van Oosterom & Strackee 1983) over 4π.
-fn winding(positions: &[DVec3], triangles: &[[u32; 3]], x: DVec3) -> f64 {
-    let total: f64 = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize] - x);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            let numerator = a.dot(b.cross(c));
-            let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-            2.0 * numerator.atan2(denominator)
-        })
-        .sum();
-    total / (4.0 * PI)
-}
-
 fn cage_winding(cage: &Cage, x: DVec3) -> f64 {
-    winding(cage.positions(), cage.triangles(), x)
+    winding_number(cage.positions(), cage.triangles(), x)
 }
 
 fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -422,7 +409,7 @@ fn comb_prongs_stay_apart_and_the_cage_is_tight() {
     // Prongs span x ∈ [1.5k, 1.5k + 1], y ∈ [1, 5]: the gaps' centres.
     for k in 0..4 {
         let gap = DVec3::new(1.5 * k as f64 + 1.25, 3.0, 0.0);
-        assert!(winding(&comb.positions, &comb.triangles, gap).abs() < 1e-9);
+        assert!(winding_number(&comb.positions, &comb.triangles, gap).abs() < 1e-9);
         assert_outside("comb", &generated.cage, gap, "the middle of the gap");
     }
     let ratio = generated.stats.volume_ratio().unwrap();
@@ -463,7 +450,7 @@ fn a_small_target_is_reached_with_coarser_voxels_chosen_for_it() {
 #[test]
 fn torus_keeps_its_hole() {
     let torus = torus();
-    assert!(winding(&torus.positions, &torus.triangles, DVec3::ZERO).abs() < 1e-9);
+    assert!(winding_number(&torus.positions, &torus.triangles, DVec3::ZERO).abs() < 1e-9);
     let generated = generate(&torus, 48);
     let euler = check_cage("torus", &torus, 2, &generated);
     assert_eq!(generated.stats.shells, 1);
@@ -486,7 +473,7 @@ fn two_blobs_apart_get_two_shells() {
     let blobs = two_blobs(0.3);
     let gap = 0.3 / blobs.diagonal();
     assert!((0.05..0.07).contains(&gap), "gap {gap}");
-    assert!(winding(&blobs.positions, &blobs.triangles, DVec3::ZERO).abs() < 1e-9);
+    assert!(winding_number(&blobs.positions, &blobs.triangles, DVec3::ZERO).abs() < 1e-9);
     let options = CageOptions {
         cell_size: Some(0.01),
         ..CageOptions::new(40)
@@ -651,7 +638,7 @@ fn bundled_comb_fingers_stay_apart() {
     assert_target("bundled comb", &generated);
     check_cage("bundled comb", &comb, 1, &generated);
     for gap in bundled_comb_gaps() {
-        assert!(winding(&comb.positions, &comb.triangles, gap).abs() < 1e-6);
+        assert!(winding_number(&comb.positions, &comb.triangles, gap).abs() < 1e-6);
         assert_outside(
             "bundled comb",
             &generated.cage,

@@ -6,11 +6,13 @@
 //! Winding numbers and distances are computed here, relative to the object,
 //! independently of the library.
 
+mod common;
+
+use common::winding_number;
 use glam::DVec3;
 use pmvc::geometry::autocage::{generate_cage, plan_cage, AutoCageError, CageOptions};
 use pmvc::geometry::procedural::{self, SplitMix64};
 use pmvc::geometry::TriMesh;
-use std::f64::consts::PI;
 
 fn sphere_at(offset: DVec3) -> TriMesh {
     let cage = procedural::icosphere(1.0, 3);
@@ -19,22 +21,6 @@ fn sphere_at(offset: DVec3) -> TriMesh {
         triangles: cage.triangles().to_vec(),
         triangle_faces: cage.triangle_faces().to_vec(),
     }
-}
-
-/// Generalised winding number of `x` (van Oosterom–Strackee), every vector
-/// taken from `x`, so a far offset loses no precision before the subtraction.
-fn winding(positions: &[DVec3], triangles: &[[u32; 3]], x: DVec3) -> f64 {
-    let total: f64 = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize] - x);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            let numerator = a.dot(b.cross(c));
-            let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-            2.0 * numerator.atan2(denominator)
-        })
-        .sum();
-    total / (4.0 * PI)
 }
 
 /// `count` vertices uniform in a box of side `side`, and `faces` triangles of
@@ -181,7 +167,7 @@ fn the_cage_does_not_depend_on_where_the_mesh_is() {
             "offset {offset}: a vertex moved {worst} (diagonal {diagonal})"
         );
         for p in &sphere.positions {
-            let w = winding(cage.positions(), cage.triangles(), *p);
+            let w = winding_number(cage.positions(), cage.triangles(), *p);
             assert!(
                 (w - 1.0).abs() < 1e-6,
                 "offset {offset}: winding {w} at {p}"

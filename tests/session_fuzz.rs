@@ -5,28 +5,14 @@
 //! would exhaust memory (a device as a mesh) give a clean error under an
 //! address-space limit instead of an abort.
 
+mod common;
+
+use common::comb_session;
 use pmvc::app::scenes::BundledScene;
 use pmvc::app::session::open_session;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn comb_session() -> Value {
-    let (_, cage) = BundledScene::Comb.build().expect("the comb builds");
-    let pose: Vec<[f64; 3]> = cage.positions().iter().map(|p| p.to_array()).collect();
-    json!({
-        "pmvc_session": 1,
-        "title": "comb",
-        "mesh": {"bundled": "comb"},
-        "cage": {"bundled": "comb"},
-        "pose": pose,
-        "named_poses": [{"name": "rest", "positions": pose}],
-        "method": "pmvc",
-        "parameters": {"resolution": 16, "grid": 32},
-        "view": {"handle_size": 4.0, "heat_vertex": 2},
-        "cameras": [{"target": [0.0, 0.5, 0.0], "distance": 6.0, "yaw": 0.3, "pitch": 0.2}],
-    })
-}
 
 /// xorshift64*: reproducible without a dependency.
 struct Random(u64);

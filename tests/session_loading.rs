@@ -3,26 +3,12 @@
 //! menu's range), long text is cut with a notice, the file is read with a size
 //! limit, and messages number what they name as the file writes it.
 
-use pmvc::app::scenes::BundledScene;
+mod common;
+
+use common::comb_session;
 use pmvc::app::session::{open_session, OpenedSession};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-
-/// A valid session of the bundled comb at rest, as JSON.
-fn comb_session() -> Value {
-    let (_, cage) = BundledScene::Comb.build().expect("the comb builds");
-    let pose: Vec<[f64; 3]> = cage.positions().iter().map(|p| p.to_array()).collect();
-    json!({
-        "pmvc_session": 1,
-        "title": "comb",
-        "mesh": {"bundled": "comb"},
-        "cage": {"bundled": "comb"},
-        "pose": pose,
-        "named_poses": [{"name": "rest", "positions": pose}],
-        "method": "pmvc",
-        "parameters": {"resolution": 16, "grid": 32},
-    })
-}
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);

@@ -123,3 +123,41 @@ pub fn parse_npy_f32(bytes: &[u8]) -> (Vec<usize>, Vec<f32>, String) {
         .collect();
     (shape, values, header)
 }
+
+/// Generalised winding number of `x` with respect to a triangle soup, as the sum
+/// of the triangles' signed solid angles (van Oosterom & Strackee 1983) over 4π,
+/// every vector taken from `x`: an independent reference for the library's own.
+pub fn winding_number(positions: &[glam::DVec3], triangles: &[[u32; 3]], x: glam::DVec3) -> f64 {
+    let total: f64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize] - x);
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let numerator = a.dot(b.cross(c));
+            let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+            2.0 * numerator.atan2(denominator)
+        })
+        .sum();
+    total / (4.0 * std::f64::consts::PI)
+}
+
+#[cfg(feature = "editor")]
+/// A valid session of the bundled comb at rest, with every key a session may hold.
+pub fn comb_session() -> serde_json::Value {
+    let (_, cage) = pmvc::app::scenes::BundledScene::Comb
+        .build()
+        .expect("the comb builds");
+    let pose: Vec<[f64; 3]> = cage.positions().iter().map(|p| p.to_array()).collect();
+    serde_json::json!({
+        "pmvc_session": 1,
+        "title": "comb",
+        "mesh": {"bundled": "comb"},
+        "cage": {"bundled": "comb"},
+        "pose": pose,
+        "named_poses": [{"name": "rest", "positions": pose}],
+        "method": "pmvc",
+        "parameters": {"resolution": 16, "grid": 32},
+        "view": {"handle_size": 4.0, "heat_vertex": 2},
+        "cameras": [{"target": [0.0, 0.5, 0.0], "distance": 6.0, "yaw": 0.3, "pitch": 0.2}],
+    })
+}
