@@ -182,17 +182,24 @@ fn library_scene_is_the_same_everywhere(name: &str, cage: &Cage, points: &[DVec3
                 *method,
                 DVec3::splat(offset),
             );
-            let worst = moved
-                .iter()
-                .zip(&shifted_moved)
-                .map(|(a, b)| a.distance(*b))
-                .fold(0.0, f64::max);
-            assert!(
-                worst <= POSITION_TOLERANCE * diagonal,
-                "{name} at {offset}, {method:?}: deformed positions differ by {worst:e}"
-            );
+            let what = format!("{name} at {offset}, {method:?}");
+            assert_same_positions(&what, moved, &shifted_moved, diagonal);
         }
     }
+}
+
+/// The deformed positions of the scene at the origin and of the shifted one
+/// (with the offset taken off) agree within the tolerance.
+fn assert_same_positions(what: &str, at_origin: &[DVec3], shifted: &[DVec3], diagonal: f64) {
+    let worst = at_origin
+        .iter()
+        .zip(shifted)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= POSITION_TOLERANCE * diagonal,
+        "{what}: deformed positions differ by {worst:e}"
+    );
 }
 
 #[test]
@@ -462,15 +469,8 @@ mod command_line {
                     difference <= WEIGHT_TOLERANCE,
                     "{name} at {offset}, {method:?}: weights differ by {difference:e}"
                 );
-                let worst = moved
-                    .iter()
-                    .zip(shifted_moved)
-                    .map(|(a, b)| a.distance(*b))
-                    .fold(0.0, f64::max);
-                assert!(
-                    worst <= POSITION_TOLERANCE * diagonal,
-                    "{name} at {offset}, {method:?}: deformed positions differ by {worst:e}"
-                );
+                let what = format!("{name} at {offset}, {method:?}");
+                assert_same_positions(&what, moved, shifted_moved, diagonal);
             }
         }
     }

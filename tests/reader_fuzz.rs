@@ -6,6 +6,9 @@
 //! independent reading of its `v` lines (OBJ), every index in range, every
 //! coordinate finite.
 
+mod common;
+
+use common::Random;
 use glam::DVec3;
 use pmvc::geometry::{parse_mesh, LoadError, MeshFile};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -14,21 +17,6 @@ use std::path::Path;
 const OBJ: &str = "# a quad and a triangle\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0.5\nv 0.5 0.5 1 1\nvt 0 0\nvn 0 0 1\ng part\nf 1 2 3 4\nf 1/1 2/1 5/1\nf -5 -3 -1\n";
 const OFF: &str = "OFF\n# comment\n5 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n0.5 0.5 1\n4 0 1 2 3\n3 0 1 4\n3 2 3 4 255 0 0\n";
 const CASES_PER_FILE: usize = 4000;
-
-/// xorshift64*: deterministic, so a failure names a reproducible case.
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 const REPLACEMENTS: &[&str] = &[
     "1e308",

@@ -7,28 +7,12 @@
 
 mod common;
 
-use common::comb_session;
+use common::{comb_session, Random};
 use pmvc::app::scenes::BundledScene;
 use pmvc::app::session::open_session;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// xorshift64*: reproducible without a dependency.
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 fn odd_value(random: &mut Random) -> Value {
     match random.below(14) {

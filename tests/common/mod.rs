@@ -161,3 +161,20 @@ pub fn comb_session() -> serde_json::Value {
         "cameras": [{"target": [0.0, 0.5, 0.0], "distance": 6.0, "yaw": 0.3, "pitch": 0.2}],
     })
 }
+
+/// xorshift64*: a seeded generator for the fuzz tests, deterministic so that a
+/// failure names a reproducible case, and with no dependency.
+pub struct Random(pub u64);
+
+impl Random {
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
