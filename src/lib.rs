@@ -20,5 +20,7 @@ pub mod coords;
 pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+#[cfg(feature = "python")]
+mod python;
 #[cfg(feature = "editor")]
 pub mod render;

@@ -1,0 +1,159 @@
+//! Arrays in and out. Points come in as any array-like of real numbers with
+//! shape (n, 3) (converted by numpy, so lists, tuples and arrays of any float or
+//! integer dtype work); faces as a sequence of index sequences, so that quads
+//! stay quads. Everything that comes out is a numpy array.
+
+use super::errors::{error, Kind};
+use crate::geometry::budget::{bytes_for, check_memory};
+use glam::DVec3;
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+/// `value` as float64 positions of shape (n, 3); `what` names the argument in
+/// messages ("points", "cage vertices").
+pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
+    let py = value.py();
+    let numpy = py.import("numpy")?;
+    let array = numpy.call_method1("asarray", (value,)).map_err(|cause| {
+        error(
+            Kind::Input,
+            format!("{what}: not an array of numbers of shape (n, 3) ({cause})"),
+        )
+    })?;
+    let dtype = array.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u") {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "{what}: dtype {} is not a real number type (use floats, e.g. numpy.float64)",
+                dtype.str()?
+            ),
+        ));
+    }
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(error(
+            Kind::Input,
+            format!("{what}: shape {shape:?} is not (n, 3)"),
+        ));
+    }
+    let rows = shape[0];
+    check_memory(
+        || format!("{what}: a copy of {rows} positions"),
+        bytes_for(rows as u64, 2 * std::mem::size_of::<DVec3>() as u64),
+    )
+    .map_err(|too_large| error(Kind::TooLarge, format!("{what}: {too_large}")))?;
+    let contiguous = numpy.call_method1("ascontiguousarray", (array, numpy.getattr("float64")?))?;
+    let contiguous = contiguous.cast_into::<PyArray2<f64>>()?;
+    let readonly = contiguous.readonly();
+    let values = readonly
+        .as_slice()
+        .map_err(|cause| error(Kind::Input, format!("{what}: {cause}")))?;
+    let points: Vec<DVec3> = values.chunks_exact(3).map(DVec3::from_slice).collect();
+    if let Some(row) = points.iter().position(|p| !p.is_finite()) {
+        let p = points[row];
+        return Err(error(
+            Kind::Input,
+            format!(
+                "{what}: row {row} is not finite ({}, {}, {})",
+                p.x, p.y, p.z
+            ),
+        ));
+    }
+    Ok(points)
+}
+
+/// `value` as polygons of vertex indices (0-based) into `vertex_count` vertices,
+/// each of at least 3 corners.
+pub(super) fn faces(
+    value: &Bound<'_, PyAny>,
+    vertex_count: usize,
+    what: &str,
+) -> PyResult<Vec<Vec<u32>>> {
+    let not_faces = |cause: PyErr| {
+        error(
+            Kind::Input,
+            format!("{what}: not a sequence of faces, each a sequence of vertex indices ({cause})"),
+        )
+    };
+    if let Ok(count) = value.len() {
+        check_memory(
+            || format!("{what}: {count} faces"),
+            bytes_for(count as u64, 64),
+        )
+        .map_err(|too_large| error(Kind::TooLarge, format!("{what}: {too_large}")))?;
+    }
+    let mut faces = Vec::new();
+    for (face, item) in value.try_iter().map_err(not_faces)?.enumerate() {
+        let item = item?;
+        let mut corners = Vec::new();
+        for corner in item.try_iter().map_err(not_faces)? {
+            let corner = corner?;
+            let index: i64 = corner.extract().map_err(|_| {
+                let shown = corner
+                    .repr()
+                    .map(|r| r.to_string())
+                    .unwrap_or_else(|_| "?".into());
+                error(
+                    Kind::Input,
+                    format!("{what}: face {face}: {shown} is not an integer vertex index"),
+                )
+            })?;
+            if index < 0 || index as u64 >= vertex_count as u64 {
+                return Err(error(
+                    Kind::Input,
+                    format!(
+                        "{what}: face {face} refers to vertex {index}, but there are {vertex_count} vertices (indices count from 0)"
+                    ),
+                ));
+            }
+            corners.push(index as u32);
+        }
+        if corners.len() < 3 {
+            return Err(error(
+                Kind::Input,
+                format!(
+                    "{what}: face {face} has {} corners; a face needs at least 3",
+                    corners.len()
+                ),
+            ));
+        }
+        faces.push(corners);
+    }
+    Ok(faces)
+}
+
+/// Positions as a float64 array of shape (n, 3).
+pub(super) fn positions_array<'py>(
+    py: Python<'py>,
+    points: &[DVec3],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let flat: Vec<f64> = points.iter().flat_map(|p| p.to_array()).collect();
+    PyArray1::from_vec(py, flat).reshape([points.len(), 3])
+}
+
+/// Row-major values as an array of shape (rows, cols), without a copy.
+pub(super) fn matrix<'py, T: numpy::Element>(
+    py: Python<'py>,
+    values: Vec<T>,
+    rows: usize,
+    cols: usize,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    PyArray1::from_vec(py, values).reshape([rows, cols])
+}
+
+/// Triangles as an int64 array of shape (t, 3).
+pub(super) fn triangles_array<'py>(
+    py: Python<'py>,
+    triangles: &[[u32; 3]],
+) -> PyResult<Bound<'py, PyArray2<i64>>> {
+    let flat: Vec<i64> = triangles.iter().flatten().map(|&i| i64::from(i)).collect();
+    matrix(py, flat, triangles.len(), 3)
+}
+
+/// Polygons as a list of lists of indices.
+pub(super) fn faces_list<'py>(py: Python<'py>, faces: &[Vec<u32>]) -> PyResult<Bound<'py, PyList>> {
+    PyList::new(py, faces.iter().map(|face| face.to_vec()))
+}

@@ -1,0 +1,397 @@
+//! `bind` and `deform`. The work runs on its own thread with the GIL released,
+//! so other Python threads (and other binds) run meanwhile; the calling thread
+//! wakes every [`POLL`] to report progress and to check for Ctrl-C, which
+//! cancels the work through its cancel flag and raises `KeyboardInterrupt`
+//! once the work has stopped (within one block of rows or one GPU batch).
+
+use super::arrays::{matrix, positions};
+use super::errors::{error, Kind};
+use super::scene::{class_codes, PyCage};
+use super::weights::{PyWeights, WeightsData};
+use crate::coords::{BindOptions, BindProgress, Method, Parameter};
+use crate::geometry::classify_points;
+use crate::gpu::{Backend, BindError, BindInput, Binder, GpuContext};
+use numpy::PyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::{Duration, Instant};
+
+/// How often a waiting call reports progress and checks for signals.
+const POLL: Duration = Duration::from_millis(50);
+
+/// How a long call is observed and stopped.
+pub(super) struct Interruptible<'a, 'py> {
+    /// Ask the work to stop early.
+    pub cancel: &'a (dyn Fn() + Sync),
+    /// The user's `progress(done, total)` callback.
+    pub progress: Option<&'a Bound<'py, PyAny>>,
+    /// The work's `(done, total)` now.
+    pub done: &'a (dyn Fn() -> (usize, usize) + Sync),
+}
+
+/// Run `work` on a thread of its own with the GIL released. Every [`POLL`] the
+/// caller reports progress (when it moved: `(0, total)` first, `(total, total)`
+/// last on success) and checks for signals; a signal or an exception from the
+/// callback cancels the work and is raised once it has stopped.
+pub(super) fn run_interruptible<T: Send>(
+    py: Python<'_>,
+    task: Interruptible<'_, '_>,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    let finished = AtomicBool::new(false);
+    let mut failure: Option<PyErr> = None;
+    let mut reported: Option<usize> = None;
+    let mut report = |done: usize, total: usize| -> PyResult<()> {
+        if let Some(callback) = task.progress {
+            if reported != Some(done) {
+                reported = Some(done);
+                callback.call1((done, total))?;
+            }
+        }
+        Ok(())
+    };
+    let (_, total) = (task.done)();
+    if let Err(raised) = report(0, total) {
+        return Err(raised);
+    }
+    let outcome = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let result = work();
+            finished.store(true, Ordering::Release);
+            result
+        });
+        loop {
+            py.detach(|| {
+                let started = Instant::now();
+                while !finished.load(Ordering::Acquire) && started.elapsed() < POLL {
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+            });
+            if finished.load(Ordering::Acquire) {
+                break;
+            }
+            if failure.is_none() {
+                let (done, total) = (task.done)();
+                let checked = py.check_signals().and_then(|()| report(done, total));
+                if let Err(raised) = checked {
+                    (task.cancel)();
+                    failure = Some(raised);
+                }
+            }
+        }
+        // The worker has finished; joining does not wait.
+        worker.join()
+    });
+    if let Some(raised) = failure {
+        return Err(raised);
+    }
+    let result = outcome.map_err(|_| error(Kind::Bind, "internal error: the work panicked"))?;
+    let (_, total) = (task.done)();
+    report(total, total)?;
+    Ok(result)
+}
+
+/// The backend for "auto", "cpu" or "gpu", as the command line chooses it:
+/// `auto` binds on a hardware GPU when there is one, on the CPU otherwise (a
+/// software adapter is slower than the CPU path). Devices are opened once per
+/// process.
+// The command line's `choose_backend` (src/cli/commands.rs) makes the same
+// choice; both could call one function in `gpu`.
+fn choose_backend(py: Python<'_>, choice: &str) -> PyResult<Backend> {
+    static ANY: OnceLock<Result<Arc<GpuContext>, String>> = OnceLock::new();
+    static HARDWARE: OnceLock<Option<Arc<GpuContext>>> = OnceLock::new();
+    match choice {
+        "cpu" => Ok(Backend::Cpu),
+        "gpu" => {
+            let context = py.detach(|| {
+                ANY.get_or_init(|| {
+                    GpuContext::new()
+                        .map(Arc::new)
+                        .map_err(|cause| cause.to_string())
+                })
+                .clone()
+            });
+            context
+                .map(Backend::Gpu)
+                .map_err(|cause| error(Kind::Backend, format!("backend \"gpu\": {cause}")))
+        }
+        "auto" => {
+            let context = py.detach(|| {
+                HARDWARE
+                    .get_or_init(|| GpuContext::new_hardware().ok().flatten().map(Arc::new))
+                    .clone()
+            });
+            Ok(context.map_or(Backend::Cpu, Backend::Gpu))
+        }
+        other => Err(error(
+            Kind::Parameter,
+            format!("backend \"{other}\" is not one of \"auto\", \"cpu\", \"gpu\""),
+        )),
+    }
+}
+
+/// The family named `id`, or an error listing the known ones.
+pub(super) fn method_from(id: &str) -> PyResult<Method> {
+    Method::from_id(id).ok_or_else(|| {
+        let known: Vec<&str> = Method::ALL.iter().map(|m| m.id()).collect();
+        error(
+            Kind::Parameter,
+            format!(
+                "method \"{id}\" is not a family; known: {}",
+                known.join(", ")
+            ),
+        )
+    })
+}
+
+/// A parameter's value from Python, checked by its spec's one `validate`.
+fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u32> {
+    let spec = parameter.spec();
+    let value: i128 = value.extract().map_err(|_| {
+        error(
+            Kind::Parameter,
+            format!("{} must be an integer, not {value}", parameter.id()),
+        )
+    })?;
+    // Below zero or past u64 it is out of range all the same; the spec's
+    // message gives the range.
+    let clamped = u64::try_from(value).unwrap_or(u64::MAX);
+    spec.validate(clamped).map_err(|cause| {
+        let message = cause
+            .to_string()
+            .replacen(&clamped.to_string(), &value.to_string(), 1);
+        error(Kind::Parameter, message)
+    })
+}
+
+/// The options of a bind of `method` with `resolution` and `grid`: the
+/// family's own parameter is checked, the others are not read.
+/// A parameter not given keeps its default.
+fn bind_options(
+    method: Method,
+    resolution: Option<&Bound<'_, PyAny>>,
+    grid: Option<&Bound<'_, PyAny>>,
+) -> PyResult<BindOptions> {
+    let mut options = BindOptions::for_method(method);
+    if let Some(spec) = method.spec().parameter {
+        let given = match spec.key {
+            Parameter::Resolution => resolution,
+            Parameter::Grid => grid,
+        };
+        if let Some(given) = given.filter(|value| !value.is_none()) {
+            options.set(spec.key, parameter_value(spec.key, given)?);
+        }
+    }
+    options
+        .validate()
+        .map_err(|cause| error(Kind::Parameter, cause.to_string()))?;
+    Ok(options)
+}
+
+/// Bind ``points`` to ``cage`` with one family: a :class:`Weights` whose
+/// ``matrix`` is float32 (n, columns), bit-for-bit what ``pmvc bind`` writes.
+///
+/// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
+/// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
+/// its family). ``backend`` is ``"auto"`` (a hardware GPU when there is one),
+/// ``"cpu"`` or ``"gpu"``; families without a GPU kernel bind on the CPU.
+/// ``progress``, if given, is called with ``(done, total)`` rows, from
+/// ``(0, total)`` to ``(total, total)``. The GIL is released while binding;
+/// Ctrl-C cancels within about a second.
+#[pyfunction]
+#[pyo3(
+    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None)"
+)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn bind<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    cage: PyRef<'py, PyCage>,
+    method: &str,
+    resolution: Option<Bound<'py, PyAny>>,
+    grid: Option<Bound<'py, PyAny>>,
+    backend: &str,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<PyWeights> {
+    let method = method_from(method)?;
+    let options = bind_options(method, resolution.as_ref(), grid.as_ref())?;
+    let points = positions(points, "points")?;
+    bind_points(py, points, &cage, options, backend, progress.as_ref())
+}
+
+/// Bind already-checked points; `bind` and `deform` share it.
+pub(super) fn bind_points(
+    py: Python<'_>,
+    points: Vec<glam::DVec3>,
+    cage: &PyCage,
+    options: BindOptions,
+    backend: &str,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyWeights> {
+    let backend = choose_backend(py, backend)?;
+    let on_gpu = matches!(backend, Backend::Gpu(_))
+        && crate::gpu::kernels::Kernel::of(options.method).is_some();
+    let rows = points.len();
+    let columns = options.method.columns(&cage.cage);
+    crate::geometry::budget::check_memory(
+        || format!("the weights ({rows} rows × {columns} columns × 4 bytes)"),
+        crate::geometry::budget::bytes_for(rows as u64, 4 * columns as u64),
+    )
+    .map_err(|cause| error(Kind::TooLarge, format!("bind: {cause}")))?;
+    let points: Arc<[glam::DVec3]> = points.into();
+    let shared = BindProgress::new(rows);
+    let task = Interruptible {
+        cancel: &|| shared.cancel(),
+        progress,
+        done: &|| (shared.done(), rows),
+    };
+    let cage_arc = Arc::clone(&cage.cage);
+    let bound_points = Arc::clone(&points);
+    let (classes, result) = run_interruptible(py, task, || {
+        let classes: Arc<[_]> = classify_points(&cage_arc, &bound_points).classes.into();
+        let input = BindInput {
+            points: bound_points,
+            classes: Arc::clone(&classes),
+            cage: cage_arc,
+            options,
+        };
+        let result = Binder::new(backend).bind_blocking(&input, &shared);
+        (classes, result)
+    })?;
+    let output = result.map_err(|cause| bind_error(&cause))?;
+    let weights = output
+        .weights
+        .ok_or_else(|| error(Kind::Bind, "internal error: the bind returned no weights"))?;
+    let codes = class_codes(&classes);
+    let data = WeightsData {
+        options: Some(options),
+        layout: options.method.spec().columns,
+        backend: Some(if on_gpu { "gpu" } else { "cpu" }.to_owned()),
+        device: Some(output.stats.device.clone()),
+        seconds: Some(output.stats.elapsed.as_secs_f64()),
+        vertex_columns: cage.cage.vertex_count(),
+        triangles: cage.cage.triangles().to_vec(),
+        points_digest: None,
+        cage_digest: None,
+    };
+    PyWeights::new(
+        matrix(py, weights.values, weights.rows, weights.cols)?.unbind(),
+        Some(numpy::PyArray1::from_vec(py, codes).unbind()),
+        data,
+    )
+}
+
+fn bind_error(cause: &BindError) -> PyErr {
+    let kind = match cause {
+        BindError::InvalidInput(_) | BindError::ResolutionTooHigh { .. } => Kind::Parameter,
+        _ => Kind::Bind,
+    };
+    error(kind, format!("bind: {cause}"))
+}
+
+/// The points moved by the cage's move from ``cage`` to ``deformed_vertices``,
+/// float64 (n, 3): what ``pmvc deform`` writes.
+///
+/// With ``weights`` (from :func:`bind` or :func:`load_weights`), those are
+/// applied; they must have been bound for these points and this cage. Without,
+/// ``method`` (default ``"pmvc"``) is bound first, with ``resolution``,
+/// ``grid``, ``backend`` and ``progress`` as :func:`bind` takes them. Each
+/// point moves by Σₖ wₖ dₖ, dₖ the move of column k's vector (a cage vertex's
+/// position, or for Green coordinates a triangle's scaled normal), summed in
+/// float64.
+#[pyfunction]
+#[pyo3(
+    signature = (points, cage, deformed_vertices, weights=None, method=None, **parameters),
+    text_signature = "(points, cage, deformed_vertices, weights=None, method='pmvc', **parameters)"
+)]
+pub(super) fn deform<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    cage: PyRef<'py, PyCage>,
+    deformed_vertices: &Bound<'py, PyAny>,
+    weights: Option<PyRef<'py, PyWeights>>,
+    method: Option<&str>,
+    parameters: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pose = positions(deformed_vertices, "deformed_vertices")?;
+    let expected = cage.cage.vertex_count();
+    if pose.len() != expected {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "deformed_vertices: {} vertices, but the cage has {expected}; a pose must keep the cage's vertices in order",
+                pose.len()
+            ),
+        ));
+    }
+    let points = positions(points, "points")?;
+    let parameter = |name: &str| -> PyResult<Option<Bound<'py, PyAny>>> {
+        parameters.map_or(Ok(None), |given| given.get_item(name))
+    };
+    if let Some(given) = parameters {
+        for key in given.keys() {
+            let key: String = key.extract()?;
+            if !["resolution", "grid", "backend", "progress"].contains(&key.as_str()) {
+                return Err(error(
+                    Kind::Parameter,
+                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress)"),
+                ));
+            }
+            if weights.is_some() {
+                return Err(error(
+                    Kind::Parameter,
+                    format!("deform: \"{key}\" is for binding, but weights were given"),
+                ));
+            }
+        }
+    }
+    let fresh;
+    let weights = match weights {
+        Some(weights) => {
+            if let Some(asked) = method {
+                let asked = method_from(asked)?;
+                if Some(asked) != weights.method() {
+                    return Err(error(
+                        Kind::Weights,
+                        format!(
+                            "deform: method \"{}\" was asked for, but the weights are {}",
+                            asked.id(),
+                            weights.method().map_or("of no known family", |m| m.id())
+                        ),
+                    ));
+                }
+            }
+            weights
+        }
+        None => {
+            let method = method_from(method.unwrap_or("pmvc"))?;
+            let options = bind_options(
+                method,
+                parameter("resolution")?.as_ref(),
+                parameter("grid")?.as_ref(),
+            )?;
+            let backend: String = match parameter("backend")? {
+                Some(value) => value.extract()?,
+                None => "auto".into(),
+            };
+            let progress = parameter("progress")?.filter(|p| !p.is_none());
+            fresh = Py::new(
+                py,
+                bind_points(
+                    py,
+                    points.clone(),
+                    &cage,
+                    options,
+                    &backend,
+                    progress.as_ref(),
+                )?,
+            )?;
+            fresh.borrow(py)
+        }
+    };
+    let deformed = weights.apply(py, &points, &cage, &pose)?;
+    super::arrays::positions_array(py, &deformed)
+}

@@ -1,0 +1,182 @@
+"""Type stubs of the compiled module; import everything from ``pmvc``."""
+
+from os import PathLike
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+ArrayLike = npt.ArrayLike
+"""Any array-like of real numbers: a numpy array, a list of lists..."""
+Path = Union[str, "PathLike[str]"]
+Progress = Callable[[int, int], Any]
+"""Called with ``(done, total)``; raising an exception cancels the work."""
+
+__version__: str
+
+class Cage:
+    """A validated cage: closed, edge-manifold, consistently oriented, no
+    degenerate triangles, not crossing itself (the command line's checks).
+
+    ``vertices`` is an (m, 3) array-like; ``faces`` a sequence of polygons of
+    0-based vertex indices (quads stay quads; they are cut along their shorter
+    diagonal, larger polygons fanned from their first corner). An inward-facing
+    cage is flipped (see ``flipped``). Raises InputError or CageError.
+    """
+
+    def __init__(self, vertices: ArrayLike, faces: Sequence[Sequence[int]]) -> None: ...
+    @staticmethod
+    def load(path: Path) -> "Cage":
+        """Read and validate an OBJ or OFF file. Raises FileError (naming the
+        file and line) or CageError."""
+        ...
+    @property
+    def vertices(self) -> npt.NDArray[np.float64]:
+        """Positions, float64 (m, 3), in file order (the weights' columns)."""
+        ...
+    @property
+    def faces(self) -> List[List[int]]:
+        """The polygons as given, reversed if the cage was flipped."""
+        ...
+    @property
+    def triangles(self) -> npt.NDArray[np.int64]:
+        """Outward triangles, int64 (t, 3): what Green's ψ columns refer to."""
+        ...
+    @property
+    def triangle_faces(self) -> npt.NDArray[np.int64]:
+        """For each triangle, the face (0-based) it was cut from."""
+        ...
+    @property
+    def flipped(self) -> bool:
+        """Whether the faces pointed inward and were reversed."""
+        ...
+    @property
+    def volume(self) -> float:
+        """Enclosed volume."""
+        ...
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal."""
+        ...
+    @property
+    def notices(self) -> List[str]:
+        """What validation noticed without refusing the cage."""
+        ...
+    @property
+    def path(self) -> Optional[str]:
+        """The file it was read from, or None."""
+        ...
+
+class Weights:
+    """The weights of a bind, and what a reader needs to trust them."""
+
+    @property
+    def matrix(self) -> npt.NDArray[np.float32]:
+        """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes."""
+        ...
+    @property
+    def classes(self) -> Optional[npt.NDArray[np.int8]]:
+        """Per row: 0 inside the cage, 1 on it, 2 outside (the family's
+        outside policy applies). None for a file written without them."""
+        ...
+    @property
+    def method(self) -> Optional[str]:
+        """The family's id; None for a plain .npy read without metadata."""
+        ...
+    @property
+    def parameters(self) -> Dict[str, int]:
+        """The family's own parameters, e.g. ``{"resolution": 32}``."""
+        ...
+    @property
+    def backend(self) -> Optional[str]:
+        """Where the weights were computed: "cpu" or "gpu"."""
+        ...
+    @property
+    def device(self) -> Optional[str]:
+        """"CPU" or the GPU adapter's name."""
+        ...
+    @property
+    def seconds(self) -> Optional[float]:
+        """How long the bind took."""
+        ...
+    @property
+    def columns(self) -> List[Tuple[str, int]]:
+        """What each column is: ``("vertex", j)`` per cage vertex (φ for
+        Green), then for Green ``("triangle", k)`` per ``triangles[k]`` (ψ)."""
+        ...
+    @property
+    def columns_layout(self) -> str:
+        """"cage_vertices" or "cage_vertices_then_triangles"."""
+        ...
+    @property
+    def triangles(self) -> Optional[npt.NDArray[np.int64]]:
+        """For Green coordinates, the triangles ψ refers to (int64 (t, 3),
+        corners in the order used); None otherwise."""
+        ...
+
+def load_mesh(path: Path) -> Tuple[npt.NDArray[np.float64], List[List[int]]]:
+    """Read an OBJ or OFF file: ``(vertices, faces)``, vertices float64 (n, 3)
+    in file order, faces polygons of 0-based indices (empty for a point set)."""
+    ...
+
+def bind(
+    points: ArrayLike,
+    cage: Cage,
+    method: str = "pmvc",
+    resolution: int = 32,
+    grid: int = 64,
+    backend: str = "auto",
+    progress: Optional[Progress] = None,
+) -> Weights:
+    """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
+
+    ``resolution`` is PMVC's cube-map resolution, ``grid`` harmonic
+    coordinates' grid; each is read only by its family and checked against its
+    range. ``backend``: "auto" (a hardware GPU when there is one), "cpu" or
+    "gpu". The GIL is released; Ctrl-C cancels within about a second."""
+    ...
+
+def deform(
+    points: ArrayLike,
+    cage: Cage,
+    deformed_vertices: ArrayLike,
+    weights: Optional[Weights] = None,
+    method: str = "pmvc",
+    **parameters: Any,
+) -> npt.NDArray[np.float64]:
+    """The points moved by the cage's move to ``deformed_vertices``, float64
+    (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
+    bound first with ``parameters`` (resolution, grid, backend, progress)."""
+    ...
+
+def classify(points: ArrayLike, cage: Cage) -> npt.NDArray[np.int8]:
+    """Per point: 0 inside the cage, 1 on it, 2 outside (as ``bind``)."""
+    ...
+
+def generate_cage(
+    vertices: ArrayLike,
+    faces: Sequence[Sequence[int]],
+    target: int,
+    clearance: Optional[float] = None,
+    cell_size: Optional[float] = None,
+    progress: Optional[Progress] = None,
+) -> Tuple[Cage, Dict[str, Any]]:
+    """A cage of about ``target`` vertices around a triangle mesh, and a dict
+    of what ``pmvc cage`` prints."""
+    ...
+
+def families() -> List[Dict[str, Any]]:
+    """Every family: id, name, summary, parameters, positive_inside,
+    outside_policy, columns_layout, gpu_kernel."""
+    ...
+
+def save_weights(path: Path, weights: Weights) -> None:
+    """Write ``weights`` as ``pmvc bind`` does: the matrix (.npy, or .npz with
+    phi and psi for Green), the classes (W.classes.npy) and the metadata
+    (W.json), all or nothing."""
+    ...
+
+def load_weights(path: Path) -> Weights:
+    """Read a .npy/.npz written by ``pmvc bind`` or :func:`save_weights`, with
+    its metadata and classes when they are beside it."""
+    ...

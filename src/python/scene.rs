@@ -1,0 +1,335 @@
+//! `Cage`, `load_mesh`, `classify`, `generate_cage` and `families`.
+
+use super::arrays::{faces_list, positions, positions_array, triangles_array};
+use super::binding::{run_interruptible, Interruptible};
+use super::errors::{cage_load_error, error, load_error, Kind};
+use super::polygons::{polygons, triangulate};
+use crate::coords::family::ColumnLayout;
+use crate::coords::Method;
+use crate::geometry::autocage::{self, CageOptions};
+use crate::geometry::{self, classify_points, Cage, CageReport, PointClass};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::Arc;
+
+/// A validated cage: closed, edge-manifold, consistently oriented, no degenerate
+/// triangles, not crossing itself (the checks of the command line).
+///
+/// ``Cage(vertices, faces)`` takes an (m, 3) array-like of positions and a
+/// sequence of faces, each a sequence of 0-based vertex indices (polygons are
+/// cut into triangles as the files are: quads along their shorter diagonal,
+/// larger polygons fanned from their first corner). An inward-facing cage is
+/// flipped (``flipped`` says so). ``Cage.load(path)`` reads an OBJ or OFF file.
+#[pyclass(name = "Cage", module = "pmvc", frozen)]
+pub(super) struct PyCage {
+    pub(super) cage: Arc<Cage>,
+    faces: Vec<Vec<u32>>,
+    report: CageReport,
+    pub(super) path: Option<PathBuf>,
+}
+
+impl PyCage {
+    fn validated(mesh: geometry::TriMesh, path: Option<PathBuf>, py: Python<'_>) -> PyResult<Self> {
+        let mut faces = polygons(&mesh);
+        let (cage, report) = py.detach(|| Cage::new(mesh)).map_err(|cause| match &path {
+            Some(path) => cage_load_error(&geometry::CageLoadError::Invalid {
+                path: path.clone(),
+                source: cause,
+            }),
+            None => error(
+                Kind::Cage,
+                format!("cage: {cause} (faces and vertices counted from 1)"),
+            ),
+        })?;
+        if report.flipped {
+            for face in &mut faces {
+                face.reverse();
+            }
+        }
+        Ok(Self {
+            cage: Arc::new(cage),
+            faces,
+            report,
+            path,
+        })
+    }
+}
+
+#[pymethods]
+impl PyCage {
+    #[new]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let vertices = positions(vertices, "cage vertices")?;
+        let faces = super::arrays::faces(faces, vertices.len(), "cage faces")?;
+        Self::validated(triangulate(&faces, &vertices), None, py)
+    }
+
+    /// Read and validate a cage from an OBJ or OFF file.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let file = py
+            .detach(|| geometry::load_mesh(&path))
+            .map_err(|cause| load_error(&cause))?;
+        Self::validated(file.mesh, Some(path), py)
+    }
+
+    /// Vertex positions, float64, shape (m, 3), in file order (weights columns
+    /// follow it).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        positions_array(py, self.cage.positions())
+    }
+
+    /// The faces as given (polygons of 0-based vertex indices), reversed if the
+    /// cage was flipped to face outward.
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        faces_list(py, &self.faces)
+    }
+
+    /// The outward-facing triangles the faces were cut into, int64, shape (t, 3):
+    /// the triangles Green coordinates' ψ columns refer to, corners in this order.
+    #[getter]
+    fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        triangles_array(py, self.cage.triangles())
+    }
+
+    /// For each triangle, the face (0-based) it was cut from.
+    #[getter]
+    fn triangle_faces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let faces: Vec<i64> = self
+            .cage
+            .triangle_faces()
+            .iter()
+            .map(|&f| f.into())
+            .collect();
+        PyArray1::from_vec(py, faces)
+    }
+
+    /// Whether the faces pointed inward and were reversed.
+    #[getter]
+    fn flipped(&self) -> bool {
+        self.report.flipped
+    }
+
+    /// Enclosed volume (positive).
+    #[getter]
+    fn volume(&self) -> f64 {
+        self.report.volume
+    }
+
+    /// Length of the bounding-box diagonal.
+    #[getter]
+    fn diagonal(&self) -> f64 {
+        self.cage.diagonal()
+    }
+
+    /// What validation noticed without refusing the cage, one line each (as
+    /// the command line prints them).
+    #[getter]
+    fn notices(&self) -> Vec<String> {
+        self.report.messages()
+    }
+
+    /// The file the cage was read from, or None.
+    #[getter]
+    fn path(&self) -> Option<PathBuf> {
+        self.path.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Cage({} vertices, {} faces, {} triangles{})",
+            self.cage.vertex_count(),
+            self.faces.len(),
+            self.cage.triangle_count(),
+            self.path
+                .as_ref()
+                .map(|p| format!(", from {}", geometry::shown_path(p)))
+                .unwrap_or_default()
+        )
+    }
+}
+
+/// Read an OBJ or OFF file: ``(vertices, faces)``, vertices float64 (n, 3) in
+/// file order, faces a list of polygons of 0-based indices (empty for a point
+/// set).
+#[pyfunction]
+pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
+    let file = py
+        .detach(|| geometry::load_mesh(&path))
+        .map_err(|cause| load_error(&cause))?;
+    let vertices = positions_array(py, &file.mesh.positions)?;
+    let faces = faces_list(py, &polygons(&file.mesh))?;
+    PyTuple::new(py, [vertices.into_any(), faces.into_any()])
+}
+
+/// The class code of a point: 0 inside, 1 on the cage, 2 outside.
+pub(super) fn class_codes(classes: &[PointClass]) -> Vec<i8> {
+    classes
+        .iter()
+        .map(|class| match class {
+            PointClass::Inside => 0,
+            PointClass::OnSurface { .. } => 1,
+            PointClass::Outside => 2,
+        })
+        .collect()
+}
+
+/// Where each point lies, int8: 0 inside the cage, 1 on it, 2 outside (by the
+/// generalised winding number, as ``bind`` classes its rows).
+#[pyfunction]
+pub(super) fn classify<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    cage: PyRef<'py, PyCage>,
+) -> PyResult<Bound<'py, PyArray1<i8>>> {
+    let points = positions(points, "points")?;
+    let cage = Arc::clone(&cage.cage);
+    let codes = py.detach(|| class_codes(&classify_points(&cage, &points).classes));
+    Ok(PyArray1::from_vec(py, codes))
+}
+
+/// Generate a cage of about ``target`` vertices around a triangle mesh, as
+/// ``pmvc cage`` does. Returns ``(cage, report)``; ``report`` is a dict of what
+/// ``pmvc cage`` prints. ``clearance`` and ``cell_size`` are fractions of the
+/// mesh's bounding-box diagonal (None: chosen). ``progress``, if given, is
+/// called with ``(done, total)`` (thousandths). Ctrl-C cancels.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, target, clearance=None, cell_size=None, progress=None))]
+pub(super) fn generate_cage<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+    target: usize,
+    clearance: Option<f64>,
+    cell_size: Option<f64>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<(PyCage, Bound<'py, PyDict>)> {
+    let vertices = positions(vertices, "mesh vertices")?;
+    let faces = super::arrays::faces(faces, vertices.len(), "mesh faces")?;
+    let mesh = triangulate(&faces, &vertices);
+    let options = CageOptions {
+        clearance,
+        cell_size,
+        ..CageOptions::new(target)
+    };
+    autocage::plan_cage(&mesh, &options).map_err(|cause| autocage_error(&cause))?;
+    const TOTAL: u32 = 1000;
+    let done = AtomicU32::new(0);
+    let cancelled = AtomicBool::new(false);
+    let task = Interruptible {
+        cancel: &|| cancelled.store(true, Ordering::Relaxed),
+        progress: progress.as_ref(),
+        done: &|| (done.load(Ordering::Relaxed) as usize, TOTAL as usize),
+    };
+    let generated = run_interruptible(py, task, || {
+        autocage::generate_cage(&mesh, &options, &|fraction| {
+            let thousandths = (fraction.clamp(0.0, 1.0) * TOTAL as f32) as u32;
+            done.fetch_max(thousandths, Ordering::Relaxed);
+            !cancelled.load(Ordering::Relaxed)
+        })
+    })?
+    .map_err(|cause| autocage_error(&cause))?;
+    let stats = &generated.stats;
+    let report = PyDict::new(py);
+    report.set_item("vertices", stats.vertices)?;
+    report.set_item("triangles", stats.triangles)?;
+    report.set_item("target_vertices", stats.target_vertices)?;
+    report.set_item("target_reached", stats.target_reached())?;
+    report.set_item("shells", stats.shells)?;
+    report.set_item("min_clearance", stats.min_clearance)?;
+    report.set_item("mesh_diagonal", stats.mesh_diagonal)?;
+    report.set_item("outside_vertices", stats.outside_vertices)?;
+    report.set_item("cage_volume", stats.cage_volume)?;
+    report.set_item("mesh_volume", stats.mesh_volume)?;
+    report.set_item("mesh_volume_from_voxels", stats.mesh_volume_from_voxels)?;
+    report.set_item("volume_ratio", stats.volume_ratio())?;
+    report.set_item("min_angle_degrees", stats.min_angle_degrees)?;
+    report.set_item("cell_size", stats.cell_size)?;
+    report.set_item("cell_size_chosen", stats.cell_size_chosen)?;
+    report.set_item("cell_size_asked", stats.cell_size_asked)?;
+    report.set_item("merge_distance", stats.merge_distance())?;
+    report.set_item("reach", stats.reach)?;
+    report.set_item("grid", stats.grid.to_vec())?;
+    report.set_item("surface_vertices", stats.surface_vertices)?;
+    report.set_item("seconds", stats.seconds)?;
+    let cage = PyCage::validated(
+        geometry::TriMesh {
+            positions: generated.cage.positions().to_vec(),
+            triangles: generated.cage.triangles().to_vec(),
+            triangle_faces: Vec::new(),
+        },
+        None,
+        py,
+    )?;
+    Ok((cage, report))
+}
+
+fn autocage_error(cause: &autocage::AutoCageError) -> PyErr {
+    use autocage::AutoCageError as E;
+    let kind = match cause {
+        E::TooFewVertices { .. } | E::TooManyVertices { .. } => Kind::Parameter,
+        E::BadClearance { .. } | E::BadCellSize { .. } => Kind::Parameter,
+        E::NoTriangles | E::Flat => Kind::Input,
+        E::TooManySamples { .. } | E::GridTooLarge { .. } | E::NotEnoughMemory { .. } => {
+            Kind::TooLarge
+        }
+        E::Cancelled | E::Invalid(_) | E::NotEnclosing { .. } => Kind::Bind,
+    };
+    error(kind, format!("generate_cage: {cause}"))
+}
+
+/// Every coordinate family: a list of dicts with ``id`` (the ``method``
+/// argument), ``name``, ``summary``, ``parameters`` (each with ``id``,
+/// ``label``, ``default``, ``min``, ``max`` and the editor's ``choices``),
+/// ``positive_inside`` (whether weights inside the cage are never negative),
+/// ``outside_policy``, ``columns_layout`` and ``gpu_kernel`` (whether
+/// ``backend="gpu"`` runs it on the GPU; otherwise it binds on the CPU).
+#[pyfunction]
+pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let list = PyList::empty(py);
+    for method in Method::ALL {
+        let spec = method.spec();
+        let family = PyDict::new(py);
+        family.set_item("id", spec.id)?;
+        family.set_item("name", spec.name)?;
+        family.set_item("summary", spec.summary)?;
+        let parameters = PyList::empty(py);
+        if let Some(parameter) = spec.parameter {
+            let entry = PyDict::new(py);
+            entry.set_item("id", parameter.key.id())?;
+            entry.set_item("label", parameter.label)?;
+            entry.set_item("default", parameter.default)?;
+            entry.set_item("min", parameter.min)?;
+            entry.set_item("max", parameter.max)?;
+            entry.set_item("choices", parameter.choices.to_vec())?;
+            parameters.append(entry)?;
+        }
+        family.set_item("parameters", parameters)?;
+        family.set_item("positive_inside", spec.positive_inside)?;
+        family.set_item("outside_policy", spec.outside_policy)?;
+        family.set_item("columns_layout", columns_layout(spec.columns))?;
+        family.set_item(
+            "gpu_kernel",
+            crate::gpu::kernels::Kernel::of(method).is_some(),
+        )?;
+        list.append(family)?;
+    }
+    Ok(list)
+}
+
+/// The name saved files give a column layout.
+pub(super) fn columns_layout(layout: ColumnLayout) -> &'static str {
+    match layout {
+        ColumnLayout::CageVertices => "cage_vertices",
+        ColumnLayout::CageVerticesThenTriangles => "cage_vertices_then_triangles",
+    }
+}
