@@ -6,14 +6,16 @@
 
 use super::arrays::{matrix, positions};
 use super::errors::{error, Kind};
-use super::scene::{class_codes, PyCage};
-use super::weights::{PyWeights, WeightsData};
+use super::scene::PyCage;
+use super::weights::PyWeights;
+use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::coords::{BindOptions, BindProgress, Method, Parameter};
 use crate::geometry::classify_points;
 use crate::gpu::{Backend, BindError, BindInput, Binder, GpuContext};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
@@ -265,23 +267,30 @@ pub(super) fn bind_points(
     let weights = output
         .weights
         .ok_or_else(|| error(Kind::Bind, "internal error: the bind returned no weights"))?;
+    let cage_file = cage
+        .path
+        .as_deref()
+        .map(|path| path.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let metadata = WeightsMetadata::new(&BindRecord {
+        options,
+        cage: &cage.cage,
+        points: &points,
+        classes: &classes,
+        backend: if on_gpu { "gpu" } else { "cpu" },
+        device: &output.stats.device,
+        seconds: output.stats.elapsed.as_secs_f64(),
+        mesh_file: "",
+        cage_file: &cage_file,
+        weights_file: Path::new(""),
+    });
     let codes = class_codes(&classes);
-    let data = WeightsData {
-        options: Some(options),
-        layout: options.method.spec().columns,
-        backend: Some(if on_gpu { "gpu" } else { "cpu" }.to_owned()),
-        device: Some(output.stats.device.clone()),
-        seconds: Some(output.stats.elapsed.as_secs_f64()),
-        vertex_columns: cage.cage.vertex_count(),
-        triangles: cage.cage.triangles().to_vec(),
-        points_digest: None,
-        cage_digest: None,
-    };
-    PyWeights::new(
+    Ok(PyWeights::new(
         matrix(py, weights.values, weights.rows, weights.cols)?.unbind(),
-        Some(numpy::PyArray1::from_vec(py, codes).unbind()),
-        data,
-    )
+        numpy::PyArray1::from_vec(py, codes).unbind(),
+        metadata,
+        options,
+    ))
 }
 
 fn bind_error(cause: &BindError) -> PyErr {
@@ -353,13 +362,13 @@ pub(super) fn deform<'py>(
         Some(weights) => {
             if let Some(asked) = method {
                 let asked = method_from(asked)?;
-                if Some(asked) != weights.method() {
+                if asked != weights.method() {
                     return Err(error(
                         Kind::Weights,
                         format!(
                             "deform: method \"{}\" was asked for, but the weights are {}",
                             asked.id(),
-                            weights.method().map_or("of no known family", |m| m.id())
+                            weights.method().id()
                         ),
                     ));
                 }

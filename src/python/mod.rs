@@ -38,8 +38,8 @@ fn _native(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(scene::families, module)?)?;
     module.add_function(wrap_pyfunction!(binding::bind, module)?)?;
     module.add_function(wrap_pyfunction!(binding::deform, module)?)?;
-    // module.add_function(wrap_pyfunction!(weights::save_weights, module)?)?;
-    // module.add_function(wrap_pyfunction!(weights::load_weights, module)?)?;
+    module.add_function(wrap_pyfunction!(weights::save_weights, module)?)?;
+    module.add_function(wrap_pyfunction!(weights::load_weights, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,9 +5,10 @@ use super::binding::{run_interruptible, Interruptible};
 use super::errors::{cage_load_error, error, load_error, Kind};
 use super::polygons::{polygons, triangulate};
 use crate::coords::family::ColumnLayout;
+use crate::coords::metadata::class_codes;
 use crate::coords::Method;
 use crate::geometry::autocage::{self, CageOptions};
-use crate::geometry::{self, classify_points, Cage, CageReport, PointClass};
+use crate::geometry::{self, classify_points, Cage, CageReport};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -169,18 +170,6 @@ pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'
     let vertices = positions_array(py, &file.mesh.positions)?;
     let faces = faces_list(py, &polygons(&file.mesh))?;
     PyTuple::new(py, [vertices.into_any(), faces.into_any()])
-}
-
-/// The class code of a point: 0 inside, 1 on the cage, 2 outside.
-pub(super) fn class_codes(classes: &[PointClass]) -> Vec<i8> {
-    classes
-        .iter()
-        .map(|class| match class {
-            PointClass::Inside => 0,
-            PointClass::OnSurface { .. } => 1,
-            PointClass::Outside => 2,
-        })
-        .collect()
 }
 
 /// Where each point lies, int8: 0 inside the cage, 1 on it, 2 outside (by the

@@ -1,85 +1,118 @@
-//! The `Weights` class: a bind's matrix and what a reader needs to trust it.
+//! The `Weights` class, `save_weights` and `load_weights`: a bind's matrix with
+//! its class mask and metadata (`coords::metadata`, the files `pmvc bind`
+//! writes beside its weights).
 
-use super::errors::{error, Kind};
-use super::scene::{columns_layout, PyCage};
+use super::errors::{error, file_error, Kind};
+use super::scene::PyCage;
 use crate::coords::family::ColumnLayout;
+use crate::coords::metadata::{
+    classes_path, load_weights_set, save_weights_set, MetadataError, WeightsMetadata,
+};
 use crate::coords::npy::row_sum_off;
-use crate::coords::{BindOptions, Method};
+use crate::coords::{BindOptions, Method, Weights};
+use crate::geometry::shown_path;
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
 
-/// What a `Weights` knows besides its arrays.
-#[derive(Clone, Debug)]
-pub(super) struct WeightsData {
-    /// The family and its parameters; None for a `.npy` read without metadata.
-    pub options: Option<BindOptions>,
-    pub layout: ColumnLayout,
-    pub backend: Option<String>,
-    pub device: Option<String>,
-    pub seconds: Option<f64>,
-    /// Columns that belong to cage vertices.
-    pub vertex_columns: usize,
-    /// The cage's triangles (ψ column k refers to triangle k for Green).
-    pub triangles: Vec<[u32; 3]>,
-    pub points_digest: Option<String>,
-    pub cage_digest: Option<String>,
-}
-
-/// The weights of a bind: ``matrix`` (float32, one row per point, one column per
-/// ``columns`` entry), ``classes`` (int8 per row: 0 inside, 1 on the cage, 2
-/// outside, where the family's outside policy applies), the family
+/// The weights of a bind: ``matrix`` (float32, one row per point, one column
+/// per entry of ``columns``), ``classes`` (int8 per row: 0 inside, 1 on the
+/// cage, 2 outside, where the family's outside policy applies), the family
 /// (``method``, ``parameters``), where it ran (``backend``, ``device``,
 /// ``seconds``), and for Green coordinates the ``triangles`` that ψ refers to.
+/// ``metadata`` is all of it as ``pmvc bind`` writes it in ``W.json``.
 #[pyclass(name = "Weights", module = "pmvc", frozen)]
 pub(super) struct PyWeights {
     matrix: Py<PyArray2<f32>>,
-    classes: Option<Py<PyArray1<i8>>>,
-    data: WeightsData,
+    classes: Py<PyArray1<i8>>,
+    metadata: WeightsMetadata,
+    options: BindOptions,
+    /// The file the weights were read from or last saved to, for messages.
+    path: Option<PathBuf>,
 }
 
 impl PyWeights {
     pub(super) fn new(
         matrix: Py<PyArray2<f32>>,
-        classes: Option<Py<PyArray1<i8>>>,
-        data: WeightsData,
-    ) -> PyResult<Self> {
-        Ok(Self {
+        classes: Py<PyArray1<i8>>,
+        metadata: WeightsMetadata,
+        options: BindOptions,
+    ) -> Self {
+        Self {
             matrix,
             classes,
-            data,
-        })
-    }
-
-    pub(super) fn method(&self) -> Option<Method> {
-        self.data.options.map(|options| options.method)
-    }
-
-    pub(super) fn data(&self) -> &WeightsData {
-        &self.data
-    }
-
-    pub(super) fn matrix_ref(&self) -> &Py<PyArray2<f32>> {
-        &self.matrix
-    }
-
-    pub(super) fn classes_ref(&self) -> Option<&Py<PyArray1<i8>>> {
-        self.classes.as_ref()
-    }
-
-    /// The family whose column vectors these weights multiply: Green for φ and
-    /// ψ, any vertex family otherwise (their columns are the cage vertices).
-    fn columns_method(&self) -> Method {
-        match self.data.layout {
-            ColumnLayout::CageVerticesThenTriangles => Method::Green,
-            ColumnLayout::CageVertices => self.method().unwrap_or(Method::Mvc),
+            metadata,
+            options,
+            path: None,
         }
     }
 
-    /// `points` moved as `pmvc deform --weights` moves them, after the checks it
-    /// makes: the shape fits the points and cage, every value is finite, and
-    /// every row's cage-vertex weights sum to 1.
+    pub(super) fn method(&self) -> Method {
+        self.options.method
+    }
+
+    /// How messages name these weights: their file, or "weights".
+    fn shown(&self) -> PathBuf {
+        self.path
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("weights"))
+    }
+
+    /// The matrix as the library's `Weights`, after the checks `pmvc deform
+    /// --weights` makes on a file: the shape the metadata states, finite
+    /// values, and cage-vertex weights summing to 1 in every row (the array is
+    /// its owner's to change).
+    fn checked_matrix(&self, py: Python<'_>) -> PyResult<Weights> {
+        let (rows, columns) = (self.metadata.rows, self.metadata.columns);
+        let vertices = self.metadata.cage.vertices;
+        let matrix = self.matrix.bind(py).readonly();
+        let shape = matrix.shape().to_vec();
+        if shape != [rows, columns] {
+            return Err(error(
+                Kind::Weights,
+                format!(
+                    "{}: the matrix has shape {shape:?}, but the weights are ({rows}, {columns})",
+                    shown_path(&self.shown())
+                ),
+            ));
+        }
+        let values: Vec<f32> = match matrix.as_slice() {
+            Ok(values) => values.to_vec(),
+            Err(_) => matrix.as_array().iter().copied().collect(),
+        };
+        for (row, values) in values.chunks(columns.max(1)).enumerate() {
+            if let Some(column) = values.iter().position(|w| !w.is_finite()) {
+                return Err(error(
+                    Kind::Weights,
+                    format!(
+                        "{}: row {row}, column {column} is not finite ({})",
+                        shown_path(&self.shown()),
+                        values[column]
+                    ),
+                ));
+            }
+            if let Some((sum, tolerance)) = row_sum_off(&values[..vertices.min(values.len())]) {
+                return Err(error(
+                    Kind::Weights,
+                    format!(
+                        "{}: row {row}'s cage-vertex weights sum to {sum}, not 1 (± {tolerance:.1e})",
+                        shown_path(&self.shown())
+                    ),
+                ));
+            }
+        }
+        Ok(Weights {
+            rows,
+            cols: columns,
+            values,
+        })
+    }
+
+    /// `points` moved as `pmvc deform --weights` moves them, after its checks:
+    /// the weights were bound for these points and this cage (the metadata's
+    /// counts and digests), and the matrix is sound.
     pub(super) fn apply(
         &self,
         py: Python<'_>,
@@ -87,58 +120,29 @@ impl PyWeights {
         cage: &PyCage,
         pose: &[DVec3],
     ) -> PyResult<Vec<DVec3>> {
-        let method = self.columns_method();
-        let (rows, columns) = (points.len(), method.columns(&cage.cage));
-        let vertices = cage.cage.vertex_count();
-        let matrix = self.matrix.bind(py).readonly();
-        let shape = matrix.shape().to_vec();
-        if shape != [rows, columns] {
-            return Err(error(
-                Kind::Weights,
-                format!(
-                    "weights: shape {shape:?} does not fit {rows} points and a cage of {vertices} vertices{}: expected ({rows}, {columns})",
-                    if method == Method::Green {
-                        format!(" and {} triangles", cage.cage.triangle_count())
-                    } else {
-                        String::new()
-                    }
-                ),
-            ));
-        }
-        let contiguous;
-        let values: &[f32] = match matrix.as_slice() {
-            Ok(values) => values,
-            Err(_) => {
-                contiguous = matrix.as_array().iter().copied().collect::<Vec<f32>>();
-                &contiguous
-            }
-        };
-        for (row, values) in values.chunks(columns.max(1)).enumerate() {
-            if let Some(column) = values.iter().position(|w| !w.is_finite()) {
-                return Err(error(
-                    Kind::Weights,
-                    format!(
-                        "weights: row {row}, column {column} is not finite ({})",
-                        values[column]
-                    ),
-                ));
-            }
-            if let Some((sum, tolerance)) = row_sum_off(&values[..vertices]) {
-                return Err(error(
-                    Kind::Weights,
-                    format!(
-                        "weights: row {row}'s cage-vertex weights sum to {sum}, not 1 (± {tolerance:.1e})"
-                    ),
-                ));
-            }
-        }
-        let weights = crate::coords::Weights {
-            rows,
-            cols: columns,
-            values: values.to_vec(),
-        };
-        let moves = method.column_displacements(&cage.cage, pose);
+        self.metadata
+            .check_inputs(&self.shown(), points, &cage.cage)
+            .map_err(|cause| metadata_error(&cause))?;
+        let weights = self.checked_matrix(py)?;
+        let moves = self.method().column_displacements(&cage.cage, pose);
         Ok(py.detach(|| weights.apply_displacements(points, &moves)))
+    }
+}
+
+/// A metadata or weights-file error as the exception it is.
+fn metadata_error(cause: &MetadataError) -> PyErr {
+    let message = cause.to_string();
+    match cause {
+        MetadataError::Read { path, .. } => file_error(Kind::File, message, path, None),
+        MetadataError::Json { path, line, .. } => {
+            file_error(Kind::File, message, path, Some(*line))
+        }
+        MetadataError::Write(source) => file_error(Kind::File, message, &source.path, None),
+        MetadataError::Field { path, .. }
+        | MetadataError::Parameter { path, .. }
+        | MetadataError::Mismatch { path, .. }
+        | MetadataError::Classes { path, .. } => file_error(Kind::Weights, message, path, None),
+        MetadataError::Weights(_) => error(Kind::Weights, message),
     }
 }
 
@@ -151,18 +155,16 @@ impl PyWeights {
     }
 
     /// The class of each row, int8: 0 inside the cage, 1 on it, 2 outside (its
-    /// row follows the family's outside policy; see :func:`families`). None for
-    /// weights read from a file written without its classes.
+    /// row follows the family's outside policy; see :func:`families`).
     #[getter]
-    fn classes<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i8>>> {
-        self.classes.as_ref().map(|c| c.bind(py).clone())
+    fn classes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i8>> {
+        self.classes.bind(py).clone()
     }
 
-    /// The family's id ("mvc", "pmvc", "harmonic", "green"); None for a plain
-    /// `.npy` read without its metadata.
+    /// The family's id: "mvc", "pmvc", "harmonic" or "green".
     #[getter(method)]
-    fn method_id(&self) -> Option<&'static str> {
-        self.method().map(Method::id)
+    fn method_id(&self) -> &'static str {
+        self.method().id()
     }
 
     /// The family's own parameters, e.g. ``{"resolution": 32}`` (empty for MVC
@@ -170,48 +172,48 @@ impl PyWeights {
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let parameters = PyDict::new(py);
-        if let Some((spec, value)) = self.data.options.and_then(|o| o.parameter()) {
-            parameters.set_item(spec.key.id(), value)?;
+        for (name, value) in &self.metadata.parameters {
+            parameters.set_item(name, value)?;
         }
         Ok(parameters)
     }
 
-    /// Where the weights were computed: "cpu" or "gpu" (None when unknown).
+    /// Where the weights were computed: "cpu" or "gpu".
     #[getter]
-    fn backend(&self) -> Option<String> {
-        self.data.backend.clone()
+    fn backend(&self) -> String {
+        self.metadata.backend.clone()
     }
 
     /// The device, e.g. "CPU" or the GPU adapter's name.
     #[getter]
-    fn device(&self) -> Option<String> {
-        self.data.device.clone()
+    fn device(&self) -> String {
+        self.metadata.device.clone()
     }
 
-    /// Seconds the bind took (classification excluded).
+    /// Seconds the bind took (classification and copies excluded).
     #[getter]
-    fn seconds(&self) -> Option<f64> {
-        self.data.seconds
+    fn seconds(&self) -> f64 {
+        self.metadata.seconds
     }
 
     /// What each column is, in order: ``("vertex", j)`` for cage vertex j (φ_j
-    /// for Green coordinates), then for Green coordinates ``("triangle", k)`` for
-    /// ``triangles[k]`` (ψ_k, which multiplies that triangle's scaled normal).
+    /// for Green coordinates), then for Green coordinates ``("triangle", k)``
+    /// for ``triangles[k]`` (ψ_k, which multiplies that triangle's scaled
+    /// normal).
     #[getter]
     fn columns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let mut entries: Vec<(&str, usize)> = (0..self.data.vertex_columns)
-            .map(|j| ("vertex", j))
-            .collect();
-        if self.data.layout == ColumnLayout::CageVerticesThenTriangles {
-            entries.extend((0..self.data.triangles.len()).map(|k| ("triangle", k)));
+        let vertices = self.metadata.cage.vertices;
+        let mut entries: Vec<(&str, usize)> = (0..vertices).map(|j| ("vertex", j)).collect();
+        if self.method().spec().columns == ColumnLayout::CageVerticesThenTriangles {
+            entries.extend((0..self.metadata.cage.triangles).map(|k| ("triangle", k)));
         }
         PyList::new(py, entries)
     }
 
     /// "cage_vertices" or "cage_vertices_then_triangles" (Green coordinates).
     #[getter]
-    fn columns_layout(&self) -> &'static str {
-        columns_layout(self.data.layout)
+    fn columns_layout(&self) -> String {
+        self.metadata.columns_layout.clone()
     }
 
     /// For Green coordinates, the cage triangles that ψ columns refer to, int64
@@ -219,24 +221,90 @@ impl PyWeights {
     /// rule); None for families whose columns are only cage vertices.
     #[getter]
     fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<i64>>>> {
-        if self.data.layout != ColumnLayout::CageVerticesThenTriangles {
-            return Ok(None);
+        match &self.metadata.triangles {
+            Some(triangles) => super::arrays::triangles_array(py, triangles).map(Some),
+            None => Ok(None),
         }
-        super::arrays::triangles_array(py, &self.data.triangles).map(Some)
     }
 
-    fn __repr__(&self, py: Python<'_>) -> String {
-        let shape = self.matrix.bind(py).shape().to_vec();
+    /// Everything ``W.json`` holds, as a dict (``json.load`` of the file
+    /// :func:`save_weights` writes).
+    #[getter]
+    fn metadata<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?
+            .call_method1("loads", (self.metadata.to_json_pretty(),))
+    }
+
+    fn __repr__(&self) -> String {
         format!(
-            "Weights({}, {} × {} float32{})",
-            self.method().map_or("unknown family", |m| m.name()),
-            shape[0],
-            shape[1],
-            self.data
-                .backend
-                .as_ref()
-                .map(|b| format!(", {b}"))
-                .unwrap_or_default()
+            "Weights({}, {} × {} float32, {})",
+            self.method().name(),
+            self.metadata.rows,
+            self.metadata.columns,
+            self.metadata.backend
         )
     }
+}
+
+/// Write ``weights`` as ``pmvc bind`` writes them: the matrix to ``path``
+/// (``.npy``; Green coordinates' φ and ψ to a ``.npz``), the classes to
+/// ``W.classes.npy`` and the metadata to ``W.json`` beside it, all three or none
+/// (each through a temporary file renamed into place).
+#[pyfunction]
+pub(super) fn save_weights(
+    py: Python<'_>,
+    path: PathBuf,
+    weights: PyRef<'_, PyWeights>,
+) -> PyResult<()> {
+    let npz = weights.method().spec().columns == ColumnLayout::CageVerticesThenTriangles;
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let wanted = if npz { "npz" } else { "npy" };
+    if extension.as_deref() != Some(wanted) {
+        return Err(file_error(
+            Kind::File,
+            format!(
+                "{}: {} weights are written as .{wanted}; use {}",
+                shown_path(&path),
+                weights.method().name(),
+                shown_path(&path.with_extension(wanted))
+            ),
+            &path,
+            None,
+        ));
+    }
+    let matrix = weights.checked_matrix(py)?;
+    let classes: Vec<i8> = weights.classes.bind(py).readonly().as_array().to_vec();
+    let mut metadata = weights.metadata.clone();
+    metadata.classes.file = classes_path(&path)
+        .file_name()
+        .map(|name| name.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    py.detach(|| save_weights_set(&path, &matrix, &metadata, &classes))
+        .map_err(|cause| metadata_error(&cause))
+}
+
+/// Read weights written by ``pmvc bind`` or :func:`save_weights`: the metadata
+/// (``W.json``) first, then the matrix with the shape it states (checked as
+/// ``pmvc deform --weights`` checks it), then the classes (``W.classes.npy``).
+#[pyfunction]
+pub(super) fn load_weights(py: Python<'_>, path: PathBuf) -> PyResult<PyWeights> {
+    let loaded = py
+        .detach(|| load_weights_set(&path))
+        .map_err(|cause| metadata_error(&cause))?;
+    let matrix = super::arrays::matrix(
+        py,
+        loaded.weights.values,
+        loaded.weights.rows,
+        loaded.weights.cols,
+    )?;
+    let mut weights = PyWeights::new(
+        matrix.unbind(),
+        PyArray1::from_vec(py, loaded.classes).unbind(),
+        loaded.metadata,
+        loaded.options,
+    );
+    weights.path = Some(path);
+    Ok(weights)
 }

@@ -123,8 +123,13 @@ def test_deform_refuses_what_does_not_fit(box):
     weights = pmvc.bind(points, box, method="mvc")
     with pytest.raises(pmvc.InputError, match="7 vertices, but the cage has 8"):
         pmvc.deform(points, box, BOX[:7], weights=weights)
-    with pytest.raises(pmvc.WeightsError, match=r"shape \[2, 8\] does not fit 3 points"):
+    with pytest.raises(pmvc.WeightsError, match="bound for other inputs: rows is 2 there, 3 here"):
         pmvc.deform(points + [[0.5, 0.5, 0.25]], box, BOX, weights=weights)
+    with pytest.raises(pmvc.WeightsError, match="bound for other inputs: mesh.digest is"):
+        pmvc.deform([[0.5, 0.5, 0.5], [0.25, 0.5, 0.25]], box, BOX, weights=weights)
+    moved_box = pmvc.Cage(BOX + 0.01, BOX_FACES)
+    with pytest.raises(pmvc.WeightsError, match="bound for other inputs: cage.digest is"):
+        pmvc.deform(points, moved_box, BOX, weights=weights)
     with pytest.raises(pmvc.WeightsError, match='method "green" was asked for, but the weights are mvc'):
         pmvc.deform(points, box, BOX, weights=weights, method="green")
     with pytest.raises(pmvc.ParameterError, match='"resolution" is for binding'):
@@ -133,7 +138,7 @@ def test_deform_refuses_what_does_not_fit(box):
         pmvc.deform(points, box, BOX, resolutoin=8)
     # The matrix is a numpy array its owner may change: it is checked when applied.
     weights.matrix[1, 3] = np.nan
-    with pytest.raises(pmvc.WeightsError, match=r"row 1, column 3 is not finite"):
+    with pytest.raises(pmvc.WeightsError, match=r"^weights: row 1, column 3 is not finite"):
         pmvc.deform(points, box, BOX, weights=weights)
     weights.matrix[1, 3] = 0.5
     with pytest.raises(pmvc.WeightsError, match=r"row 1's cage-vertex weights sum to"):

@@ -34,8 +34,8 @@ from ._native import (
     families,
     generate_cage,
     load_mesh,
-    # load_weights,
-    # save_weights,
+    load_weights,
+    save_weights,
 )
 
 #: Class codes of ``Weights.classes`` and :func:`classify`.
