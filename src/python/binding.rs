@@ -55,9 +55,7 @@ pub(super) fn run_interruptible<T: Send>(
         Ok(())
     };
     let (_, total) = (task.done)();
-    if let Err(raised) = report(0, total) {
-        return Err(raised);
-    }
+    report(0, total)?;
     let outcome = std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
             let result = work();

@@ -197,11 +197,20 @@ pub(super) fn generate_cage<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
     faces: &Bound<'py, PyAny>,
-    target: usize,
+    target: i64,
     clearance: Option<f64>,
     cell_size: Option<f64>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(PyCage, Bound<'py, PyDict>)> {
+    let target = usize::try_from(target).map_err(|_| {
+        error(
+            Kind::Parameter,
+            format!(
+                "generate_cage: target {target}: a cage needs at least {} vertices",
+                autocage::MIN_TARGET_VERTICES
+            ),
+        )
+    })?;
     let vertices = positions(vertices, "mesh vertices")?;
     let faces = super::arrays::faces(faces, vertices.len(), "mesh faces")?;
     let mesh = triangulate(&faces, &vertices);

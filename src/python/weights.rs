@@ -10,6 +10,7 @@ use crate::coords::metadata::{
 };
 use crate::coords::npy::row_sum_off;
 use crate::coords::{BindOptions, Method, Weights};
+use crate::geometry::budget::{bytes_for, check_memory};
 use crate::geometry::shown_path;
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
@@ -78,6 +79,16 @@ impl PyWeights {
                 ),
             ));
         }
+        check_memory(
+            || format!("a copy of the weights ({rows} rows × {columns} columns × 4 bytes)"),
+            bytes_for(rows as u64, 4 * columns as u64),
+        )
+        .map_err(|cause| {
+            error(
+                Kind::TooLarge,
+                format!("{}: {cause}", shown_path(&self.shown())),
+            )
+        })?;
         let values: Vec<f32> = match matrix.as_slice() {
             Ok(values) => values.to_vec(),
             Err(_) => matrix.as_array().iter().copied().collect(),

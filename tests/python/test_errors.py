@@ -149,6 +149,10 @@ def test_generate_cage_refuses_bad_targets_and_flat_meshes(comb_points):
     _, faces = pmvc.load_mesh(ASSETS / "comb_mesh.obj")
     with pytest.raises(pmvc.ParameterError, match="at least 8 vertices; 3 were asked for"):
         pmvc.generate_cage(comb_points, faces, target=3)
+    with pytest.raises(pmvc.ParameterError, match="target -1: a cage needs at least 8 vertices"):
+        pmvc.generate_cage(comb_points, faces, target=-1)
+    with pytest.raises(pmvc.ParameterError, match="the clearance must be a positive fraction"):
+        pmvc.generate_cage(comb_points, faces, target=60, clearance=-0.5)
     flat = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
     with pytest.raises(pmvc.InputError, match="flat"):
         pmvc.generate_cage(flat, [[0, 1, 2]], target=8)

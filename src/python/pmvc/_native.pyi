@@ -75,28 +75,28 @@ class Weights:
         """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes."""
         ...
     @property
-    def classes(self) -> Optional[npt.NDArray[np.int8]]:
+    def classes(self) -> npt.NDArray[np.int8]:
         """Per row: 0 inside the cage, 1 on it, 2 outside (the family's
-        outside policy applies). None for a file written without them."""
+        outside policy applies)."""
         ...
     @property
-    def method(self) -> Optional[str]:
-        """The family's id; None for a plain .npy read without metadata."""
+    def method(self) -> str:
+        """The family's id: "mvc", "pmvc", "harmonic" or "green"."""
         ...
     @property
     def parameters(self) -> Dict[str, int]:
         """The family's own parameters, e.g. ``{"resolution": 32}``."""
         ...
     @property
-    def backend(self) -> Optional[str]:
+    def backend(self) -> str:
         """Where the weights were computed: "cpu" or "gpu"."""
         ...
     @property
-    def device(self) -> Optional[str]:
+    def device(self) -> str:
         """"CPU" or the GPU adapter's name."""
         ...
     @property
-    def seconds(self) -> Optional[float]:
+    def seconds(self) -> float:
         """How long the bind took."""
         ...
     @property
@@ -112,6 +112,11 @@ class Weights:
     def triangles(self) -> Optional[npt.NDArray[np.int64]]:
         """For Green coordinates, the triangles ψ refers to (int64 (t, 3),
         corners in the order used); None otherwise."""
+        ...
+    @property
+    def metadata(self) -> Dict[str, Any]:
+        """Everything W.json holds (family, parameters, backend, time, column
+        layout, class counts, digests of the points and cage)."""
         ...
 
 def load_mesh(path: Path) -> Tuple[npt.NDArray[np.float64], List[List[int]]]:
