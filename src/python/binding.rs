@@ -292,8 +292,14 @@ pub(super) fn bind_points(
 }
 
 fn bind_error(cause: &BindError) -> PyErr {
+    use crate::coords::harmonic::HarmonicError;
+    use crate::gpu::GpuError;
     let kind = match cause {
         BindError::InvalidInput(_) | BindError::ResolutionTooHigh { .. } => Kind::Parameter,
+        BindError::Harmonic(
+            HarmonicError::NotEnoughMemory { .. } | HarmonicError::GridTooLarge { .. },
+        )
+        | BindError::Gpu(GpuError::OutOfMemory(_) | GpuError::TooLarge { .. }) => Kind::TooLarge,
         _ => Kind::Bind,
     };
     error(kind, format!("bind: {cause}"))

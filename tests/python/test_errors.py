@@ -113,6 +113,12 @@ def test_bad_parameters_raise_parameter_errors(box, arguments, words):
     assert words in str(raised.value)
 
 
+def test_work_that_cannot_fit_in_memory_is_refused_with_its_size(box):
+    with pytest.raises(pmvc.TooLargeError, match=r"harmonic (bind at grid|grid of) 2048") as raised:
+        pmvc.bind([[0.5, 0.5, 0.5]], box, method="harmonic", grid=2048)
+    assert isinstance(raised.value, MemoryError)
+
+
 def test_a_parameter_of_another_family_is_not_read(box):
     weights = pmvc.bind([[0.5, 0.5, 0.5]], box, method="mvc", resolution=0, grid=1)
     assert weights.parameters == {}
