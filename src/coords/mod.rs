@@ -25,7 +25,7 @@ pub mod green;
 pub mod harmonic;
 pub mod mvc;
 pub mod npy;
-pub mod npy_header;
+pub use crate::geometry::npy_header;
 pub mod npz;
 pub mod pmvc;
 pub mod quality;
