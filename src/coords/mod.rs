@@ -23,6 +23,7 @@ pub mod cubemap;
 pub mod family;
 pub mod green;
 pub mod harmonic;
+pub mod metadata;
 pub mod mvc;
 pub mod npy;
 pub use crate::geometry::npy_header;

@@ -10,7 +10,7 @@ use super::npy::{
     ExpectedArray, NpyError,
 };
 use super::Weights;
-use crate::geometry::PendingOutput;
+use crate::geometry::{PendingOutput, WriteSeek};
 use std::io::{Read, Seek, Write as _};
 use std::path::Path;
 
@@ -32,37 +32,64 @@ pub fn write_npz_to(
     weights: &Weights,
     vertex_columns: usize,
 ) -> Result<(), NpyError> {
+    // The preambles are checked before anything is written.
+    npz_preambles(path, weights, vertex_columns)?;
+    output.finish_seekable(|out| write_npz(out, path, weights, vertex_columns))?;
+    Ok(())
+}
+
+/// The two arrays' names, column ranges and `.npy` preambles.
+type NpzParts = [(&'static str, std::ops::Range<usize>, Vec<u8>); 2];
+
+fn npz_preambles(
+    path: &Path,
+    weights: &Weights,
+    vertex_columns: usize,
+) -> Result<NpzParts, NpyError> {
     let vertex_columns = vertex_columns.min(weights.cols);
-    let parts = [
-        (PHI, 0..vertex_columns),
-        (PSI, vertex_columns..weights.cols),
-    ];
-    let mut preambles = Vec::new();
-    for (_, columns) in &parts {
-        preambles.push(npy_preamble(path, weights.rows, columns.len())?);
-    }
-    output.finish_seekable(|out| {
-        let mut zip = zip::ZipWriter::new(out);
-        for ((name, columns), preamble) in parts.iter().zip(&preambles) {
-            let bytes = preamble.len() as u64 + 4 * (weights.rows * columns.len()) as u64;
-            let options = zip::write::SimpleFileOptions::default()
-                .compression_method(zip::CompressionMethod::Stored)
-                .large_file(bytes >= u64::from(u32::MAX));
-            zip.start_file(format!("{name}.npy"), options)
-                .map_err(std::io::Error::other)?;
-            zip.write_all(preamble)?;
-            // Row by row: each array is a column range of the joint matrix.
-            for row in weights
-                .values
-                .chunks(weights.cols.max(1))
-                .take(weights.rows)
-            {
-                write_f32_values(&mut zip, &row[columns.clone()])?;
-            }
+    let phi = 0..vertex_columns;
+    let psi = vertex_columns..weights.cols;
+    Ok([
+        (
+            PHI,
+            phi.clone(),
+            npy_preamble(path, weights.rows, phi.len())?,
+        ),
+        (
+            PSI,
+            psi.clone(),
+            npy_preamble(path, weights.rows, psi.len())?,
+        ),
+    ])
+}
+
+/// The archive's bytes, written into `out` (which the zip writer seeks back in).
+pub fn write_npz(
+    out: &mut dyn WriteSeek,
+    path: &Path,
+    weights: &Weights,
+    vertex_columns: usize,
+) -> std::io::Result<()> {
+    let parts = npz_preambles(path, weights, vertex_columns).map_err(std::io::Error::other)?;
+    let mut zip = zip::ZipWriter::new(out);
+    for (name, columns, preamble) in &parts {
+        let bytes = preamble.len() as u64 + 4 * (weights.rows * columns.len()) as u64;
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored)
+            .large_file(bytes >= u64::from(u32::MAX));
+        zip.start_file(format!("{name}.npy"), options)
+            .map_err(std::io::Error::other)?;
+        zip.write_all(preamble)?;
+        // Row by row: each array is a column range of the joint matrix.
+        for row in weights
+            .values
+            .chunks(weights.cols.max(1))
+            .take(weights.rows)
+        {
+            write_f32_values(&mut zip, &row[columns.clone()])?;
         }
-        zip.finish().map_err(std::io::Error::other)?;
-        Ok(())
-    })?;
+    }
+    zip.finish().map_err(std::io::Error::other)?;
     Ok(())
 }
 

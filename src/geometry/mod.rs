@@ -35,7 +35,7 @@ pub use io::{
 pub use normals::vertex_normals;
 pub use output::{
     extension_warning, human_bytes, refuse_same_file, refuse_unwritable, remove_unfinished_outputs,
-    resolve_output, write_atomically, OutputSet, OutputTarget, PendingOutput,
+    resolve_output, write_atomically, OutputSet, OutputTarget, PendingOutput, WriteSeek,
 };
 pub use ply::{colour_byte, write_coloured_ply};
 pub use points_npy::write_points_npy;

@@ -1,6 +1,6 @@
 //! Outputs replaced together or not at all: a mesh and the cage made for it.
 
-use super::{folder_of, resolve_output, Finished, OutputTarget, PendingOutput, Written};
+use super::{folder_of, resolve_output, Finished, OutputTarget, PendingOutput, WriteSeek, Written};
 use crate::geometry::error::{shown_path, WriteError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -64,9 +64,25 @@ impl OutputSet {
         self,
         mut write: impl FnMut(usize, &mut dyn Write) -> std::io::Result<()>,
     ) -> Result<(), WriteError> {
+        self.finish_into(false, |index, out| write(index, out))
+    }
+
+    /// [`Self::finish`] for outputs that seek back while written (zip archives).
+    pub fn finish_seekable(
+        self,
+        write: impl FnMut(usize, &mut dyn WriteSeek) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
+        self.finish_into(true, write)
+    }
+
+    fn finish_into(
+        self,
+        seeks: bool,
+        mut write: impl FnMut(usize, &mut dyn WriteSeek) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
         let mut files = Vec::with_capacity(self.outputs.len());
         for (index, output) in self.outputs.into_iter().enumerate() {
-            if let Written::File(finished) = output.write(false, |out| write(index, out))? {
+            if let Written::File(finished) = output.write(seeks, |out| write(index, out))? {
                 files.push(finished);
             }
         }
