@@ -111,20 +111,31 @@ fn compute_weights_on(
 ) -> Result<Weights> {
     let rows = input.mesh.mesh.positions.len();
     let bar = progress_bar(rows as u64, choice.method);
-    let (weights, _) = bind_rows(input, 0..rows, choice, &backend, &bar)?;
+    let bound = bind_rows(input, 0..rows, choice, &backend, &bar)?;
     bar.finish_and_clear();
-    Ok(weights)
+    Ok(bound.weights)
 }
 
-/// Bind the points in `range`, moving `bar` on from the range's start. Returns
-/// the weights and where they were computed.
+/// Weights of a range of rows, and how they were computed.
+pub(super) struct BoundRows {
+    pub weights: Weights,
+    /// Where they were computed, in words ("CPU", or the adapter).
+    pub device: String,
+    /// Whether GPU kernels computed them (a family without one binds on the
+    /// CPU on every backend).
+    pub on_gpu: bool,
+    /// The bind's own time, without loading or writing.
+    pub seconds: f64,
+}
+
+/// Bind the points in `range`, moving `bar` on from the range's start.
 pub(super) fn bind_rows(
     input: &BoundInput,
     range: std::ops::Range<usize>,
     choice: &MethodChoice,
     backend: &Backend,
     bar: &indicatif::ProgressBar,
-) -> Result<(Weights, String)> {
+) -> Result<BoundRows> {
     let bind_input = BindInput {
         points: input.mesh.mesh.positions[range.clone()].into(),
         classes: input.classes.classes[range.clone()].into(),
@@ -145,16 +156,21 @@ pub(super) fn bind_rows(
     let weights = output
         .weights
         .context("internal error: the bind returned no CPU weights")?;
-    Ok((weights, output.stats.device))
+    let on_gpu = matches!(backend, Backend::Gpu(_))
+        && crate::gpu::kernels::Kernel::of(choice.method).is_some();
+    Ok(BoundRows {
+        weights,
+        device: output.stats.device,
+        on_gpu,
+        seconds: output.stats.elapsed.as_secs_f64(),
+    })
 }
 
-/// What a bind used, for the summary line: "PMVC 32²", "harmonic grid 64", "MVC".
-pub(super) fn method_label(choice: &MethodChoice) -> String {
-    use crate::coords::Parameter;
-    let name = choice.method.name();
-    match choice.method.spec().parameter.as_ref().map(|p| p.key) {
-        Some(Parameter::Resolution) => format!("{name} {}²", choice.resolution),
-        Some(Parameter::Grid) => format!("{name} grid {}", choice.grid),
+/// What a bind used, for the summary line: "PMVC 32²", "HC grid 64", "MVC".
+pub(super) fn method_label(options: BindOptions) -> String {
+    let name = options.method.name();
+    match options.parameter() {
+        Some((spec, value)) => format!("{name} {}", (spec.format)(value)),
         None => name.to_owned(),
     }
 }

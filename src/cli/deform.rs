@@ -5,12 +5,61 @@ use super::commands::{
     check_output, compute_weights, load_input, method_label, outside_note, outside_policy, summary,
     InputRules,
 };
-use super::weights_format::{read_weights_for, stored_family};
+use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
 use super::DeformArgs;
+use crate::coords::metadata::{metadata_path, read_metadata, WeightsMetadata};
+use crate::coords::{BindOptions, Method};
 use crate::geometry::{self, bounds_of, find_crossing, shown_path, Cage};
 use anyhow::{bail, Result};
 use glam::DVec3;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// What `--weights` brings: the family its rows apply as and, when `pmvc bind`
+/// wrote `W.json` beside it, that metadata (and where it was read).
+struct StoredWeights {
+    options: BindOptions,
+    metadata: Option<(PathBuf, WeightsMetadata)>,
+}
+
+/// Read `W.json` beside the weights `path` when it is there: the family and
+/// parameters come from it, and its file must be the format that family is
+/// written in. Without it (weights from an older pmvc, or saved by numpy) one
+/// warning says that nothing can be checked, and the file's format and
+/// `--method` decide the family, as before.
+fn stored_weights(path: &Path, asked: Method) -> Result<StoredWeights> {
+    let json = metadata_path(path);
+    if !json.exists() {
+        let method = stored_family(path, asked)?;
+        warn_line!(
+            "pmvc: {}: warning: no {} beside it (weights from an older pmvc, or saved by numpy), so they cannot be checked against the mesh and cage, and nothing records how they were bound",
+            shown_path(path),
+            shown_path(&json)
+        );
+        return Ok(StoredWeights {
+            options: BindOptions::for_method(method),
+            metadata: None,
+        });
+    }
+    let metadata = read_metadata(&json)?;
+    let options = metadata.options(&json)?;
+    let method = options.method;
+    if writes_npz(method) != is_npz(path) {
+        let format = |npz: bool| if npz { ".npz" } else { ".npy" };
+        bail!(
+            "{}: it is a {}, but its metadata {} says it holds {} coordinates (--method {}), which are written as {}",
+            shown_path(path),
+            format(is_npz(path)),
+            shown_path(&json),
+            method.name(),
+            method.id(),
+            format(writes_npz(method)),
+        );
+    }
+    Ok(StoredWeights {
+        options,
+        metadata: Some((json, metadata)),
+    })
+}
 
 /// Whether `path` asks for the deformed points as a `.npy` array.
 fn writes_points_npy(path: &Path) -> bool {
@@ -34,13 +83,22 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     )?;
     // The family of stored weights decides what the warnings say of vertices
     // outside the cage, so it is known before the inputs are read.
-    let (method, policy) = match &args.weights {
-        Some(path) => {
-            let method = stored_family(path, args.method.method)?;
-            (method, outside_policy(Some(method)))
-        }
-        None => (args.method.method, outside_policy(Some(args.method.method))),
+    let stored = match &args.weights {
+        Some(path) => Some(stored_weights(path, args.method.method)?),
+        None => None,
     };
+    let (options, policy) = match &stored {
+        Some(stored) => {
+            let recorded = stored.metadata.is_some() || writes_npz(stored.options.method);
+            let known = recorded.then_some(stored.options.method);
+            (stored.options, outside_policy(known))
+        }
+        None => (
+            args.method.options(),
+            outside_policy(Some(args.method.method)),
+        ),
+    };
+    let method = options.method;
     let holds_weights = args.weights.is_none();
     let input = load_input(
         &args.input,
@@ -60,6 +118,9 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             shown_path(&args.input.cage)
         );
     }
+    if let Some((json, metadata)) = stored.as_ref().and_then(|s| s.metadata.as_ref()) {
+        metadata.check_inputs(json, &input.mesh.mesh.positions, &input.cage)?;
+    }
     warn_if_crossed(&input.cage, &pose.mesh.positions, &args.deformed_cage);
     let weights = match &args.weights {
         Some(path) => read_weights_for(path, &input, method)?,
@@ -77,9 +138,14 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     } else {
         geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     }
-    let source = match &args.weights {
-        Some(path) => format!("weights from {}", shown_path(path)),
-        None => format!("{} weights", method_label(&args.method)),
+    let source = match (&args.weights, &stored) {
+        (Some(path), Some(stored)) if stored.metadata.is_some() => format!(
+            "{} weights from {}",
+            method_label(stored.options),
+            shown_path(path)
+        ),
+        (Some(path), _) => format!("weights from {}", shown_path(path)),
+        (None, _) => format!("{} weights", method_label(options)),
     };
     summary(format_args!(
         "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",

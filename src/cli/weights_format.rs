@@ -42,7 +42,8 @@ pub(super) fn check_weights_format(args: &BindArgs) -> Result<()> {
     }
 }
 
-fn is_npz(path: &std::path::Path) -> bool {
+/// Whether `path` names a `.npz` (Green coordinates' φ and ψ).
+pub(super) fn is_npz(path: &std::path::Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"))
 }
