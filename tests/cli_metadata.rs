@@ -666,3 +666,110 @@ fn the_files_beside_the_weights_are_refused_as_the_weights_are() {
     assert!(!Path::new("/dev/null.json").exists());
     assert!(!Path::new("/dev/null.classes.npy").exists());
 }
+
+#[test]
+fn weights_of_one_name_in_both_formats_are_not_mistaken_for_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, cage, _) = comb_scene(dir.path(), 20);
+    let npy = dir.path().join("w.npy");
+    let npz = dir.path().join("w.npz");
+    for (method, out) in [("mvc", &npy), ("green", &npz)] {
+        let output = bind(&mesh, &cage_path, method, out, &[]);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    // w.json is the Green bind's now: the .npy is refused, not applied as Green.
+    let pose = write(dir.path(), "pose.obj", &cage_obj(&cage));
+    let out = dir.path().join("deformed.obj");
+    let output = deform(
+        &mesh,
+        &cage_path,
+        &pose,
+        &out,
+        &["--weights", path_str(&npy)],
+    );
+    assert_clean_failure(&output, "w.npy", "w.json says it holds Green coordinates");
+    let output = deform(
+        &mesh,
+        &cage_path,
+        &pose,
+        &out,
+        &["--weights", path_str(&npz)],
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+}
+
+#[test]
+fn mutated_npy_point_sets_load_or_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let points: Vec<DVec3> = (0..9)
+        .map(|i| DVec3::new(i as f64, 0.5 * i as f64, -0.25))
+        .collect();
+    let path = dir.path().join("mutated.npy");
+    for valid in [f64_points_npy(&points), f32_points_npy(&points)] {
+        std::fs::write(&path, valid).unwrap();
+        assert_eq!(
+            pmvc::geometry::load_mesh(&path).unwrap().mesh.positions,
+            points
+        );
+    }
+    let mut random = Random(0x5eed_0f_9017);
+    let mut loaded = 0;
+    for (case, valid) in [f64_points_npy(&points), f32_points_npy(&points)]
+        .iter()
+        .cycle()
+        .take(600)
+        .enumerate()
+    {
+        let mut bytes = valid.clone();
+        for _ in 0..1 + random.below(4) {
+            match random.below(3) {
+                0 => {
+                    let at = random.below(bytes.len());
+                    bytes[at] = random.next() as u8;
+                }
+                1 => bytes.truncate(random.below(bytes.len() + 1)),
+                _ => bytes.extend((0..random.below(30)).map(|_| random.next() as u8)),
+            }
+        }
+        std::fs::write(&path, &bytes).unwrap();
+        match pmvc::geometry::load_mesh(&path) {
+            Ok(file) => {
+                loaded += 1;
+                assert!(
+                    file.mesh.positions.iter().all(|p| p.is_finite()),
+                    "case {case}"
+                );
+                assert!(file.mesh.triangles.is_empty(), "case {case}");
+            }
+            Err(error) => {
+                let message = error.to_string();
+                assert!(message.contains("mutated.npy"), "case {case}: {message}");
+                assert!(!message.contains('\n'), "case {case}: {message}");
+            }
+        }
+    }
+    // Changed values and padding still read: the reader is not refusing everything.
+    assert!(loaded > 0, "no mutated file loaded");
+}
+
+#[test]
+fn help_says_what_bind_writes_and_what_deform_reads_and_writes() {
+    let help = |command: &str| {
+        let output = pmvc(&[command, "--help"]);
+        assert!(output.status.success());
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    };
+    let bind = help("bind");
+    for said in [
+        "W.json",
+        "W.classes.npy",
+        "0 inside, 1 on the cage, 2 outside",
+        ".npy array of shape (n, 3)",
+    ] {
+        assert!(bind.contains(said), "bind --help: {said}: {bind}");
+    }
+    let deform = help("deform");
+    for said in ["W.json beside them", "float64 of shape (mesh vertices, 3)"] {
+        assert!(deform.contains(said), "deform --help: {said}: {deform}");
+    }
+}

@@ -142,7 +142,7 @@ pub struct BindArgs {
     pub input: CageInput,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated).
+    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated). Beside W.npy or W.npz go W.json (the method and its parameters, backend, device, the bind's seconds, program version, what each column is and Green's psi triangles, the outside policy, the inputs' names and digests) and W.classes.npy (int8 per row: 0 inside, 1 on the cage, 2 outside), replaced together with the weights or not at all; beside a device or pipe, none.
     #[arg(long, value_name = "W.npy|W.npz")]
     pub out: PathBuf,
     /// Bind and write this many rows at a time, so that memory holds one block
@@ -161,7 +161,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format.

@@ -5,7 +5,7 @@
 
 use super::budget::{bytes_for, check_memory};
 use super::npy_header::{header_bytes, read_fully, read_header, shape_text};
-use super::output::{human_bytes, write_atomically};
+use super::output::write_atomically;
 use super::{LoadError, MeshFile, MeshFormat, TriMesh, WriteError};
 use glam::DVec3;
 use std::io::Read;
@@ -119,16 +119,7 @@ pub(super) fn read_points_npy(path: &Path, max_points: usize) -> Result<MeshFile
         }
     }
     let rows = rows as usize; // at most max_points
-    check_memory(
-        || {
-            format!(
-                "its {rows} points ({})",
-                human_bytes(bytes_for(rows as u64, 24))
-            )
-        },
-        bytes_for(rows as u64, 24),
-    )
-    .map_err(|error| {
+    check_memory(|| format!("its {rows} points"), bytes_for(rows as u64, 24)).map_err(|error| {
         io_error(std::io::Error::new(
             std::io::ErrorKind::OutOfMemory,
             error.to_string(),
