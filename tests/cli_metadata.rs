@@ -773,3 +773,50 @@ fn help_says_what_bind_writes_and_what_deform_reads_and_writes() {
         assert!(deform.contains(said), "deform --help: {said}: {deform}");
     }
 }
+
+#[test]
+fn metadata_records_where_the_rows_were_computed() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, _, _) = comb_scene(dir.path(), 30);
+    let bind_on_gpu = |method: &str, extra: &[&str]| {
+        let out = dir.path().join(format!("{method}.npy"));
+        let mut args = vec![
+            "bind",
+            "--mesh",
+            path_str(&mesh),
+            "--cage",
+            path_str(&cage_path),
+            "--method",
+            method,
+            "--backend",
+            "gpu",
+            "--out",
+            path_str(&out),
+        ];
+        args.extend_from_slice(extra);
+        (pmvc(&args), dir.path().join(format!("{method}.json")))
+    };
+    let (output, json) = bind_on_gpu("pmvc", &["--resolution", "8"]);
+    if !output.status.success() {
+        assert!(
+            std::env::var("PMVC_REQUIRE_GPU").as_deref() != Ok("1"),
+            "no GPU adapter: {}",
+            stderr(&output)
+        );
+        assert_clean_failure(&output, "--backend gpu", "adapter");
+        println!("not run: no GPU adapter");
+        return;
+    }
+    let json = read_json(&json);
+    assert_eq!(json["backend"], "gpu");
+    let device = json["device"].as_str().unwrap();
+    assert!(!device.is_empty() && device != "CPU", "{device}");
+    // Harmonic coordinates have no GPU kernel: their rows come from the CPU.
+    let (output, json) = bind_on_gpu("harmonic", &["--grid", "16"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json = read_json(&json);
+    assert_eq!(
+        (&json["backend"], &json["device"]),
+        (&"cpu".into(), &"CPU".into())
+    );
+}
