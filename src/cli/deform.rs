@@ -75,12 +75,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         args.deformed_cage.as_path(),
     ];
     inputs.extend(args.weights.as_deref());
-    check_output(
-        &args.out,
-        &inputs,
-        &["obj", "npy"],
-        "an OBJ mesh (float64 points when it ends in .npy)",
-    )?;
+    check_output(&args.out, &inputs, &["obj", "npy"], "an OBJ mesh")?;
     // The family of stored weights decides what the warnings say of vertices
     // outside the cage, so it is known before the inputs are read.
     let stored = match &args.weights {
