@@ -37,8 +37,7 @@ pub(super) fn outside_policy(method: Option<Method>) -> &'static str {
 /// How `load_input` treats the inputs: whose columns the weights have, what
 /// vertices outside the cage get, and how many weights rows are held at once.
 pub(super) struct InputRules<'a> {
-    /// The family whose columns are held (and whose policy is said when
-    /// `outside_policy` is not overridden).
+    /// The family whose weights are held: it decides their columns.
     pub method: Method,
     /// `--strict`: vertices outside the cage are an error.
     pub strict: bool,
@@ -240,7 +239,7 @@ pub(super) fn check_output(
 
 /// An error before the work starts when a dense `rows` × `cols` weights matrix
 /// cannot fit in the memory left, instead of an abort once it is allocated.
-pub(super) fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
+fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
     use crate::geometry::budget::{bytes_for, check_memory};
     let bytes = bytes_for(rows as u64, bytes_for(cols as u64, 4));
     check_memory(
