@@ -262,6 +262,15 @@ fn the_files_beside_the_weights_are_refused_as_the_weights_are() {
     let output = bind(&mesh, &cage_path, "mvc", &out, &[]);
     assert_clean_failure(&output, "w.classes.npy", "is the input");
     assert!(!out.exists() && !dir.path().join("w.json").exists());
+    // Metadata that links to an input.
+    let out = dir.path().join("u.npy");
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&cage_path, dir.path().join("u.json")).unwrap();
+        let output = bind(&mesh, &cage_path, "mvc", &out, &[]);
+        assert_clean_failure(&output, "u.json", "is the input");
+        assert!(!out.exists());
+    }
 
     // Metadata no one may write.
     let out = dir.path().join("v.npy");
