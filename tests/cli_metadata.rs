@@ -4,7 +4,6 @@
 //! files from a bind in blocks, weights for other inputs refused by the field
 //! that differs, weights without metadata used with one warning, and the files
 //! beside the weights refused as the weights are.
-#![cfg(feature = "editor")]
 
 mod cli_support;
 mod common;

@@ -3,7 +3,6 @@
 //! malformed, and written as float64 by `pmvc deform --out X.npy`; the warning
 //! for a deformed cage that crosses itself; outside-vertex warnings in each
 //! family's own words.
-#![cfg(feature = "editor")]
 
 mod cli_support;
 mod common;

@@ -186,6 +186,7 @@ pub(super) fn summary(line: std::fmt::Arguments) {
 pub(super) fn outside_note(input: &BoundInput) -> String {
     match input.classes.outside.len() {
         0 => "all vertices inside the cage".to_owned(),
+        1 => "1 vertex outside the cage".to_owned(),
         n => format!("{n} vertices outside the cage"),
     }
 }
