@@ -15,12 +15,12 @@ shoot() { # NAME ARGS...
 }
 shoot default-scene
 shoot first-run --demo
-shoot pmvc-posed --pose docs/poses/middle-finger-sideways.obj
-shoot mvc-posed --method mvc --pose docs/poses/middle-finger-sideways.obj
+shoot pmvc-posed --pose docs/poses/middle-finger-forward.obj
+shoot mvc-posed --method mvc --pose docs/poses/middle-finger-forward.obj
 shoot scanned-elephant assets/scan_mesh.obj assets/scan_cage.obj
 
 # The comparison gallery (docs/comparison.md).
-finger=docs/poses/middle-finger-sideways.obj
+finger=docs/poses/middle-finger-forward.obj
 shoot compare-side-by-side --pose "$finger" --view side-by-side
 shoot compare-heatmap --pose "$finger" --view side-by-side --heatmap 7
 shoot compare-heatmap-log --pose "$finger" --view side-by-side --heatmap 7 --log-scale

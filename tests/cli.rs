@@ -224,23 +224,33 @@ fn deform_with_stored_weights_matches_deform_that_binds() {
     );
     assert!(output.status.success(), "{}", stderr(&output));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-    // Weights of the wrong shape are refused.
+    // Weights for another mesh are refused: by their metadata, and without it by
+    // their shape.
     let small = dir.path().join("small.obj");
     std::fs::write(&small, "v 0.5 0.5 0\n").unwrap();
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&small),
-        "--cage",
-        path_str(&cage_path),
-        "--deformed-cage",
-        path_str(&pose_path),
-        "--weights",
-        path_str(&weights),
-        "--out",
-        path_str(&a),
-    ]);
-    assert_clean_failure(&output, path_str(&weights), "shape (100,");
+    let deform_small = || {
+        pmvc(&[
+            "deform",
+            "--mesh",
+            path_str(&small),
+            "--cage",
+            path_str(&cage_path),
+            "--deformed-cage",
+            path_str(&pose_path),
+            "--weights",
+            path_str(&weights),
+            "--out",
+            path_str(&a),
+        ])
+    };
+    let json = weights.with_extension("json");
+    assert_clean_failure(
+        &deform_small(),
+        path_str(&json),
+        "rows is 100 there, 1 here",
+    );
+    std::fs::remove_file(&json).unwrap();
+    assert_clean_failure(&deform_small(), path_str(&weights), "shape (100,");
 }
 
 #[test]
@@ -522,15 +532,17 @@ fn bind_and_deform_say_what_they_wrote_on_a_terminal_and_nothing_on_a_pipe() {
         return;
     };
     let expected = format!(
-        "pmvc: wrote {}: 50 × {} float32 weights (PMVC 32², CPU) in ",
+        "pmvc: wrote {} (classes in {}, metadata in {}): 50 × {} float32 weights (PMVC 32², CPU) bound in ",
         weights.display(),
+        weights.with_extension("classes.npy").display(),
+        weights.with_extension("json").display(),
         comb.vertex_count()
     );
     assert!(said.contains(&expected), "{said}");
     assert!(said.contains("; all vertices inside the cage"), "{said}");
     let said = on_a_terminal(&deform).unwrap();
     let expected = format!(
-        "pmvc: wrote {}: 50 vertices deformed with weights from {} in ",
+        "pmvc: wrote {}: 50 vertices deformed with PMVC 32² weights from {} in ",
         deformed.display(),
         weights.display()
     );

@@ -148,16 +148,35 @@ fn deform_applies_stored_or_fresh_green_coordinates_and_keeps_similarities() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-5 * 1.7 * cage.diagonal(), "worst {worst:e}");
 
-    // Green coordinates cannot come from a .npy.
+    // Green coordinates cannot come from a .npy. With its metadata a .npy
+    // applies as the family recorded there, whatever --method says.
     let npy = dir.path().join("p.npy");
     let mut args = bind_args(&mesh, &cage_path, &npy);
     args[6] = "pmvc";
     assert!(pmvc(&args).status.success());
     let output = deform(&stored, &["--method", "green", "--weights", path_str(&npy)]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    std::fs::remove_file(npy.with_extension("json")).unwrap();
+    let output = deform(&stored, &["--method", "green", "--weights", path_str(&npy)]);
     assert_clean_failure(&output, path_str(&npy), "read from a .npz");
     // A .npz for another cage is refused with both shapes.
     let small = dir.path().join("small.obj");
     std::fs::write(&small, "v 0.5 0.5 0\n").unwrap();
+    let output = pmvc(&[
+        "deform",
+        "--mesh",
+        path_str(&small),
+        "--cage",
+        path_str(&cage_path),
+        "--deformed-cage",
+        path_str(&pose_path),
+        "--weights",
+        path_str(&weights),
+        "--out",
+        path_str(&stored),
+    ]);
+    assert_clean_failure(&output, "w.json", "rows is");
+    std::fs::remove_file(weights.with_extension("json")).unwrap();
     let output = pmvc(&[
         "deform",
         "--mesh",

@@ -151,7 +151,7 @@ fn outside_vertices_are_reported_apart_from_the_inside_ones() {
     assert_eq!(quality.negative_vertices, 0, "{quality:?}");
     assert_eq!(quality.negative_share, 0.0);
     use egui_kittest::kittest::Queryable;
-    harness.get_by_label("outside: with λ < 0 (MVC)");
+    harness.get_by_label("outside: with λ < 0");
     harness.get_by_label("inside: vertices with λ < 0");
 
     // The negativity view paints the outside vertex grey, not as negativity, on

@@ -1,13 +1,10 @@
 //! The work behind each subcommand.
 
-use super::weights_format::{check_weights_format, read_weights_for, writes_npz};
-use super::{BackendArg, BindArgs, CageInput, CheckArgs, DeformArgs, GenerateArgs, MethodChoice};
-use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values, write_npy_to};
-use crate::coords::npz::{npz_payload_bytes, write_npz_to};
+use super::{BackendArg, CageInput, CheckArgs, GenerateArgs, MethodChoice};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use crate::geometry::{
     self, classify_points, extension_warning, refuse_same_file, shown_path, Cage, MeshFile,
-    OutputSet, PendingOutput, PointClasses,
+    OutputSet, PointClasses,
 };
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{anyhow, bail, Context, Result};
@@ -27,19 +24,36 @@ pub(super) struct BoundInput {
 /// vertex count and the weights' columns: all of them, none, or a block.
 pub(super) type ResidentRows<'a> = &'a dyn Fn(usize, usize) -> usize;
 
+/// What the outside warning says of vertices outside the cage: the family's
+/// own policy, or, for stored weights whose family is not recorded, that their
+/// rows are used as stored.
+pub(super) fn outside_policy(method: Option<Method>) -> &'static str {
+    match method {
+        Some(method) => method.spec().outside_policy,
+        None => "their rows are used as the weights file stores them (it has no metadata to say how they were bound)",
+    }
+}
+
+/// How `load_input` treats the inputs: whose columns the weights have, what
+/// vertices outside the cage get, and how many weights rows are held at once.
+pub(super) struct InputRules<'a> {
+    /// The family whose weights are held: it decides their columns.
+    pub method: Method,
+    /// `--strict`: vertices outside the cage are an error.
+    pub strict: bool,
+    /// What the warning says those vertices get ([`outside_policy`]).
+    pub outside_policy: &'static str,
+    pub resident_rows: ResidentRows<'a>,
+}
+
 /// Load and validate the inputs, printing the cage's notices and the outside count.
-/// Weights rows that cannot fit in memory (`resident_rows`) are an error before
-/// any work on the points.
-pub(super) fn load_input(
-    input: &CageInput,
-    choice: &MethodChoice,
-    resident_rows: ResidentRows,
-) -> Result<BoundInput> {
-    let strict = choice.strict;
+/// Weights rows that cannot fit in memory (`rules.resident_rows`) are an error
+/// before any work on the points.
+pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundInput> {
     let mesh = geometry::load_mesh(&input.mesh)?;
     let (cage, report) = geometry::load_cage(&input.cage)?;
-    let columns = choice.method.columns(&cage);
-    let rows = resident_rows(mesh.mesh.positions.len(), columns);
+    let columns = rules.method.columns(&cage);
+    let rows = (rules.resident_rows)(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
     for message in report.messages() {
         warn_line!("pmvc: {}: {message}", shown_path(&input.cage));
@@ -47,22 +61,18 @@ pub(super) fn load_input(
     let classes = classify_points(&cage, &mesh.mesh.positions);
     if !classes.outside.is_empty() {
         let summary = outside_summary(&classes, mesh.mesh.positions.len());
-        if strict {
+        if rules.strict {
             bail!(
                 "{}: {summary} of {} (--strict)",
                 shown_path(&input.mesh),
                 shown_path(&input.cage)
             );
         }
-        let policy = if choice.method == Method::Green {
-            "they get Green's exterior extension through the nearest cage triangle, exact at rest and continuous across it".to_owned()
-        } else {
-            format!("they get MVC weights (beyond {} cage diagonals, MVC's affine extension), which sum to one, reproduce their points at any distance and meet the inside coordinates continuously on the cage", crate::coords::mvc::FAR_FIELD_DIAGONALS)
-        };
         warn_line!(
-            "pmvc: {}: warning: {summary} of {}; {policy}",
+            "pmvc: {}: warning: {summary} of {}; {}",
             shown_path(&input.mesh),
             shown_path(&input.cage),
+            rules.outside_policy,
         );
     }
     Ok(BoundInput {
@@ -100,20 +110,31 @@ fn compute_weights_on(
 ) -> Result<Weights> {
     let rows = input.mesh.mesh.positions.len();
     let bar = progress_bar(rows as u64, choice.method);
-    let (weights, _) = bind_rows(input, 0..rows, choice, &backend, &bar)?;
+    let bound = bind_rows(input, 0..rows, choice, &backend, &bar)?;
     bar.finish_and_clear();
-    Ok(weights)
+    Ok(bound.weights)
 }
 
-/// Bind the points in `range`, moving `bar` on from the range's start. Returns
-/// the weights and where they were computed.
-fn bind_rows(
+/// Weights of a range of rows, and how they were computed.
+pub(super) struct BoundRows {
+    pub weights: Weights,
+    /// Where they were computed, in words ("CPU", or the adapter).
+    pub device: String,
+    /// Whether GPU kernels computed them (a family without one binds on the
+    /// CPU on every backend).
+    pub on_gpu: bool,
+    /// The bind's own time, without loading or writing.
+    pub seconds: f64,
+}
+
+/// Bind the points in `range`, moving `bar` on from the range's start.
+pub(super) fn bind_rows(
     input: &BoundInput,
     range: std::ops::Range<usize>,
     choice: &MethodChoice,
     backend: &Backend,
     bar: &indicatif::ProgressBar,
-) -> Result<(Weights, String)> {
+) -> Result<BoundRows> {
     let bind_input = BindInput {
         points: input.mesh.mesh.positions[range.clone()].into(),
         classes: input.classes.classes[range.clone()].into(),
@@ -134,53 +155,39 @@ fn bind_rows(
     let weights = output
         .weights
         .context("internal error: the bind returned no CPU weights")?;
-    Ok((weights, output.stats.device))
+    let on_gpu = matches!(backend, Backend::Gpu(_))
+        && crate::gpu::kernels::Kernel::of(choice.method).is_some();
+    Ok(BoundRows {
+        weights,
+        device: output.stats.device,
+        on_gpu,
+        seconds: output.stats.elapsed.as_secs_f64(),
+    })
 }
 
-/// What a bind used, for the summary line: "PMVC 32²", "harmonic grid 64", "MVC".
-fn method_label(choice: &MethodChoice) -> String {
-    use crate::coords::Parameter;
-    let name = choice.method.name();
-    match choice.method.spec().parameter.as_ref().map(|p| p.key) {
-        Some(Parameter::Resolution) => format!("{name} {}²", choice.resolution),
-        Some(Parameter::Grid) => format!("{name} grid {}", choice.grid),
+/// What a bind used, for the summary line: "PMVC 32²", "HC grid 64", "MVC".
+pub(super) fn method_label(options: BindOptions) -> String {
+    let name = options.method.name();
+    match options.parameter() {
+        Some((spec, value)) => format!("{name} {}", (spec.format)(value)),
         None => name.to_owned(),
     }
 }
 
 /// One line on stderr when it is a terminal: what was written and how. Scripts
 /// reading a pipe get nothing, as before.
-fn summary(line: std::fmt::Arguments) {
+pub(super) fn summary(line: std::fmt::Arguments) {
     use std::io::IsTerminal;
     if std::io::stderr().is_terminal() {
         let _ = writeln!(std::io::stderr(), "pmvc: {line}");
     }
 }
 
-fn outside_note(input: &BoundInput) -> String {
+pub(super) fn outside_note(input: &BoundInput) -> String {
     match input.classes.outside.len() {
         0 => "all vertices inside the cage".to_owned(),
+        1 => "1 vertex outside the cage".to_owned(),
         n => format!("{n} vertices outside the cage"),
-    }
-}
-
-/// Rows a streamed bind computes and writes at a time when `--block-rows` is not
-/// given: 256 MiB of weights, so that memory stays flat however large the mesh.
-const BLOCK_BYTES: usize = 256 << 20;
-
-/// Rows held at once by `pmvc bind`: everything for a family that solves for the
-/// whole cage or is written as a `.npz` (array after array), a block for one whose
-/// rows are independent.
-fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
-    if args.method.method.spec().rows_independent && !writes_npz(args.method.method) {
-        let block = args
-            .block_rows
-            .map_or(BLOCK_BYTES / (4 * columns.max(1)), |rows| {
-                usize::try_from(rows).unwrap_or(usize::MAX)
-            });
-        rows.min(block.max(1))
-    } else {
-        rows
     }
 }
 
@@ -246,160 +253,6 @@ fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result
             shown_path(mesh)
         )
     })
-}
-
-pub(super) fn bind(args: &BindArgs) -> Result<()> {
-    let inputs = [args.input.mesh.as_path(), args.input.cage.as_path()];
-    check_weights_format(args)?;
-    let (extensions, what): (&[&str], _) = if writes_npz(args.method.method) {
-        (&["npz"], "phi and psi float32 arrays in .npz format")
-    } else {
-        (&["npy"], "float32 weights in .npy format")
-    };
-    check_output(&args.out, &inputs, extensions, what)?;
-    // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
-    // on the driver: do it while the inputs load and are classified.
-    let choice = args.method.backend;
-    let probe = std::thread::spawn(move || choose_backend(choice));
-    let input = load_input(&args.input, &args.method, &|rows, columns| {
-        bind_resident_rows(args, rows, columns)
-    })?;
-    let backend = probe
-        .join()
-        .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
-    let rows = input.mesh.mesh.positions.len();
-    let columns = args.method.method.columns(&input.cage);
-    // Opened before the work, so that a full disk or an unwritable folder is
-    // reported now, and a signal during the bind removes the temporary file.
-    let output = PendingOutput::create(&args.out)?;
-    output.check_space(if writes_npz(args.method.method) {
-        npz_payload_bytes(rows, columns)
-    } else {
-        npy_file_bytes(rows, columns)
-    })?;
-    let started = std::time::Instant::now();
-    let device = bind_to(args, &input, backend, output, rows, columns)?;
-    let shape = if writes_npz(args.method.method) {
-        let vertices = input.cage.vertex_count();
-        format!(
-            "phi {rows} × {vertices} and psi {rows} × {} float32",
-            columns - vertices
-        )
-    } else {
-        format!("{rows} × {columns} float32 weights")
-    };
-    summary(format_args!(
-        "wrote {}: {shape} ({}, {device}) in {:.2} s; {}",
-        shown_path(&args.out),
-        method_label(&args.method),
-        started.elapsed().as_secs_f64(),
-        outside_note(&input)
-    ));
-    Ok(())
-}
-
-/// Bind and write the weights, whole or in blocks of rows; returns where they
-/// were computed.
-fn bind_to(
-    args: &BindArgs,
-    input: &BoundInput,
-    backend: Backend,
-    output: PendingOutput,
-    rows: usize,
-    columns: usize,
-) -> Result<String> {
-    let block = bind_resident_rows(args, rows, columns);
-    let bar = progress_bar(rows as u64, args.method.method);
-    if block >= rows {
-        let (weights, device) = bind_rows(input, 0..rows, &args.method, &backend, &bar)?;
-        bar.finish_and_clear();
-        if writes_npz(args.method.method) {
-            let vertices = args.method.method.vertex_columns(&input.cage);
-            write_npz_to(output, &args.out, &weights, vertices)?;
-        } else {
-            write_npy_to(output, &args.out, &weights)?;
-        }
-        return Ok(device);
-    }
-    // In blocks of rows, each written as soon as it is bound: memory stays at one
-    // block, and the disk is the only limit.
-    let preamble = npy_preamble(&args.out, rows, columns)?;
-    let mut bind_error = None;
-    let mut device = String::new();
-    let written = output.finish(|out| {
-        out.write_all(&preamble)?;
-        for start in (0..rows).step_by(block) {
-            let range = start..(start + block).min(rows);
-            match bind_rows(input, range, &args.method, &backend, &bar) {
-                Ok((weights, used)) => {
-                    device = used;
-                    write_f32_values(out, &weights.values)?
-                }
-                Err(error) => {
-                    bind_error = Some(error);
-                    return Err(std::io::Error::other("the bind failed"));
-                }
-            }
-        }
-        Ok(())
-    });
-    bar.finish_and_clear();
-    match (bind_error, written) {
-        (Some(error), _) => Err(error),
-        (None, result) => Ok(result.map(|()| device)?),
-    }
-}
-
-pub(super) fn deform(args: &DeformArgs) -> Result<()> {
-    let started = std::time::Instant::now();
-    let mut inputs = vec![
-        args.input.mesh.as_path(),
-        args.input.cage.as_path(),
-        args.deformed_cage.as_path(),
-    ];
-    inputs.extend(args.weights.as_deref());
-    check_output(&args.out, &inputs, &["obj"], "an OBJ mesh")?;
-    let holds_weights = args.weights.is_none();
-    let input = load_input(&args.input, &args.method, &|rows, _| {
-        if holds_weights {
-            rows
-        } else {
-            0
-        }
-    })?;
-    let pose = geometry::load_mesh(&args.deformed_cage)?;
-    let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
-    if found != expected {
-        bail!(
-            "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
-            shown_path(&args.deformed_cage),
-            shown_path(&args.input.cage)
-        );
-    }
-    let (weights, method) = match &args.weights {
-        Some(path) => read_weights_for(path, &input, args.method.method)?,
-        None => (compute_weights(&input, &args.method)?, args.method.method),
-    };
-    // Displacement form, p + Σλ(c̃ − c): the same as Σλc̃ for weights that
-    // reproduce their points at rest (every family pmvc binds), and better in f32:
-    // Σλc̃ carries each weight's rounding times the cage's distance from the
-    // origin, this form only times how far the cage moved. Rows were checked to
-    // sum to 1 when read, so a translation of the cage moves every vertex with it.
-    let moves = method.column_displacements(&input.cage, &pose.mesh.positions);
-    let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
-    geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
-    let source = match &args.weights {
-        Some(path) => format!("weights from {}", geometry::shown_path(path)),
-        None => format!("{} weights", method_label(&args.method)),
-    };
-    summary(format_args!(
-        "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",
-        shown_path(&args.out),
-        deformed.len(),
-        started.elapsed().as_secs_f64(),
-        outside_note(&input)
-    ));
-    Ok(())
 }
 
 pub(super) fn check(args: &CheckArgs) -> Result<()> {

@@ -23,8 +23,10 @@ macro_rules! warn_line {
 }
 
 mod bench;
+mod bind;
 mod cage;
 mod commands;
+mod deform;
 mod environment;
 mod parse;
 mod weights_format;
@@ -93,7 +95,8 @@ pub enum BackendArg {
 
 #[derive(Debug, clap::Args)]
 pub struct CageInput {
-    /// The mesh to deform (.obj or .off). A file with vertices and no faces is a point set.
+    /// The mesh to deform (.obj or .off). A file with vertices and no faces is a
+    /// point set, and so is a .npy array of shape (n, 3), float32 or float64, in C order.
     #[arg(long, value_name = "MESH")]
     pub mesh: PathBuf,
     /// The cage: a closed, consistently oriented triangle or polygon mesh (.obj or .off).
@@ -115,7 +118,9 @@ pub struct MethodChoice {
     /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
-    /// Treat mesh vertices outside the cage as an error instead of giving them MVC weights.
+    /// Treat mesh vertices outside the cage as an error instead of binding them by
+    /// the family's outside policy (MVC weights for MVC, PMVC and harmonic
+    /// coordinates; Green's exterior extension for Green coordinates).
     #[arg(long)]
     pub strict: bool,
 }
@@ -137,7 +142,7 @@ pub struct BindArgs {
     pub input: CageInput,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated).
+    /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated). Beside W.npy or W.npz go W.json (the method and its parameters, backend, device, the bind's seconds, program version, what each column is and Green's psi triangles, the outside policy, the inputs' names and digests) and W.classes.npy (int8 per row: 0 inside, 1 on the cage, 2 outside), replaced together with the weights or not at all; beside a device or pipe, none.
     #[arg(long, value_name = "W.npy|W.npz")]
     pub out: PathBuf,
     /// Bind and write this many rows at a time, so that memory holds one block
@@ -156,11 +161,11 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
-    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh.
-    #[arg(long, value_name = "M2.obj")]
+    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format.
+    #[arg(long, value_name = "M2.obj|P2.npy")]
     pub out: PathBuf,
 }
 
@@ -385,8 +390,8 @@ pub fn main() -> ExitCode {
             }
             .map_err(anyhow::Error::from)
         }
-        Some(Command::Bind(args)) => commands::bind(&args),
-        Some(Command::Deform(args)) => commands::deform(&args),
+        Some(Command::Bind(args)) => bind::bind(&args),
+        Some(Command::Deform(args)) => deform::deform(&args),
         Some(Command::Check(args)) => commands::check(&args),
         Some(Command::Cage(args)) => cage::cage(&args),
         Some(Command::Bench(args)) => bench::run(&args),

@@ -42,23 +42,18 @@ pub(super) fn check_weights_format(args: &BindArgs) -> Result<()> {
     }
 }
 
-/// Weights from a file and the family they apply as: a `.npz` holds Green
-/// coordinates (φ and ψ), a `.npy` one weight per cage vertex, whatever `--method`
-/// says, except that Green coordinates cannot come from a `.npy`. The file's
-/// arrays must have this mesh's and cage's shape, finite values, and rows of
-/// cage-vertex weights that sum to 1 (checked as they are read).
-pub(super) fn read_weights_for(
-    path: &std::path::Path,
-    input: &BoundInput,
-    asked: Method,
-) -> Result<(Weights, Method)> {
-    let rows = input.mesh.mesh.positions.len();
-    let (vertices, triangles) = (input.cage.vertex_count(), input.cage.triangle_count());
-    let is_npz = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
-    if is_npz {
-        return Ok((read_npz(path, rows, vertices, triangles)?, Method::Green));
+/// Whether `path` names a `.npz` (Green coordinates' φ and ψ).
+pub(super) fn is_npz(path: &std::path::Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npz"))
+}
+
+/// The family stored weights apply as: a `.npz` holds Green coordinates (φ and
+/// ψ), a `.npy` one weight per cage vertex, whatever `--method` says, except
+/// that Green coordinates cannot come from a `.npy`.
+pub(super) fn stored_family(path: &std::path::Path, asked: Method) -> Result<Method> {
+    if is_npz(path) {
+        return Ok(Method::Green);
     }
     if writes_npz(asked) {
         bail!(
@@ -68,6 +63,24 @@ pub(super) fn read_weights_for(
             asked.id()
         );
     }
-    let weights = read_npy(path, ExpectedArray::cage_vertices(rows, vertices))?;
-    Ok((weights, asked))
+    Ok(asked)
+}
+
+/// Weights of `method` ([`stored_family`]) from a file. The file's arrays must
+/// have this mesh's and cage's shape, finite values, and rows of cage-vertex
+/// weights that sum to 1 (checked as they are read).
+pub(super) fn read_weights_for(
+    path: &std::path::Path,
+    input: &BoundInput,
+    method: Method,
+) -> Result<Weights> {
+    let rows = input.mesh.mesh.positions.len();
+    let (vertices, triangles) = (input.cage.vertex_count(), input.cage.triangle_count());
+    if writes_npz(method) {
+        return Ok(read_npz(path, rows, vertices, triangles)?);
+    }
+    Ok(read_npy(
+        path,
+        ExpectedArray::cage_vertices(rows, vertices),
+    )?)
 }

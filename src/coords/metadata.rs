@@ -446,17 +446,10 @@ pub fn read_metadata(path: &Path) -> Result<WeightsMetadata, MetadataError> {
 
 /// The bytes of the class mask: a 1-D int8 `.npy` of `codes`.
 pub fn write_classes_npy_to(out: &mut dyn Write, codes: &[i8]) -> std::io::Result<()> {
-    let mut header = format!(
-        "{{'descr': '|i1', 'fortran_order': False, 'shape': ({},), }}",
-        codes.len()
-    );
-    let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
-    header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
-    header.push('\n');
-    out.write_all(b"\x93NUMPY\x01\x00")?;
     // A 1-D header is well under 64 KiB, whatever the length.
-    out.write_all(&(header.len() as u16).to_le_bytes())?;
-    out.write_all(header.as_bytes())?;
+    let preamble = super::npy_header::header_bytes("|i1", &[codes.len() as u64])
+        .map_err(std::io::Error::other)?;
+    out.write_all(&preamble)?;
     let bytes: Vec<u8> = codes.iter().map(|&c| c as u8).collect();
     out.write_all(&bytes)
 }
@@ -485,8 +478,8 @@ pub fn read_classes_npy(path: &Path, rows: usize) -> Result<Vec<i8>, MetadataErr
     }
     if header.shape != [rows as u64] {
         return Err(classes(format!(
-            "expected shape ({rows},), one class per weights row, found {:?}",
-            header.shape
+            "expected shape ({rows},), one class per weights row, found {}",
+            super::npy_header::shape_text(&header.shape)
         )));
     }
     let start = usize::try_from(header.data_offset).unwrap_or(usize::MAX);

@@ -26,7 +26,7 @@ pub mod harmonic;
 pub mod metadata;
 pub mod mvc;
 pub mod npy;
-pub mod npy_header;
+pub use crate::geometry::npy_header;
 pub mod npz;
 pub mod pmvc;
 pub mod quality;

@@ -15,9 +15,9 @@ pub const NEGATIVE_TOLERANCE: f64 = 1e-7;
 /// Quality of one set of weights against the points and cage they were bound for.
 ///
 /// Negativity is measured over the vertices inside the cage (and on it), where a
-/// family's promise holds; vertices outside get MVC weights under every family's
-/// outside policy, so their negative weights are reported apart and say nothing
-/// about the family.
+/// family's promise holds; vertices outside follow the family's outside policy
+/// (MVC weights, or Green coordinates' exterior extension), which promises no
+/// sign, so their negative weights are reported apart.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WeightQuality {
     /// Inside vertices with any weight < -NEGATIVE_TOLERANCE, as a share of the

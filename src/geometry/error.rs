@@ -17,7 +17,7 @@ pub enum LoadError {
     Empty { path: PathBuf },
     #[error("{path}: not a text mesh file (binary data near byte {offset})", path = shown_path(path))]
     Binary { path: PathBuf, offset: usize },
-    #[error("{path}: unknown mesh format (expected a .obj or .off file)", path = shown_path(path))]
+    #[error("{path}: unknown mesh format (expected a .obj or .off file, or a .npy point set)", path = shown_path(path))]
     UnknownFormat { path: PathBuf },
     #[error("{path}:{line}: {message}", path = shown_path(path))]
     Parse {
@@ -46,6 +46,9 @@ pub enum LoadError {
     },
     #[error("{path}: {message}", path = shown_path(path))]
     Obj { path: PathBuf, message: String },
+    /// A `.npy` point set that is not an (n, 3) array of finite floats.
+    #[error("{path}: {message}", path = shown_path(path))]
+    Npy { path: PathBuf, message: String },
     #[error("{path}: {count} vertices is more than the {limit} this tool supports", path = shown_path(path))]
     TooLarge {
         path: PathBuf,

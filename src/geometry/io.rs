@@ -4,7 +4,9 @@
 use super::budget::{available_memory, bytes_for, check_memory, read_limited_text};
 use super::error::{CageLoadError, WriteError};
 use super::normals::vertex_normals;
+use super::obj::MAX_VERTICES;
 use super::output::{human_bytes, write_atomically};
+use super::points_npy::read_points_npy;
 use super::{obj, off, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
 use std::io::Write;
@@ -23,6 +25,7 @@ fn format_of(path: &Path) -> Result<MeshFormat, LoadError> {
     match extension.as_deref() {
         Some("obj") => Ok(MeshFormat::Obj),
         Some("off") => Ok(MeshFormat::Off),
+        Some("npy") => Ok(MeshFormat::Npy),
         _ => Err(LoadError::UnknownFormat {
             path: path.to_owned(),
         }),
@@ -62,18 +65,24 @@ fn parse_memory(format: MeshFormat, text: &[u8]) -> u64 {
         ],
         // Per line at most one position; per number at most a triangle's share.
         MeshFormat::Off => [text, bytes_for(lines, 24), bytes_for(tokens, 8)],
+        // Binary: never parsed as text.
+        MeshFormat::Npy => [text, 0, 0],
     };
     total.into_iter().fold(0, u64::saturating_add)
 }
 
-/// Read an OBJ or OFF file (chosen by extension, case-insensitive), refusing
-/// what would not fit in memory before allocating it: a regular file by its
-/// size (its text and a copy) before it is read, then every file by what its
-/// text holds ([`parse_memory`]) before it is parsed. A device or pipe, which
-/// has no size, is read up to [`MESH_FILE_LIMIT`] or half the memory available,
-/// and no further than a NUL byte.
+/// Read an OBJ or OFF file, or a `.npy` point set (chosen by extension,
+/// case-insensitive), refusing what would not fit in memory before allocating
+/// it: a regular file by its size (its text and a copy) before it is read, then
+/// every file by what its text holds ([`parse_memory`]) before it is parsed. A
+/// device or pipe, which has no size, is read up to [`MESH_FILE_LIMIT`] or half
+/// the memory available, and no further than a NUL byte. A `.npy` is read by
+/// [`super::points_npy`]'s rules: an (n, 3) array of finite float32 or float64.
 pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
     let format = format_of(path)?;
+    if format == MeshFormat::Npy {
+        return read_points_npy(path, MAX_VERTICES);
+    }
     let io_error = |source| LoadError::Io {
         path: path.to_owned(),
         source,
@@ -153,6 +162,10 @@ pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
     match format_of(path)? {
         MeshFormat::Obj => obj::parse_obj(path, text),
         MeshFormat::Off => off::parse_off(path, &text),
+        MeshFormat::Npy => Err(LoadError::Npy {
+            path: path.to_owned(),
+            message: "a .npy point set is binary; read it with load_mesh".to_owned(),
+        }),
     }
 }
 

@@ -11,10 +11,12 @@ mod error;
 mod intersect;
 mod io;
 mod normals;
+pub mod npy_header;
 mod obj;
 mod off;
 mod output;
 mod ply;
+mod points_npy;
 pub mod procedural;
 pub mod subdivide;
 pub mod twisted_bar;
@@ -25,6 +27,7 @@ pub use classify::{
     generalized_winding_number, PointClass, PointClasses,
 };
 pub use error::{shown_path, CageError, CageLoadError, LoadError, WriteError};
+pub use intersect::{find_crossing, Crossing};
 pub use io::{
     cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_mesh_with_normals,
     write_obj, write_obj_to,
@@ -35,6 +38,7 @@ pub use output::{
     resolve_output, write_atomically, OutputSet, OutputTarget, PendingOutput, WriteSeek,
 };
 pub use ply::{colour_byte, write_coloured_ply};
+pub use points_npy::write_points_npy;
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;
@@ -79,6 +83,8 @@ pub fn bounds_of(points: &[DVec3]) -> (DVec3, DVec3) {
 pub enum MeshFormat {
     Obj,
     Off,
+    /// An (n, 3) float32 or float64 NumPy array: a point set.
+    Npy,
 }
 
 /// A mesh as read from a file, with what is needed to write it back deformed.

@@ -11,7 +11,7 @@ use glam::DVec3;
 use std::path::Path;
 
 /// Largest vertex ordinal that survives the round trip through tobj's f32 positions.
-const MAX_VERTICES: usize = 1 << 24;
+pub(super) const MAX_VERTICES: usize = 1 << 24;
 
 pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError> {
     let parse_error = |line: usize, message: String| LoadError::Parse {

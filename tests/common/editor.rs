@@ -66,9 +66,9 @@ fn render_state_with(
     }
 }
 
-/// The user guide's pose of the default scene: one prong bent sideways.
+/// The user guide's pose of the default scene: the middle prong's tip pushed forward.
 pub fn guide_pose() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-sideways.obj")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/poses/middle-finger-forward.obj")
 }
 
 pub fn editor() -> Option<Harness<'static, EditorApp>> {

@@ -60,6 +60,8 @@ impl FileAction {
             FileAction::OpenSession | FileAction::SaveSession => &["json"],
             FileAction::SaveImage => &["png"],
             FileAction::ExportColouredMesh => &["ply"],
+            // Point sets (n × 3 arrays) open wherever a mesh does.
+            FileAction::OpenMesh | FileAction::LoadPose => &["obj", "off", "npy"],
             _ => &["obj", "off"],
         }
     }

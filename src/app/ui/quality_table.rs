@@ -63,16 +63,17 @@ impl EditorApp {
                     ui.end_row();
                 }
                 ui.label("outside vertices").on_hover_text(
-                    "Vertices outside the cage get MVC weights under every method \
-                     (the outside policy), so their negative weights are counted here, \
-                     not above.",
+                    "Vertices outside the cage follow each family's outside policy \
+                     (MVC weights under MVC, PMVC and HC; Green coordinates' own \
+                     exterior extension under Green), so their negative weights are \
+                     counted here, not above.",
                 );
                 for _ in &methods {
                     ui.label(outside.to_string());
                 }
                 ui.end_row();
                 if outside > 0 {
-                    ui.label("outside: with λ < 0 (MVC)");
+                    ui.label("outside: with λ < 0");
                     for &method in &methods {
                         ui.label(self.document.bound(method).map_or("—".into(), |set| {
                             set.quality.outside_negative_vertices.to_string()

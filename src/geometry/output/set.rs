@@ -58,6 +58,14 @@ impl OutputSet {
         Ok(OutputSet { outputs })
     }
 
+    /// An error unless output `index`'s file system has room for `bytes` more
+    /// ([`PendingOutput::check_space`]).
+    pub fn check_space(&self, index: usize, bytes: u64) -> Result<(), WriteError> {
+        self.outputs
+            .get(index)
+            .map_or(Ok(()), |output| output.check_space(bytes))
+    }
+
     /// Write output `index` with `write(index, out)`, for each in order, then
     /// replace the targets by the rules above.
     pub fn finish(

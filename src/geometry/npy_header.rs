@@ -5,8 +5,8 @@
 
 use std::io::Read;
 
-/// The most header bytes a weights file may declare. NumPy's own reader refuses
-/// more than 10,000 unless told otherwise; a weights header is under 128.
+/// The most header bytes a weights or point-set file may declare. NumPy's own
+/// reader refuses more than 10,000 unless told otherwise; theirs are under 128.
 pub const MAX_HEADER_BYTES: u64 = 1 << 16;
 
 /// What the header says about the values that follow it.
@@ -27,7 +27,9 @@ pub enum HeaderError {
     NoMagic,
     #[error(".npy format version {major}.{minor} is not one NumPy writes (1.0, 2.0 or 3.0)")]
     Version { major: u8, minor: u8 },
-    #[error("its .npy header declares {declared} bytes, more than the {MAX_HEADER_BYTES} a weights header may be")]
+    #[error(
+        "its .npy header declares {declared} bytes, more than the {MAX_HEADER_BYTES} pmvc reads"
+    )]
     HeaderTooLong { declared: u64 },
     #[error(
         "truncated in its .npy header: the header needs {needed} bytes, the file holds {present}"
@@ -110,6 +112,39 @@ pub fn read_fully(reader: &mut impl Read, buffer: &mut [u8]) -> std::io::Result<
         }
     }
     Ok(filled)
+}
+
+/// A shape as NumPy prints it: `(12,)`, `(4, 3)`.
+pub fn shape_text(shape: &[u64]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// The bytes before the values of a version 1.0 `.npy` in C order: magic,
+/// version, header length and the dict, padded with spaces and a newline to a
+/// multiple of 64 bytes, as NumPy writes it. An error when the dict is too long
+/// for version 1.0's two-byte length.
+pub fn header_bytes(descr: &str, shape: &[u64]) -> Result<Vec<u8>, String> {
+    let shape = shape_text(shape);
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
+    header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
+    header.push('\n');
+    let length = u16::try_from(header.len())
+        .map_err(|_| format!("shape {shape} is too long for a .npy header"))?;
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&length.to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    Ok(bytes)
 }
 
 fn malformed(what: impl Into<String>) -> HeaderError {

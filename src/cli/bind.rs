@@ -1,0 +1,229 @@
+//! `pmvc bind`: the weights of every mesh vertex, computed whole or in blocks of
+//! rows and written as `.npy` (or Green coordinates' `.npz`), with what a reader
+//! needs to trust them beside them: `W.json` (the family, its parameters, the
+//! backend, the bind's time, the columns, the inputs; [`crate::coords::metadata`])
+//! and `W.classes.npy` (each row's class). The three are replaced together or
+//! not at all.
+
+use super::commands::{
+    bind_rows, check_output, choose_backend, load_input, method_label, outside_note,
+    outside_policy, progress_bar, summary, BoundInput, InputRules,
+};
+use super::weights_format::{check_weights_format, writes_npz};
+use super::BindArgs;
+use crate::coords::metadata::{
+    class_codes, classes_path, metadata_path, write_classes_npy_to, BindRecord, WeightsMetadata,
+};
+use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values};
+use crate::coords::npz::{npz_payload_bytes, write_npz};
+use crate::geometry::{
+    refuse_same_file, refuse_unwritable, resolve_output, shown_path, OutputSet, OutputTarget,
+};
+use crate::gpu::Backend;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// Rows a streamed bind computes and writes at a time when `--block-rows` is not
+/// given: 256 MiB of weights, so that memory stays flat however large the mesh.
+const BLOCK_BYTES: usize = 256 << 20;
+
+/// Rows held at once by `pmvc bind`: everything for a family that solves for the
+/// whole cage or is written as a `.npz` (array after array), a block for one whose
+/// rows are independent.
+fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
+    if args.method.method.spec().rows_independent && !writes_npz(args.method.method) {
+        let block = args
+            .block_rows
+            .map_or(BLOCK_BYTES / (4 * columns.max(1)), |rows| {
+                usize::try_from(rows).unwrap_or(usize::MAX)
+            });
+        rows.min(block.max(1))
+    } else {
+        rows
+    }
+}
+
+/// The class mask and metadata that go beside the weights `out`, each refused
+/// by the rules `--out` is held to (an input, a file its user may not write, a
+/// folder or block device). None beside a device or pipe, which has no folder
+/// to put them in.
+fn companion_paths(out: &Path, inputs: &[&Path]) -> Result<Vec<PathBuf>> {
+    if matches!(resolve_output(out)?, OutputTarget::Stream(_)) {
+        return Ok(Vec::new());
+    }
+    let paths = vec![classes_path(out), metadata_path(out)];
+    for path in &paths {
+        refuse_same_file(path, inputs)?;
+        refuse_unwritable(path)?;
+        resolve_output(path)?;
+    }
+    Ok(paths)
+}
+
+/// How the bind went, for the metadata and the summary line.
+#[derive(Default)]
+struct BindDone {
+    device: String,
+    on_gpu: bool,
+    seconds: f64,
+}
+
+pub(super) fn bind(args: &BindArgs) -> Result<()> {
+    let inputs = [args.input.mesh.as_path(), args.input.cage.as_path()];
+    check_weights_format(args)?;
+    let (extensions, what): (&[&str], _) = if writes_npz(args.method.method) {
+        (&["npz"], "phi and psi float32 arrays in .npz format")
+    } else {
+        (&["npy"], "float32 weights in .npy format")
+    };
+    check_output(&args.out, &inputs, extensions, what)?;
+    let companions = companion_paths(&args.out, &inputs)?;
+    // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
+    // on the driver: do it while the inputs load and are classified.
+    let choice = args.method.backend;
+    let probe = std::thread::spawn(move || choose_backend(choice));
+    let method = args.method.method;
+    let input = load_input(
+        &args.input,
+        &InputRules {
+            method,
+            strict: args.method.strict,
+            outside_policy: outside_policy(Some(method)),
+            resident_rows: &|rows, columns| bind_resident_rows(args, rows, columns),
+        },
+    )?;
+    let backend = probe
+        .join()
+        .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
+    let rows = input.mesh.mesh.positions.len();
+    let columns = method.columns(&input.cage);
+    // Opened before the work, so that a full disk or an unwritable folder is
+    // reported now, and a signal during the bind removes the temporary files.
+    let mut paths = vec![args.out.as_path()];
+    paths.extend(companions.iter().map(PathBuf::as_path));
+    let outputs = OutputSet::create(&paths)?;
+    outputs.check_space(
+        0,
+        if writes_npz(method) {
+            npz_payload_bytes(rows, columns)
+        } else {
+            npy_file_bytes(rows, columns)
+        },
+    )?;
+    let done = bind_to(args, &input, backend, outputs, rows, columns)?;
+    let shape = if writes_npz(method) {
+        let vertices = input.cage.vertex_count();
+        format!(
+            "phi {rows} × {vertices} and psi {rows} × {} float32",
+            columns - vertices
+        )
+    } else {
+        format!("{rows} × {columns} float32 weights")
+    };
+    let beside = match companions.as_slice() {
+        [classes, json] => format!(
+            " (classes in {}, metadata in {})",
+            shown_path(classes),
+            shown_path(json)
+        ),
+        _ => String::new(),
+    };
+    summary(format_args!(
+        "wrote {}{beside}: {shape} ({}, {}) bound in {:.2} s; {}",
+        shown_path(&args.out),
+        method_label(args.method.options()),
+        done.device,
+        done.seconds,
+        outside_note(&input)
+    ));
+    Ok(())
+}
+
+/// `W.json` for weights bound from `input` as `done` says.
+fn metadata_json(args: &BindArgs, input: &BoundInput, done: &BindDone) -> String {
+    WeightsMetadata::new(&BindRecord {
+        options: args.method.options(),
+        cage: &input.cage,
+        points: &input.mesh.mesh.positions,
+        classes: &input.classes.classes,
+        backend: if done.on_gpu { "gpu" } else { "cpu" },
+        device: &done.device,
+        seconds: done.seconds,
+        mesh_file: &args.input.mesh.to_string_lossy(),
+        cage_file: &args.input.cage.to_string_lossy(),
+        weights_file: &args.out,
+    })
+    .to_json_pretty()
+}
+
+/// Bind and write the weights, whole or in blocks of rows, then the class mask
+/// and the metadata (`outputs` holds the weights first, then any companions).
+fn bind_to(
+    args: &BindArgs,
+    input: &BoundInput,
+    backend: Backend,
+    outputs: OutputSet,
+    rows: usize,
+    columns: usize,
+) -> Result<BindDone> {
+    let block = bind_resident_rows(args, rows, columns);
+    let bar = progress_bar(rows as u64, args.method.method);
+    let codes = class_codes(&input.classes.classes);
+    let preamble = npy_preamble(&args.out, rows, columns)?;
+    if block >= rows {
+        let bound = bind_rows(input, 0..rows, &args.method, &backend, &bar)?;
+        bar.finish_and_clear();
+        let done = BindDone {
+            device: bound.device,
+            on_gpu: bound.on_gpu,
+            seconds: bound.seconds,
+        };
+        let json = metadata_json(args, input, &done);
+        let npz = writes_npz(args.method.method);
+        let vertices = args.method.method.vertex_columns(&input.cage);
+        let weights = &bound.weights;
+        outputs.finish_seekable(|index, out| match index {
+            0 if npz => write_npz(out, &args.out, weights, vertices),
+            0 => {
+                out.write_all(&preamble)?;
+                write_f32_values(out, &weights.values)
+            }
+            1 => write_classes_npy_to(out, &codes),
+            _ => out.write_all(json.as_bytes()),
+        })?;
+        return Ok(done);
+    }
+    // In blocks of rows, each written as soon as it is bound: memory stays at one
+    // block, and the disk is the only limit. The metadata, written last, has the
+    // whole bind's time.
+    let mut bind_error = None;
+    let mut done = BindDone::default();
+    let written = outputs.finish(|index, out| match index {
+        0 => {
+            out.write_all(&preamble)?;
+            for start in (0..rows).step_by(block) {
+                let range = start..(start + block).min(rows);
+                match bind_rows(input, range, &args.method, &backend, &bar) {
+                    Ok(bound) => {
+                        done.device = bound.device;
+                        done.on_gpu = bound.on_gpu;
+                        done.seconds += bound.seconds;
+                        write_f32_values(out, &bound.weights.values)?
+                    }
+                    Err(error) => {
+                        bind_error = Some(error);
+                        return Err(std::io::Error::other("the bind failed"));
+                    }
+                }
+            }
+            Ok(())
+        }
+        1 => write_classes_npy_to(out, &codes),
+        _ => out.write_all(metadata_json(args, input, &done).as_bytes()),
+    });
+    bar.finish_and_clear();
+    match (bind_error, written) {
+        (Some(error), _) => Err(error),
+        (None, result) => Ok(result.map(|()| done)?),
+    }
+}

@@ -1,0 +1,175 @@
+//! `pmvc deform`: move every mesh vertex with the cage, with fresh weights or
+//! those `pmvc bind` stored, and write the mesh as OBJ or the points as `.npy`.
+
+use super::commands::{
+    check_output, compute_weights, load_input, method_label, outside_note, outside_policy, summary,
+    InputRules,
+};
+use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
+use super::DeformArgs;
+use crate::coords::metadata::{metadata_path, read_metadata, WeightsMetadata};
+use crate::coords::{BindOptions, Method};
+use crate::geometry::{self, bounds_of, find_crossing, shown_path, Cage};
+use anyhow::{bail, Result};
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+
+/// What `--weights` brings: the family its rows apply as and, when `pmvc bind`
+/// wrote `W.json` beside it, that metadata (and where it was read).
+struct StoredWeights {
+    options: BindOptions,
+    metadata: Option<(PathBuf, WeightsMetadata)>,
+}
+
+/// Read `W.json` beside the weights `path` when it is there: the family and
+/// parameters come from it, and its file must be the format that family is
+/// written in. Without it (weights from an older pmvc, or saved by numpy) one
+/// warning says that nothing can be checked, and the file's format and
+/// `--method` decide the family, as before.
+fn stored_weights(path: &Path, asked: Method) -> Result<StoredWeights> {
+    let json = metadata_path(path);
+    if !json.exists() {
+        let method = stored_family(path, asked)?;
+        warn_line!(
+            "pmvc: {}: warning: no {} beside it (weights from an older pmvc, or saved by numpy), so they cannot be checked against the mesh and cage, and nothing records how they were bound",
+            shown_path(path),
+            shown_path(&json)
+        );
+        return Ok(StoredWeights {
+            options: BindOptions::for_method(method),
+            metadata: None,
+        });
+    }
+    let metadata = read_metadata(&json)?;
+    let options = metadata.options(&json)?;
+    let method = options.method;
+    if writes_npz(method) != is_npz(path) {
+        let format = |npz: bool| if npz { ".npz" } else { ".npy" };
+        bail!(
+            "{}: it is a {}, but its metadata {} says it holds {} coordinates (--method {}), which are written as {}",
+            shown_path(path),
+            format(is_npz(path)),
+            shown_path(&json),
+            method.name(),
+            method.id(),
+            format(writes_npz(method)),
+        );
+    }
+    Ok(StoredWeights {
+        options,
+        metadata: Some((json, metadata)),
+    })
+}
+
+/// Whether `path` asks for the deformed points as a `.npy` array.
+fn writes_points_npy(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+}
+
+pub(super) fn deform(args: &DeformArgs) -> Result<()> {
+    let started = std::time::Instant::now();
+    let mut inputs = vec![
+        args.input.mesh.as_path(),
+        args.input.cage.as_path(),
+        args.deformed_cage.as_path(),
+    ];
+    inputs.extend(args.weights.as_deref());
+    check_output(&args.out, &inputs, &["obj", "npy"], "an OBJ mesh")?;
+    // The family of stored weights decides what the warnings say of vertices
+    // outside the cage, so it is known before the inputs are read.
+    let stored = match &args.weights {
+        Some(path) => Some(stored_weights(path, args.method.method)?),
+        None => None,
+    };
+    let (options, policy) = match &stored {
+        Some(stored) => {
+            let recorded = stored.metadata.is_some() || writes_npz(stored.options.method);
+            let known = recorded.then_some(stored.options.method);
+            (stored.options, outside_policy(known))
+        }
+        None => (
+            args.method.options(),
+            outside_policy(Some(args.method.method)),
+        ),
+    };
+    let method = options.method;
+    let holds_weights = args.weights.is_none();
+    let input = load_input(
+        &args.input,
+        &InputRules {
+            method,
+            strict: args.method.strict,
+            outside_policy: policy,
+            resident_rows: &|rows, _| if holds_weights { rows } else { 0 },
+        },
+    )?;
+    let pose = geometry::load_mesh(&args.deformed_cage)?;
+    let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
+    if found != expected {
+        bail!(
+            "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
+            shown_path(&args.deformed_cage),
+            shown_path(&args.input.cage)
+        );
+    }
+    if let Some((json, metadata)) = stored.as_ref().and_then(|s| s.metadata.as_ref()) {
+        metadata.check_inputs(json, &input.mesh.mesh.positions, &input.cage)?;
+    }
+    warn_if_crossed(&input.cage, &pose.mesh.positions, &args.deformed_cage);
+    let weights = match &args.weights {
+        Some(path) => read_weights_for(path, &input, method)?,
+        None => compute_weights(&input, &args.method)?,
+    };
+    // Displacement form, p + Σλ(c̃ − c): the same as Σλc̃ for weights that
+    // reproduce their points at rest (every family pmvc binds), and better in f32:
+    // Σλc̃ carries each weight's rounding times the cage's distance from the
+    // origin, this form only times how far the cage moved. Rows were checked to
+    // sum to 1 when read, so a translation of the cage moves every vertex with it.
+    let moves = method.column_displacements(&input.cage, &pose.mesh.positions);
+    let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
+    if writes_points_npy(&args.out) {
+        geometry::write_points_npy(&args.out, &deformed)?;
+    } else {
+        geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+    }
+    let source = match (&args.weights, &stored) {
+        (Some(path), Some(stored)) if stored.metadata.is_some() => format!(
+            "{} weights from {}",
+            method_label(stored.options),
+            shown_path(path)
+        ),
+        (Some(path), _) => format!("weights from {}", shown_path(path)),
+        (None, _) => format!("{} weights", method_label(options)),
+    };
+    summary(format_args!(
+        "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",
+        shown_path(&args.out),
+        deformed.len(),
+        started.elapsed().as_secs_f64(),
+        outside_note(&input)
+    ));
+    Ok(())
+}
+
+/// A warning, not an error, when the cage in its pose crosses itself: artists
+/// fold cages on purpose, but the mesh may then pass through itself there. The
+/// faces are the cage file's, 1-based, as `pmvc check` names them.
+fn warn_if_crossed(cage: &Cage, posed: &[DVec3], pose_path: &Path) {
+    let (low, high) = bounds_of(posed);
+    let Some(crossing) = find_crossing(posed, cage.triangles(), (high - low).length()) else {
+        return;
+    };
+    let face = |triangle: usize| {
+        cage.triangle_faces()
+            .get(triangle)
+            .map_or(triangle, |&face| face as usize)
+            + 1
+    };
+    warn_line!(
+        "pmvc: {}: warning: the deformed cage crosses itself: faces {} and {} intersect; the mesh may pass through itself there (deformed anyway)",
+        shown_path(pose_path),
+        face(crossing.first),
+        face(crossing.second)
+    );
+}
