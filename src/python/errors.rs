@@ -91,6 +91,7 @@ pub(super) fn load_error(error: &LoadError) -> PyErr {
         | LoadError::UnknownFormat { path }
         | LoadError::NoVertices { path }
         | LoadError::Obj { path, .. }
+        | LoadError::Npy { path, .. }
         | LoadError::TooLarge { path, .. } => (path, None),
     };
     let kind = match error {

@@ -159,9 +159,9 @@ impl PyCage {
     }
 }
 
-/// Read an OBJ or OFF file: ``(vertices, faces)``, vertices float64 (n, 3) in
-/// file order, faces a list of polygons of 0-based indices (empty for a point
-/// set).
+/// Read an OBJ or OFF file, or a ``.npy`` point set: ``(vertices, faces)``,
+/// vertices float64 (n, 3) in file order, faces a list of polygons of 0-based
+/// indices (empty for a point set).
 #[pyfunction]
 pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
     let file = py

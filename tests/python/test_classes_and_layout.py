@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import pmvc
 from conftest import middle_finger_pose
@@ -111,6 +112,15 @@ def test_quads_stay_quads_and_are_cut_along_their_shorter_diagonal(tmp_path):
     inward = pmvc.Cage(box, [f[::-1] for f in faces])
     assert inward.flipped and inward.faces == faces
     assert any("flipped" in notice for notice in inward.notices)
+
+
+def test_a_npy_point_set_loads_as_points_without_faces(tmp_path, test_points):
+    np.save(tmp_path / "points.npy", test_points)
+    points, faces = pmvc.load_mesh(tmp_path / "points.npy")
+    assert faces == [] and points.tobytes() == test_points.tobytes()
+    np.save(tmp_path / "flat.npy", test_points[:, :2])
+    with pytest.raises(pmvc.FileError, match="flat.npy"):
+        pmvc.load_mesh(tmp_path / "flat.npy")
 
 
 def test_families_lists_every_family_with_its_parameters_and_promise():

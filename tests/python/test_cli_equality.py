@@ -70,16 +70,20 @@ def test_deform_is_what_pmvc_deform_writes_with_stored_and_fresh_weights(
     mesh = write_points_obj(tmp_path / "points.obj", test_points)
     posed = write_cage_obj(tmp_path / "posed.obj", pose, comb_cage.faces)
     cage = str(ASSETS / "comb_cage.obj")
-    # Fresh weights, both sides.
-    run_pmvc(
-        pmvc_bin, "deform", "--mesh", str(mesh), "--cage", cage, "--deformed-cage", str(posed),
-        "--method", "pmvc", "--resolution", "16", "--backend", "cpu",
-        "--out", str(tmp_path / "fresh.obj"),
-    )  # fmt: skip
+    # Fresh weights, both sides; the command line writes the points as float64
+    # .npy, and as OBJ `v` lines (printed with round-trip precision).
+    for out in ("fresh.npy", "fresh.obj"):
+        run_pmvc(
+            pmvc_bin, "deform", "--mesh", str(mesh), "--cage", cage, "--deformed-cage", str(posed),
+            "--method", "pmvc", "--resolution", "16", "--backend", "cpu",
+            "--out", str(tmp_path / out),
+        )  # fmt: skip
     fresh = pmvc.deform(
         test_points, comb_cage, pose, method="pmvc", resolution=16, backend="cpu"
     )
     assert fresh.dtype == np.float64
+    written = np.load(tmp_path / "fresh.npy")
+    assert written.dtype == np.float64 and fresh.tobytes() == written.tobytes()
     np.testing.assert_array_equal(fresh, read_obj_vertices(tmp_path / "fresh.obj"))
     assert np.abs(fresh - test_points).max() > 0.1, "the pose moved nothing"
     # Stored weights (Green's two arrays), applied by both.
@@ -89,11 +93,11 @@ def test_deform_is_what_pmvc_deform_writes_with_stored_and_fresh_weights(
     )  # fmt: skip
     run_pmvc(
         pmvc_bin, "deform", "--mesh", str(mesh), "--cage", cage, "--deformed-cage", str(posed),
-        "--weights", str(tmp_path / "W.npz"), "--out", str(tmp_path / "green.obj"),
+        "--weights", str(tmp_path / "W.npz"), "--out", str(tmp_path / "green.npy"),
     )  # fmt: skip
     weights = pmvc.bind(test_points, comb_cage, method="green", backend="cpu")
     green = pmvc.deform(test_points, comb_cage, pose, weights=weights)
-    np.testing.assert_array_equal(green, read_obj_vertices(tmp_path / "green.obj"))
+    assert green.tobytes() == np.load(tmp_path / "green.npy").tobytes()
 
 
 def test_obj_vertices_print_float64_with_round_trip_precision(pmvc_bin, tmp_path):

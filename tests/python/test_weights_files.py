@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pmvc
-from conftest import ASSETS, middle_finger_pose, read_obj_vertices, run_pmvc, write_cage_obj, write_points_obj
+from conftest import ASSETS, middle_finger_pose, run_pmvc, write_cage_obj, write_points_obj
 
 
 @pytest.mark.parametrize("method,name", [("pmvc", "W.npy"), ("green", "W.npz")])
@@ -54,10 +54,10 @@ def test_pmvc_deform_reads_what_save_weights_writes(pmvc_bin, tmp_path, test_poi
         pmvc_bin, "deform", "--mesh", str(write_points_obj(tmp_path / "p.obj", test_points)),
         "--cage", str(ASSETS / "comb_cage.obj"),
         "--deformed-cage", str(write_cage_obj(tmp_path / "posed.obj", pose, comb_cage.faces)),
-        "--weights", str(tmp_path / "W.npy"), "--out", str(tmp_path / "out.obj"),
+        "--weights", str(tmp_path / "W.npy"), "--out", str(tmp_path / "out.npy"),
     )  # fmt: skip
     np.testing.assert_array_equal(
-        read_obj_vertices(tmp_path / "out.obj"),
+        np.load(tmp_path / "out.npy"),
         pmvc.deform(test_points, comb_cage, pose, weights=weights),
     )
 

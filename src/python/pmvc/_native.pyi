@@ -120,8 +120,9 @@ class Weights:
         ...
 
 def load_mesh(path: Path) -> Tuple[npt.NDArray[np.float64], List[List[int]]]:
-    """Read an OBJ or OFF file: ``(vertices, faces)``, vertices float64 (n, 3)
-    in file order, faces polygons of 0-based indices (empty for a point set)."""
+    """Read an OBJ or OFF file, or a .npy point set: ``(vertices, faces)``,
+    vertices float64 (n, 3) in file order, faces polygons of 0-based indices
+    (empty for a point set)."""
     ...
 
 def bind(
