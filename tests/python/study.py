@@ -5,7 +5,7 @@ coordinates on one scene, deformed to one pose.
     python tests/python/study.py Beast --figure docs/images/python-study-beast.png
 
 "comb" is the bundled comb (assets/) with its middle finger pulled up by 1.5
-finger widths; any other name is a model of ../shared/data/qmvc (NAME.obj,
+times the width of its cage; any other name is a model of ../shared/data/qmvc (NAME.obj,
 NAME_Cage.obj and the target pose NAME_Cage_Deformed.obj), and the study
 prints "not run" when that folder is missing. It prints a Markdown table of
 numbers (tests/python/test_study.py checks that docs/python.md quotes the
@@ -37,8 +37,8 @@ REFERENCE = "PMVC 64²"
 
 def middle_finger_pose(cage: pmvc.Cage, lift: float = 1.5) -> np.ndarray:
     """The comb cage with the tip of its middle finger pulled up (+y) by `lift`
-    times the finger's width: the cage vertices at the top whose x lies in the
-    middle one of the five fingers' x ranges."""
+    times the width of that finger's cage: the cage vertices at the top whose x
+    lies in the middle one of the five fingers' x ranges."""
     vertices = cage.vertices.copy()
     top = vertices[:, 1].max()
     tips = np.flatnonzero(vertices[:, 1] > top - 1e-9)
