@@ -15,7 +15,7 @@ import pmvc
 def test_progress_goes_from_zero_to_total_without_going_back(comb_points, comb_cage):
     calls = []
     pmvc.bind(
-        comb_points, comb_cage, method="pmvc", resolution=48, backend="cpu",
+        comb_points, comb_cage, method="pmvc", resolution=96, backend="cpu",
         progress=lambda done, total: calls.append((done, total)),
     )  # fmt: skip
     total = len(comb_points)
