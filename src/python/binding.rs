@@ -42,6 +42,15 @@ pub(super) fn run_interruptible<T: Send>(
     task: Interruptible<'_, '_>,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    if let Some(callback) = task.progress.filter(|callback| !callback.is_callable()) {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "progress: {} is not callable; pass a function of (done, total)",
+                callback.get_type().name()?
+            ),
+        ));
+    }
     let finished = AtomicBool::new(false);
     let mut failure: Option<PyErr> = None;
     let mut reported: Option<usize> = None;

@@ -119,6 +119,11 @@ def test_work_that_cannot_fit_in_memory_is_refused_with_its_size(box):
     assert isinstance(raised.value, MemoryError)
 
 
+def test_a_progress_that_is_not_callable_is_refused(box):
+    with pytest.raises(pmvc.InputError, match="progress: int is not callable"):
+        pmvc.bind([[0.5, 0.5, 0.5]], box, progress=5)
+
+
 def test_a_parameter_of_another_family_is_not_read(box):
     weights = pmvc.bind([[0.5, 0.5, 0.5]], box, method="mvc", resolution=0, grid=1)
     assert weights.parameters == {}
