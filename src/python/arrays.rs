@@ -36,7 +36,12 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
     if shape.len() != 2 || shape[1] != 3 {
         return Err(error(
             Kind::Input,
-            format!("{what}: shape {shape:?} is not (n, 3)"),
+            format!(
+                "{what}: shape {} is not (n, 3)",
+                crate::geometry::npy_header::shape_text(
+                    &shape.iter().map(|&n| n as u64).collect::<Vec<_>>()
+                )
+            ),
         ));
     }
     let rows = shape[0];

@@ -74,8 +74,11 @@ impl PyWeights {
             return Err(error(
                 Kind::Weights,
                 format!(
-                    "{}: the matrix has shape {shape:?}, but the weights are ({rows}, {columns})",
-                    shown_path(&self.shown())
+                    "{}: the matrix has shape {}, but the weights are ({rows}, {columns})",
+                    shown_path(&self.shown()),
+                    crate::geometry::npy_header::shape_text(
+                        &shape.iter().map(|&n| n as u64).collect::<Vec<_>>()
+                    )
                 ),
             ));
         }

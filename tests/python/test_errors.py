@@ -23,8 +23,8 @@ def box():
 @pytest.mark.parametrize(
     "points,words",
     [
-        (np.zeros((4, 2)), "shape [4, 2] is not (n, 3)"),
-        (np.zeros(3), "shape [3] is not (n, 3)"),
+        (np.zeros((4, 2)), "shape (4, 2) is not (n, 3)"),
+        (np.zeros(3), "shape (3,) is not (n, 3)"),
         (np.zeros((2, 3, 1)), "is not (n, 3)"),
         ([[0.5, 0.5, 0.5], [0.5, np.nan, 0.5]], "row 1 is not finite (0.5, NaN, 0.5)"),
         ([[0.5, 0.5, np.inf]], "row 0 is not finite"),
