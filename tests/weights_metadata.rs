@@ -32,6 +32,28 @@ fn scene() -> (Cage, Vec<DVec3>) {
     (cage, points)
 }
 
+/// The metadata of a CPU bind of `points` to `cage` written to `path`.
+fn cpu_metadata(
+    options: BindOptions,
+    cage: &Cage,
+    points: &[DVec3],
+    classes: &[pmvc::geometry::PointClass],
+    path: &Path,
+) -> WeightsMetadata {
+    WeightsMetadata::new(&BindRecord {
+        options,
+        cage,
+        points,
+        classes,
+        backend: "cpu",
+        device: "CPU",
+        seconds: 0.25,
+        mesh_file: "mesh.obj",
+        cage_file: "cage.obj",
+        weights_file: path,
+    })
+}
+
 fn bind_and_save(dir: &Path, method: Method) -> (std::path::PathBuf, Cage, Vec<DVec3>) {
     let (cage, points) = scene();
     let classes = classify_points(&cage, &points).classes;
@@ -43,18 +65,7 @@ fn bind_and_save(dir: &Path, method: Method) -> (std::path::PathBuf, Cage, Vec<D
         "npy"
     };
     let path = dir.join(format!("W.{extension}"));
-    let metadata = WeightsMetadata::new(&BindRecord {
-        options,
-        cage: &cage,
-        points: &points,
-        classes: &classes,
-        backend: "cpu",
-        device: "CPU",
-        seconds: 0.25,
-        mesh_file: "mesh.obj",
-        cage_file: "cage.obj",
-        weights_file: &path,
-    });
+    let metadata = cpu_metadata(options, &cage, &points, &classes, &path);
     let codes = pmvc::coords::metadata::class_codes(&classes);
     save_weights_set(&path, &weights, &metadata, &codes).unwrap();
     let loaded = load_weights_set(&path).unwrap();
@@ -240,18 +251,7 @@ fn the_three_files_are_replaced_together_or_not_at_all() {
     let mut weights =
         bind_cpu(&points, &classes, &cage, options, &BindProgress::default()).unwrap();
     weights.values.reverse();
-    let metadata = WeightsMetadata::new(&BindRecord {
-        options,
-        cage: &cage,
-        points: &points,
-        classes: &classes,
-        backend: "cpu",
-        device: "CPU",
-        seconds: 0.5,
-        mesh_file: "",
-        cage_file: "",
-        weights_file: &path,
-    });
+    let metadata = cpu_metadata(options, &cage, &points, &classes, &path);
     let codes = vec![0; points.len()];
     assert!(save_weights_set(&path, &weights, &metadata, &codes).is_err());
     let after: Vec<Vec<u8>> = [path.clone(), classes_path(&path)]

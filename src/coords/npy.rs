@@ -4,7 +4,7 @@
 //! through a temporary file that is renamed over the target; reading checks every
 //! declared size before anything that size is allocated.
 
-use super::npy_header::{read_fully, read_header, HeaderError, NpyHeader};
+use super::npy_header::{read_fully, read_header, shape_text, HeaderError, NpyHeader};
 use super::Weights;
 use crate::geometry::budget::{bytes_for, check_memory, TooLarge};
 use crate::geometry::{shown_path, PendingOutput, WriteError};
@@ -146,20 +146,6 @@ impl ExpectedArray {
         } else {
             "this array"
         }
-    }
-}
-
-fn shape_text(shape: &[u64]) -> String {
-    match shape {
-        [one] => format!("({one},)"),
-        _ => format!(
-            "({})",
-            shape
-                .iter()
-                .map(u64::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
     }
 }
 
