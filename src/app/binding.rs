@@ -5,6 +5,7 @@
 use super::bind_queue::{Finished, JobError, JobStatus};
 use super::document::WeightSet;
 use super::editor::EditorApp;
+use super::model::Command;
 use crate::coords::{Method, Parameter};
 use crate::geometry::subdivide_midpoint;
 use crate::gpu::Backend;
@@ -70,7 +71,8 @@ impl EditorApp {
         for method in self.wanted_methods() {
             let options = self.options_for(method);
             let current = self
-                .document
+                .model
+                .document()
                 .bound(method)
                 .is_some_and(|set| set.options.same_weights_as(&options));
             if !current {
@@ -156,7 +158,7 @@ impl EditorApp {
 
     /// Make the parameter controls show what the weights in use were bound with.
     pub(super) fn sync_parameters_with_weights(&mut self) {
-        if let Some(set) = self.document.bound(self.active_method()) {
+        if let Some(set) = self.model.document().bound(self.active_method()) {
             if let Some((spec, value)) = set.options.parameter() {
                 self.bind_options.set(spec.key, value);
             }
@@ -211,7 +213,11 @@ impl EditorApp {
         };
         let method = options.method;
         let uploaded = self.with_renderer(|renderer, device, queue| {
-            renderer.set_outside(queue, &self.document.mesh().positions, &outcome.outside);
+            renderer.set_outside(
+                queue,
+                &self.model.document().mesh().positions,
+                &outcome.outside,
+            );
             renderer.set_weights(
                 device,
                 method,
@@ -240,25 +246,30 @@ impl EditorApp {
             device: outcome.device,
             quality: outcome.quality,
         };
-        self.document.install_weights(method, set, outcome.outside);
+        self.apply(Command::InstallWeights {
+            method,
+            set,
+            outside: outcome.outside,
+        });
         self.viewport.hover_readout = None;
     }
 
     /// Subdivide the cage 1-to-4 at edge midpoints, keeping the current pose
     /// (smoother coordinates near reflex edges, the paper's Figure 4), and rebind.
     pub fn subdivide_cage(&mut self) -> bool {
-        let subdivided = match subdivide_midpoint(self.document.cage(), self.document.pose()) {
-            Ok(subdivided) => subdivided,
-            Err(error) => {
-                self.error(format!("cannot subdivide the cage: {error}"));
-                return false;
-            }
-        };
-        let before = self.document.pose().len();
+        let subdivided =
+            match subdivide_midpoint(self.model.document().cage(), self.model.document().pose()) {
+                Ok(subdivided) => subdivided,
+                Err(error) => {
+                    self.error(format!("cannot subdivide the cage: {error}"));
+                    return false;
+                }
+            };
+        let before = self.model.document().pose().len();
         let after = subdivided.cage.vertex_count();
-        let document = self.document.with_cage(
+        let document = self.model.document().with_cage(
             subdivided.cage,
-            self.document.cage_path().map(Into::into),
+            self.model.document().cage_path().map(Into::into),
             subdivided.pose,
         );
         let camera = self.viewport.cameras();

@@ -382,7 +382,7 @@ impl EditorApp {
     pub fn open_cage_generation(&mut self) {
         let generation = &mut self.cage_generation;
         if !generation.target_chosen {
-            let current = self.document.cage().vertex_count();
+            let current = self.model.document().cage().vertex_count();
             generation.target_vertices = if current > MIN_TARGET_VERTICES {
                 current.min(MAX_TARGET_VERTICES)
             } else {
@@ -400,13 +400,13 @@ impl EditorApp {
 
     /// Generate a cage around the document's mesh in the background.
     pub fn start_cage_generation(&mut self) {
-        let mesh = Arc::clone(self.document.mesh());
+        let mesh = Arc::clone(self.model.document().mesh());
         self.cage_generation.start(mesh);
     }
 
     /// Called every frame: take a finished job's result.
     pub(super) fn poll_cage_generation(&mut self) {
-        let mesh = Arc::clone(self.document.mesh());
+        let mesh = Arc::clone(self.model.document().mesh());
         self.cage_generation.poll(&mesh);
     }
 
@@ -419,7 +419,7 @@ impl EditorApp {
         let cage = proposal.generated.cage;
         let vertices = cage.vertex_count();
         let rest = cage.positions().to_vec();
-        let document = self.document.with_cage(cage, None, rest);
+        let document = self.model.document().with_cage(cage, None, rest);
         self.replace_document(
             document,
             format!("use the generated {vertices}-vertex cage"),

@@ -9,10 +9,10 @@ use super::cage_generation::CageGeneration;
 use super::compare::{HoverReadout, Pane, ViewSettings};
 use super::document::Document;
 use super::exports::ImageRequest;
+use super::model::{Applied, Command, Model, Outcome, Selection, SessionView, Swapped};
 use super::pose_tools::PoseToolSettings;
 use super::readouts::ReadoutCache;
 use super::recent::RecentFiles;
-use super::scene_history::SceneHistory;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::drop_dialog::DroppedFile;
@@ -24,7 +24,6 @@ use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method};
-use crate::geometry::TriMesh;
 use crate::gpu::{Backend, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
 use crate::render::{OrbitCamera, SceneOrigin, SceneUpload, ViewportRenderer};
@@ -49,7 +48,8 @@ pub enum FileRole {
 
 pub struct EditorApp {
     pub(super) gpu: Option<GpuHandles>,
-    pub(super) document: Document,
+    /// The document, its undo log, the gesture under way and the save point.
+    pub(super) model: Model,
     pub(super) queue: BindQueue,
     /// The method a single view shows (`method`) and every family's parameters.
     pub(super) bind_options: BindOptions,
@@ -83,10 +83,6 @@ pub struct EditorApp {
     pub(super) hide_timings: bool,
     /// The first run's line saying what to look at, until it is dismissed.
     pub(super) first_run_hint: bool,
-    /// The pose when a drag on a numeric position field began.
-    pub(super) numeric_drag_start: Option<Vec<DVec3>>,
-    /// Documents replaced by opening files, switching scenes and cage edits.
-    pub(super) scene_history: SceneHistory,
     /// A file dropped on the window, waiting for the user to say what it is.
     pub(super) dropped: Option<DroppedFile>,
     /// File > Generate cage…: its window, job and proposal.
@@ -133,8 +129,10 @@ impl EditorApp {
         let refused_parameters = super::binding::with_asked_parameters(&mut bind_options, &options);
         let mut app = Self {
             gpu,
-            document: Document::new(BundledScene::Comb.title(), mesh, cage)
-                .bundled_as(BundledScene::Comb),
+            model: Model::new(
+                Document::new(BundledScene::Comb.title(), mesh, cage)
+                    .bundled_as(BundledScene::Comb),
+            ),
             queue: BindQueue::new(backend, move || wake_ctx.request_repaint()),
             bind_options,
             view: options.view,
@@ -159,8 +157,6 @@ impl EditorApp {
             binding_paused: false,
             hide_timings: options.hide_timings,
             first_run_hint: false,
-            numeric_drag_start: None,
-            scene_history: SceneHistory::default(),
             dropped: None,
             cage_generation: CageGeneration::new(cc.egui_ctx.clone()),
         };
@@ -186,11 +182,13 @@ impl EditorApp {
             _ => app.error("give a mesh with the cage; showing the default scene"),
         }
         if !opened {
-            app.install_document(app.document.clone());
+            app.install_document(app.model.document().clone());
         }
+        // Opening the files asked for is where editing starts, not an undo step.
+        app.model.apply(Command::ForgetHistory);
         if options.demo_pose && !opened {
-            let pose = scenes::comb_demo_pose(app.document.cage());
-            app.document.edit_pose(pose);
+            let pose = scenes::comb_demo_pose(app.model.document().cage());
+            app.model.apply(Command::edit_pose(pose));
             // Bundled, so there is nothing to lose on quitting.
             app.mark_pose_saved();
             app.first_run_hint = true;
@@ -199,7 +197,7 @@ impl EditorApp {
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
         }
-        let cage_vertices = app.document.pose().len();
+        let cage_vertices = app.model.document().pose().len();
         if options.view.heat_vertex >= cage_vertices {
             app.error(format!(
                 "--heatmap {}: the cage has {cage_vertices} vertices (0 to {}); showing vertex {}",
@@ -208,7 +206,7 @@ impl EditorApp {
                 app.view.heat_vertex
             ));
         }
-        let cage_triangles = app.document.cage().triangle_count();
+        let cage_triangles = app.model.document().cage().triangle_count();
         if let Some(asked) = options.view.heat_triangle.filter(|&t| t >= cage_triangles) {
             app.error(format!(
                 "--heatmap-triangle {asked}: the cage has {cage_triangles} triangles (0 to {}); showing triangle {}",
@@ -216,8 +214,6 @@ impl EditorApp {
                 app.view.heat_triangle.unwrap_or(0)
             ));
         }
-        // Opening the files asked for is where editing starts, not an undo step.
-        app.scene_history.clear();
         // A session opened above has started its binds; starting again would
         // cancel them, and a cancel pauses binding until the user asks.
         if options.session.is_none() || !opened {
@@ -229,7 +225,7 @@ impl EditorApp {
     // ---- read access, for the panels and for tests ------------------------------
 
     pub fn document(&self) -> &Document {
-        &self.document
+        self.model.document()
     }
 
     pub fn view(&self) -> &ViewSettings {
@@ -330,29 +326,66 @@ impl EditorApp {
     /// Make `document` current: the bind queue and the views start afresh on it,
     /// and the camera frames it. Not undoable: for the start-up scene.
     pub(super) fn install_document(&mut self, document: Document) {
-        self.document = document;
+        self.model
+            .apply(Command::InstallDocument(Box::new(document)));
         self.document_swapped(true);
     }
 
     /// Replace the document by `action` ("open cage.obj"), which undo reverses.
     pub(super) fn replace_document(&mut self, document: Document, action: impl Into<String>) {
-        let before = std::mem::replace(&mut self.document, document);
-        self.scene_history.record(before, action.into());
+        self.replace_document_and_view(document, action, false);
+    }
+
+    /// [`Self::replace_document`], and with `view_too` the view settings the
+    /// caller is about to change (a session's), which undo brings back as well.
+    pub(super) fn replace_document_and_view(
+        &mut self,
+        document: Document,
+        action: impl Into<String>,
+        view_too: bool,
+    ) {
+        let view = view_too.then(|| self.session_view());
+        self.model.apply(Command::ReplaceDocument {
+            document: Box::new(document),
+            action: action.into(),
+            view,
+        });
         self.document_swapped(true);
+    }
+
+    /// The view settings a session holds, as shown now.
+    fn session_view(&self) -> SessionView {
+        SessionView {
+            bind_options: self.bind_options,
+            view: self.view,
+            cameras: self.viewport.cameras(),
+        }
+    }
+
+    /// Change the model; a pose refused (of another length) is reported.
+    pub(super) fn apply(&mut self, command: Command) -> Applied {
+        let applied = self.model.apply(command);
+        if let Outcome::Refused(why) = &applied.outcome {
+            log::warn!("refused: {why}");
+        }
+        applied
     }
 
     /// After the document was swapped: the bind queue and the views start afresh
     /// on it, and the camera frames it if asked.
     fn document_swapped(&mut self, frame: bool) {
+        let document = self.model.document();
         self.queue.set_scene(
-            self.document.mesh().positions.as_slice().into(),
-            Arc::clone(self.document.cage()),
+            document.mesh().positions.as_slice().into(),
+            Arc::clone(document.cage()),
         );
         self.readouts.clear();
+        // A drag or a transform under way belonged to the old document.
         self.viewport.reset_interaction();
-        let cage_vertices = self.document.pose().len();
+        self.viewport.modal = None;
+        let cage_vertices = document.pose().len();
         self.view.heat_vertex = self.view.heat_vertex.min(cage_vertices.saturating_sub(1));
-        let cage_triangles = self.document.cage().triangle_count();
+        let cage_triangles = document.cage().triangle_count();
         self.view.heat_triangle = (self.view.heat_triangle)
             .map(|triangle| triangle.min(cage_triangles.saturating_sub(1)));
         self.binding_paused = false;
@@ -367,24 +400,24 @@ impl EditorApp {
     /// What the viewport draws this document relative to: positions on the GPU,
     /// cameras and projections are taken from there ([`SceneOrigin::of_cage`]).
     fn document_origin(&self) -> SceneOrigin {
-        SceneOrigin::of_cage(self.document.cage().positions())
+        SceneOrigin::of_cage(self.model.document().cage().positions())
     }
 
-    /// Show a document back from the scene history with the weights it had,
-    /// without binding again.
-    fn reinstate_document(&mut self, mesh_before: &Arc<TriMesh>) {
-        self.document.mark_all_changed();
-        let same_mesh = Arc::ptr_eq(mesh_before, self.document.mesh());
-        self.document_swapped(!same_mesh);
-        let rest = self.document.mesh().positions.clone();
-        let outside = self.document.outside().to_vec();
+    /// Show a document back from the undo log with the weights it had, without
+    /// binding again, and the view settings its step kept.
+    fn reinstate_document(&mut self, swapped: &Swapped) {
+        self.document_swapped(!swapped.same_mesh);
+        if let Some(view) = swapped.view {
+            self.bind_options = view.bind_options;
+            self.view = view.view;
+            self.viewport.set_cameras(view.cameras);
+        }
+        let document = self.model.document();
+        let rest = document.mesh().positions.clone();
+        let outside = document.outside().to_vec();
         let sets: Vec<_> = Method::ALL
             .iter()
-            .filter_map(|&m| {
-                self.document
-                    .bound(m)
-                    .map(|set| (m, Arc::clone(&set.weights)))
-            })
+            .filter_map(|&m| document.bound(m).map(|set| (m, Arc::clone(&set.weights))))
             .collect();
         let uploaded = self.with_renderer(|renderer, device, queue| {
             renderer.set_outside(queue, &rest, &outside);
@@ -400,12 +433,12 @@ impl EditorApp {
 
     /// Apply what changed in the document to the GPU copy and the caches.
     pub fn sync_gpu(&mut self) {
-        let changes = self.document.take_changes();
+        let changes = self.model.take_changes();
         if changes.scene {
             let origin = self.document_origin();
             self.viewport.set_origin(origin);
-            let mesh = Arc::clone(self.document.mesh());
-            let cage = Arc::clone(self.document.cage());
+            let mesh = Arc::clone(self.model.document().mesh());
+            let cage = Arc::clone(self.model.document().cage());
             self.with_renderer(|renderer, device, _| {
                 renderer.upload_scene(
                     device,
@@ -419,7 +452,7 @@ impl EditorApp {
             });
         }
         if changes.scene || changes.pose {
-            let pose = self.document.pose().to_vec();
+            let pose = self.model.document().pose().to_vec();
             self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
         }
         if changes.scene || changes.pose || !changes.weights.is_empty() {
@@ -434,81 +467,79 @@ impl EditorApp {
 
     // ---- pose editing -----------------------------------------------------------
 
-    /// Undo the last pose edit, or else the last action that replaced the
-    /// document (opening a file, switching scenes, subdividing, resting the cage).
+    /// Undo the last step: a pose edit, or an action that replaced the document
+    /// (opening a file or a session, switching scenes, subdividing, resting the cage).
     pub fn undo(&mut self) {
-        if self.document.history().can_undo() {
-            self.document.undo();
-            return;
-        }
-        let mesh_before = Arc::clone(self.document.mesh());
-        if let Some(action) = self.scene_history.undo(&mut self.document) {
-            self.reinstate_document(&mesh_before);
-            self.info(format!("undid: {action}"));
+        let applied = self.apply(Command::Undo(self.session_view()));
+        if let Some(swapped) = applied.swapped {
+            self.reinstate_document(&swapped);
+            self.info(format!("undid: {}", swapped.action));
         }
     }
 
-    /// Redo what undo reversed: the replacement of the document first if that
-    /// was undone last, else a pose edit.
+    /// Redo what undo reversed last.
     pub fn redo(&mut self) {
-        if self.document.history().can_redo() {
-            self.document.redo();
-            return;
-        }
-        let mesh_before = Arc::clone(self.document.mesh());
-        if let Some(action) = self.scene_history.redo(&mut self.document) {
-            self.reinstate_document(&mesh_before);
-            self.info(format!("redid: {action}"));
+        let applied = self.apply(Command::Redo(self.session_view()));
+        if let Some(swapped) = applied.swapped {
+            self.reinstate_document(&swapped);
+            self.info(format!("redid: {}", swapped.action));
         }
     }
 
     /// What Undo would reverse, for its menu entry ("move handles", "open cage.obj").
     pub fn undo_label(&self) -> Option<String> {
-        if let Some(step) = self.document.history().last() {
-            return Some(step.action().to_owned());
-        }
-        self.scene_history.undo_action().map(Into::into)
+        self.model.undo_label().map(Into::into)
     }
 
     /// What Redo would repeat, for its menu entry.
     pub fn redo_label(&self) -> Option<String> {
-        if let Some(step) = self.document.history().next() {
-            return Some(step.action().to_owned());
-        }
-        self.scene_history
-            .redo_action(&self.document)
-            .map(Into::into)
+        self.model.redo_label().map(Into::into)
     }
 
     pub fn reset_pose(&mut self) {
-        self.document.reset_pose();
+        let rest = self.model.document().cage().positions().to_vec();
+        self.apply(Command::edit_pose(rest));
     }
 
     /// Move one handle to `position`, recording the change for undo.
     pub fn set_handle_position(&mut self, handle: usize, position: DVec3) {
-        self.document.set_handle_position(handle, position);
+        let mut pose = self.model.document().pose().to_vec();
+        if let Some(moved) = pose.get_mut(handle) {
+            *moved = position;
+            self.apply(Command::edit_pose(pose));
+        }
     }
 
     pub fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
-        self.document.select_only(handles);
+        self.select(Selection::only(handles));
+    }
+
+    pub(super) fn select(&mut self, selection: Selection) {
+        self.apply(Command::Select(selection));
     }
 
     pub fn frame_scene(&mut self) {
-        let (centre, radius) = self.document.bounding_sphere();
+        let (centre, radius) = self.model.document().bounding_sphere();
         self.viewport.frame(centre, radius);
     }
 
     /// Frame the selected handles (F), or the whole scene when none is selected.
     /// A single handle is framed with room around it: a tenth of the cage.
     pub fn frame_selection(&mut self) {
-        let pose = self.document.pose();
-        let selected: Vec<DVec3> = self.document.selection().iter().map(|&i| pose[i]).collect();
+        let pose = self.model.document().pose();
+        let selected: Vec<DVec3> = self
+            .model
+            .document()
+            .selection()
+            .iter()
+            .map(|&i| pose[i])
+            .collect();
         if selected.is_empty() {
             self.frame_scene();
             return;
         }
         let (lo, hi) = crate::geometry::bounds_of(&selected);
-        let radius = ((hi - lo).length() / 2.0).max(0.1 * self.document.cage().diagonal());
+        let radius = ((hi - lo).length() / 2.0).max(0.1 * self.model.document().cage().diagonal());
         self.viewport.frame((lo + hi) / 2.0, radius);
     }
 

@@ -125,7 +125,9 @@ impl EditorApp {
                      the difference first"
                         .to_owned()
                 }
-                Colouring::TriangleWeight(_) if self.document.weights(pane.method()).is_some() => {
+                Colouring::TriangleWeight(_)
+                    if self.model.document().weights(pane.method()).is_some() =>
+                {
                     format!(
                         "{} has no per-triangle functions ψ; only Green coordinates do",
                         pane.method()
@@ -138,7 +140,7 @@ impl EditorApp {
         let limit = self.colour_limit(colouring, pane);
         let scale = self.view.scale_of(colouring);
         let outside: std::collections::HashSet<u32> =
-            self.document.outside().iter().copied().collect();
+            self.model.document().outside().iter().copied().collect();
         let colours: Vec<[f32; 3]> = values
             .iter()
             .enumerate()
@@ -152,11 +154,11 @@ impl EditorApp {
             })
             .collect();
         let comments = self.colour_comments(colouring, pane, limit, scale);
-        let positions = self.document.deformed_positions(pane.method());
+        let positions = self.model.document().deformed_positions(pane.method());
         let result = write_coloured_ply(
             path,
             &positions,
-            &self.document.mesh().triangles,
+            &self.model.document().mesh().triangles,
             &colours,
             &comments,
         );
@@ -168,19 +170,24 @@ impl EditorApp {
         match colouring {
             Colouring::Shaded => None,
             Colouring::CageVertexWeight(column) => {
-                let weights = self.document.weights(pane.method())?;
+                let weights = self.model.document().weights(pane.method())?;
                 let column = (column as usize).min(weights.cols.saturating_sub(1));
                 Some((0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
             Colouring::TriangleWeight(triangle) => {
-                let weights = self.document.weights(pane.method())?;
-                let column = self.document.cage().vertex_count() + triangle as usize;
+                let weights = self.model.document().weights(pane.method())?;
+                let column = self.model.document().cage().vertex_count() + triangle as usize;
                 (column < weights.cols)
                     .then(|| (0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
             Colouring::MostNegativeWeight => {
-                let weights = self.document.weights(pane.method())?;
-                let columns = self.document.cage().vertex_count().min(weights.cols);
+                let weights = self.model.document().weights(pane.method())?;
+                let columns = self
+                    .model
+                    .document()
+                    .cage()
+                    .vertex_count()
+                    .min(weights.cols);
                 Some(
                     (0..weights.rows)
                         .map(|r| {
@@ -198,7 +205,7 @@ impl EditorApp {
                 };
                 let a = self.deformed_on_cpu(against)?;
                 let b = self.deformed_on_cpu(shown)?;
-                let size = compare::cage_size(self.document.cage().positions()) as f32;
+                let size = compare::cage_size(self.model.document().cage().positions()) as f32;
                 Some(
                     b.iter()
                         .zip(a.iter())

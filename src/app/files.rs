@@ -4,6 +4,7 @@
 use super::cage_generation::cage_reaches;
 use super::document::Document;
 use super::editor::{EditorApp, FileRole};
+use super::model::Command;
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
@@ -63,9 +64,11 @@ impl EditorApp {
         for note in opened.notes {
             self.info(note);
         }
-        self.replace_document(
+        // Undo brings back the view settings the session replaces, too.
+        self.replace_document_and_view(
             opened.document,
             format!("open session {}", file_title(path)),
+            true,
         );
         let settings = opened.settings;
         self.bind_options = settings.bind_options;
@@ -101,7 +104,7 @@ impl EditorApp {
             view: self.view,
             cameras: self.viewport.camera_list(),
         };
-        match session::save_session(path, &self.document, &settings) {
+        match session::save_session(path, self.model.document(), &settings) {
             Ok(()) => {
                 self.mark_pose_saved();
                 self.session_path = Some(path.to_owned());
@@ -193,7 +196,7 @@ impl EditorApp {
             FileRole::Mesh => match load_mesh(path) {
                 // A cage that holds none of the mesh is replaced by a box, and
                 // the Generate cage window offers a real one.
-                Ok(file) if !cage_reaches(self.document.cage(), &file.mesh) => {
+                Ok(file) if !cage_reaches(self.model.document().cage(), &file.mesh) => {
                     let opened = self.open_mesh_in_box(path, file);
                     if opened {
                         self.remember(RecentEntry::Mesh(path.to_owned()));
@@ -204,9 +207,12 @@ impl EditorApp {
                 Ok(file) => Document::new(
                     file_title(path),
                     file.mesh.clone(),
-                    (**self.document.cage()).clone(),
+                    (**self.model.document().cage()).clone(),
                 )
-                .with_files(Some(file), self.document.cage_path().map(Into::into)),
+                .with_files(
+                    Some(file),
+                    self.model.document().cage_path().map(Into::into),
+                ),
                 Err(error) => {
                     self.error(error.to_string());
                     return false;
@@ -218,7 +224,9 @@ impl EditorApp {
                         self.info(message);
                     }
                     let rest = cage.positions().to_vec();
-                    self.document.with_cage(cage, Some(path.to_owned()), rest)
+                    self.model
+                        .document()
+                        .with_cage(cage, Some(path.to_owned()), rest)
                 }
                 Err(error) => {
                     self.error(error.to_string());
@@ -268,7 +276,7 @@ impl EditorApp {
     /// are one per cage vertex and within the reach a session may hold, so that
     /// what is saved can be opened again.
     pub(super) fn take_pose_file(&mut self, path: &Path, positions: Vec<glam::DVec3>) -> bool {
-        let cage_vertices = self.document.pose().len();
+        let cage_vertices = self.model.document().pose().len();
         if positions.len() != cage_vertices {
             self.error(format!(
                 "{}: the pose has {} vertices but the cage has {cage_vertices}",
@@ -277,13 +285,13 @@ impl EditorApp {
             ));
             return false;
         }
-        let reach = super::session_checks::Reach::of(self.document.cage().positions());
+        let reach = super::session_checks::Reach::of(self.model.document().cage().positions());
         if let Some((number, distance)) = reach.first_beyond(&positions) {
             let problem = reach.describe(number, distance);
             self.error(format!("{}: {problem}", shown_path(path)));
             return false;
         }
-        self.document.edit_pose(positions);
+        self.apply(Command::edit_pose(positions));
         self.mark_pose_saved();
         self.info(format!("loaded pose {}", shown_path(path)));
         true
@@ -294,9 +302,9 @@ impl EditorApp {
         if !self.refuse_overwriting_open_files(path) {
             return false;
         }
-        let cage = self.document.cage();
+        let cage = self.model.document().cage();
         let posed = TriMesh {
-            positions: self.document.pose().to_vec(),
+            positions: self.model.document().pose().to_vec(),
             triangles: cage.triangles().to_vec(),
             triangle_faces: cage.triangle_faces().to_vec(),
         };
@@ -318,8 +326,13 @@ impl EditorApp {
     /// lose the scene's input.
     pub(super) fn refuse_overwriting_open_files(&mut self, path: &Path) -> bool {
         let mut inputs = Vec::new();
-        inputs.extend(self.document.mesh_file().map(|file| file.path.as_path()));
-        inputs.extend(self.document.cage_path());
+        inputs.extend(
+            self.model
+                .document()
+                .mesh_file()
+                .map(|file| file.path.as_path()),
+        );
+        inputs.extend(self.model.document().cage_path());
         match refuse_same_file(path, &inputs) {
             Ok(()) => true,
             Err(error) => {
@@ -334,10 +347,15 @@ impl EditorApp {
         if !self.refuse_overwriting_open_files(path) {
             return false;
         }
-        let positions = self.document.deformed_positions(self.active_method());
-        let result = match self.document.mesh_file() {
+        let positions = self
+            .model
+            .document()
+            .deformed_positions(self.active_method());
+        let result = match self.model.document().mesh_file() {
             Some(file) => write_deformed_mesh(file, &positions, path),
-            None => write_mesh_with_normals(path, &positions, &self.document.mesh().triangles),
+            None => {
+                write_mesh_with_normals(path, &positions, &self.model.document().mesh().triangles)
+            }
         };
         self.report_export(result, path)
     }
@@ -365,23 +383,24 @@ impl EditorApp {
     /// Undo returns to the previous rest shape and its weights.
     pub fn pose_as_rest(&mut self) {
         let method = self.active_method();
-        if self.document.bound(method).is_none() {
+        if self.model.document().bound(method).is_none() {
             self.error(format!(
                 "cannot use the pose as rest shape before {method} is bound: the mesh would not follow the cage"
             ));
             return;
         }
         let mesh = TriMesh {
-            positions: self.document.deformed_positions(method),
-            ..(**self.document.mesh()).clone()
+            positions: self.model.document().deformed_positions(method),
+            ..(**self.model.document().mesh()).clone()
         };
         let cage = self
-            .document
+            .model
+            .document()
             .cage()
-            .with_positions(self.document.pose().to_vec());
-        let document = Document::new(self.document.title(), mesh, cage).with_files(
-            self.document.mesh_file().cloned(),
-            self.document.cage_path().map(Into::into),
+            .with_positions(self.model.document().pose().to_vec());
+        let document = Document::new(self.model.document().title(), mesh, cage).with_files(
+            self.model.document().mesh_file().cloned(),
+            self.model.document().cage_path().map(Into::into),
         );
         let camera = self.viewport.cameras();
         self.replace_document(document, "use pose as rest shape");

@@ -2,8 +2,8 @@
 //! the background, deforms it on the GPU every frame, and edits the cage. Laid
 //! out as egui's demo app is: one state struct, one file per panel.
 //!
-//! - [`document`]: what is edited (mesh, cage, pose, selection, weights, undo);
-//!   private state whose mutators report every change.
+//! - [`model`]: everything undoable (the [`document`], the one undo log, the
+//!   gesture under way, the save point), changed only through `Model::apply`.
 //! - [`bind_queue`]: binding in the background, one job at a time.
 //! - [`editor`]: the [`EditorApp`] that ties them to the viewport; `binding`,
 //!   `files` and `readouts` add its actions, `gpu_readback` what the GPU drew.
@@ -18,19 +18,17 @@ pub mod bind_queue;
 mod binding;
 pub mod cage_generation;
 pub mod compare;
-pub mod document;
 pub mod editor;
 mod exports;
 mod files;
 mod focus;
 mod frame;
 mod gpu_readback;
-pub mod history;
+pub mod model;
 mod offscreen;
 pub mod pose_tools;
 mod readouts;
 pub mod recent;
-pub mod scene_history;
 pub mod scenes;
 mod screenshot;
 mod scripted_drag;
@@ -41,6 +39,7 @@ mod viewport;
 pub mod widgets;
 
 pub use editor::{EditorApp, FileRole};
+pub use model::document;
 pub use offscreen::run_offscreen;
 pub use viewport::TransformKind;
 

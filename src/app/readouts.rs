@@ -53,17 +53,18 @@ impl ReadoutCache {
 impl EditorApp {
     /// The mesh deformed with `method` on the CPU for the current pose (cached).
     pub(super) fn deformed_on_cpu(&mut self, method: Method) -> Option<Arc<Vec<Vec3>>> {
-        let revision = self.document.pose_revision();
+        let revision = self.model.document().pose_revision();
         if let Some((made_for, positions)) = self.readouts.deformed.get(&method) {
             if *made_for == revision {
                 return Some(Arc::clone(positions));
             }
         }
-        let weights = self.document.weights(method)?;
-        let moves = method.column_displacements(self.document.cage(), self.document.pose());
+        let weights = self.model.document().weights(method)?;
+        let moves =
+            method.column_displacements(self.model.document().cage(), self.model.document().pose());
         let positions = Arc::new(compare::deform(
             weights,
-            &self.document.mesh().positions,
+            &self.model.document().mesh().positions,
             &moves,
             self.viewport.origin(),
         ));
@@ -105,16 +106,16 @@ impl EditorApp {
         match colouring {
             Colouring::Shaded => None,
             Colouring::CageVertexWeight(vertex) => {
-                compare::column_range(self.document.weights(method)?, vertex as usize)
+                compare::column_range(self.model.document().weights(method)?, vertex as usize)
             }
             Colouring::TriangleWeight(triangle) => {
-                let column = self.document.cage().vertex_count() + triangle as usize;
-                compare::column_range(self.document.weights(method)?, column)
+                let column = self.model.document().cage().vertex_count() + triangle as usize;
+                compare::column_range(self.model.document().weights(method)?, column)
             }
             Colouring::MostNegativeWeight => {
-                let weights = self.document.weights(method)?;
-                let cage_vertices = self.document.cage().vertex_count();
-                compare::row_minimum_range(weights, cage_vertices, self.document.outside())
+                let weights = self.model.document().weights(method)?;
+                let cage_vertices = self.model.document().cage().vertex_count();
+                compare::row_minimum_range(weights, cage_vertices, self.model.document().outside())
             }
             Colouring::MethodDistance => {
                 let Pane::Difference { against, shown } = pane else {
@@ -122,7 +123,7 @@ impl EditorApp {
                 };
                 let a = self.deformed_on_cpu(against)?;
                 let b = self.deformed_on_cpu(shown)?;
-                let size = compare::cage_size(self.document.cage().positions()) as f32;
+                let size = compare::cage_size(self.model.document().cage().positions()) as f32;
                 compare::distance_range(&b, &a, size)
             }
         }
@@ -174,7 +175,7 @@ impl EditorApp {
             colouring,
             scale: self.view.scale_of(colouring),
             colour_limit: self.colour_limit(colouring, pane),
-            cage_size: compare::cage_size(self.document.cage().positions()) as f32,
+            cage_size: compare::cage_size(self.model.document().cage().positions()) as f32,
         }
     }
 }

@@ -79,7 +79,7 @@ impl EditorApp {
                     Ok(from) => {
                         input.events.push(Event::PointerMoved(from));
                         input.events.push(button(from, true));
-                        drag.start = self.document.pose().get(drag.handle).copied();
+                        drag.start = self.model.document().pose().get(drag.handle).copied();
                         drag.phase = Phase::Held { from, frames: 0 };
                     }
                     Err(text) => {
@@ -112,7 +112,7 @@ impl EditorApp {
 
     /// Where the handle to drag is on screen, or why it cannot be dragged.
     fn start_drag(&mut self, handle: usize) -> Result<Pos2, String> {
-        let count = self.document.pose().len();
+        let count = self.model.document().pose().len();
         if handle >= count {
             return Err(format!(
                 "--drag {handle}: the cage has {count} vertices (0 to {})",
@@ -132,9 +132,9 @@ impl EditorApp {
 
     fn report_drag(&mut self, drag: &ScriptedDrag, now: f64) {
         let handle = drag.handle;
-        let now_at = self.document.pose().get(handle).copied();
+        let now_at = self.model.document().pose().get(handle).copied();
         let moved = now_at.zip(drag.start).map_or(0.0, |(a, b)| a.distance(b));
-        let diagonal = self.document.cage().diagonal();
+        let diagonal = self.model.document().cage().diagonal();
         let Some(since) = drag.moving_since.filter(|_| moved > 0.0) else {
             self.error(format!("--drag {handle}: the handle did not move"));
             return;

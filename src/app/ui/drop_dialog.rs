@@ -77,7 +77,7 @@ impl EditorApp {
             |n| n.to_string_lossy().into(),
         );
         let vertices = dropped.vertex_count();
-        let cage_vertices = self.document.pose().len();
+        let cage_vertices = self.model.document().pose().len();
         let mut choice = None;
         egui::Window::new("Open dropped file")
             .collapsible(false)

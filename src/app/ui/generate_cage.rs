@@ -48,10 +48,10 @@ impl EditorApp {
     fn generate_cage_contents(&mut self, ui: &mut egui::Ui) -> Option<Request> {
         let mut request = None;
         let running = self.cage_generation.is_running();
-        let mesh = self.document.mesh();
+        let mesh = self.model.document().mesh();
         ui.label(format!(
             "Around {}: {} vertices, {} triangles",
-            self.document.title(),
+            self.model.document().title(),
             mesh.positions.len(),
             mesh.triangles.len()
         ));

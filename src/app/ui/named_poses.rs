@@ -4,6 +4,7 @@
 //! what the slider shows.
 
 use crate::app::editor::EditorApp;
+use crate::app::model::{Command, GestureKind, Outcome};
 use glam::DVec3;
 
 /// The rest-to-pose slider. While it is below 100% the document shows a blend of
@@ -14,8 +15,6 @@ pub struct PoseBlend {
     target: Option<(Vec<DVec3>, u64)>,
     /// 0 = rest, 1 = the target.
     amount: f64,
-    /// The pose when a drag of the slider began: the drag is one undo step.
-    drag_start: Option<Vec<DVec3>>,
     /// The name field of "Store".
     new_name: String,
     /// The pose being renamed and the text typed so far.
@@ -38,7 +37,7 @@ impl EditorApp {
     /// The blend shown, 0 to 1 (1 when no blend is under way).
     pub fn pose_blend_amount(&self) -> f64 {
         match &self.pose_blend.target {
-            Some((_, revision)) if *revision == self.document.pose_revision() => {
+            Some((_, revision)) if *revision == self.model.document().pose_revision() => {
                 self.pose_blend.amount
             }
             _ => 1.0,
@@ -48,23 +47,29 @@ impl EditorApp {
     /// Show the rest pose blended `amount` (0 to 1) of the way to the current
     /// pose (or to the pose a blend under way is heading for), as one undo step.
     pub fn set_pose_blend(&mut self, amount: f64) {
-        let before = self.document.pose().to_vec();
+        self.apply(Command::BeginGesture(GestureKind::Blend));
         self.preview_pose_blend(amount);
+        self.end_pose_blend();
+    }
+
+    /// The blend gesture ends as one undo step named by the blend reached.
+    fn end_pose_blend(&mut self) {
         let percent = (self.pose_blend.amount * 100.0).round();
-        self.document
-            .record_undo_point_as(before, &format!("blend the pose to {percent}%"));
+        self.apply(Command::EndGesture {
+            action: format!("blend the pose to {percent}%"),
+        });
     }
 
     fn preview_pose_blend(&mut self, amount: f64) {
         let amount = amount.clamp(0.0, 1.0);
         let target = match self.pose_blend.target.take() {
-            Some((target, revision)) if revision == self.document.pose_revision() => target,
-            _ => self.document.pose().to_vec(),
+            Some((target, revision)) if revision == self.model.document().pose_revision() => target,
+            _ => self.model.document().pose().to_vec(),
         };
-        let pose = blend_poses(self.document.cage().positions(), &target, amount);
-        self.document.preview_pose(pose);
+        let pose = blend_poses(self.model.document().cage().positions(), &target, amount);
+        self.apply(Command::PreviewGesture(pose));
         self.pose_blend.amount = amount;
-        self.pose_blend.target = Some((target, self.document.pose_revision()));
+        self.pose_blend.target = Some((target, self.model.document().pose_revision()));
     }
 
     /// Keep the current pose under `name`.
@@ -74,22 +79,22 @@ impl EditorApp {
             self.error("a stored pose needs a name");
             return;
         }
-        self.document.store_named_pose(name);
+        self.apply(Command::StoreNamedPose(name.to_owned()));
         self.info(format!("stored the pose as \"{name}\""));
     }
 
     /// Pose the cage as the named pose at `index`, as one undo step.
     pub fn apply_named_pose(&mut self, index: usize) {
-        if let Some(named) = self.document.named_poses().get(index) {
+        if let Some(named) = self.model.document().named_poses().get(index) {
             let pose = named.positions.clone();
-            self.document.edit_pose(pose);
+            self.apply(Command::edit_pose(pose));
         }
     }
 
     pub(in crate::app) fn named_poses_section(&mut self, ui: &mut egui::Ui) {
         ui.label("Poses");
         let amount_now = self.pose_blend_amount();
-        let at_rest = self.document.pose() == self.document.cage().positions();
+        let at_rest = self.model.document().pose() == self.model.document().cage().positions();
         let mut percent = amount_now * 100.0;
         ui.horizontal(|ui| {
             ui.label("Rest");
@@ -107,28 +112,24 @@ impl EditorApp {
                 )
                 .on_disabled_hover_text("The cage is at rest: there is no motion to blend.");
             if slider.drag_started() {
-                self.pose_blend.drag_start = Some(self.document.pose().to_vec());
+                self.apply(Command::BeginGesture(GestureKind::Blend));
             }
             if slider.changed() {
-                if self.pose_blend.drag_start.is_some() {
+                if self.model.gesture_under_way() == Some(GestureKind::Blend) {
                     self.preview_pose_blend(percent / 100.0);
                 } else {
                     self.set_pose_blend(percent / 100.0);
                 }
             }
-            if slider.drag_stopped() {
-                if let Some(before) = self.pose_blend.drag_start.take() {
-                    let percent = (self.pose_blend.amount * 100.0).round();
-                    self.document
-                        .record_undo_point_as(before, &format!("blend the pose to {percent}%"));
-                }
+            if slider.drag_stopped() && self.model.gesture_under_way() == Some(GestureKind::Blend) {
+                self.end_pose_blend();
             }
         });
 
         ui.horizontal(|ui| {
             if self.pose_blend.new_name.is_empty() {
                 self.pose_blend.new_name =
-                    format!("pose {}", self.document.named_poses().len() + 1);
+                    format!("pose {}", self.model.document().named_poses().len() + 1);
             }
             let label = ui.label("Name:");
             let field = ui
@@ -149,7 +150,7 @@ impl EditorApp {
         let mut apply = None;
         let mut delete = None;
         let mut rename = None;
-        for (index, named) in self.document.named_poses().iter().enumerate() {
+        for (index, named) in self.model.document().named_poses().iter().enumerate() {
             ui.horizontal(|ui| match &mut self.pose_blend.renaming {
                 Some((renaming, text)) if *renaming == index => {
                     let label = ui.label("New name:");
@@ -184,16 +185,22 @@ impl EditorApp {
             self.apply_named_pose(index);
         }
         if let Some(index) = delete {
-            self.document.delete_named_pose(index);
+            self.apply(Command::DeleteNamedPose(index));
         }
         if let Some((index, name)) = rename {
             let name = name.trim().to_owned();
             if name.is_empty() {
                 self.error("a stored pose needs a name");
-            } else if self.document.rename_named_pose(index, &name) {
-                self.pose_blend.renaming = None;
-            } else {
+            } else if let Outcome::Refused(_) = self
+                .apply(Command::RenameNamedPose {
+                    index,
+                    name: name.clone(),
+                })
+                .outcome
+            {
                 self.error(format!("there is already a pose called \"{name}\""));
+            } else {
+                self.pose_blend.renaming = None;
             }
         }
     }

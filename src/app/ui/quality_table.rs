@@ -37,12 +37,12 @@ impl EditorApp {
     /// Per bound method: negativity, partition of unity, linear precision.
     pub(in crate::app) fn quality_table(&self, ui: &mut egui::Ui) {
         ui.label("Quality");
-        let methods: Vec<_> = self.document.bound_methods().collect();
+        let methods: Vec<_> = self.model.document().bound_methods().collect();
         if methods.is_empty() {
             ui.label("(nothing bound yet)");
             return;
         }
-        let outside = self.document.outside().len();
+        let outside = self.model.document().outside().len();
         egui::Grid::new("quality")
             .num_columns(methods.len() + 1)
             .striped(true)
@@ -58,7 +58,12 @@ impl EditorApp {
                     }
                     ui.label(name);
                     for &method in &methods {
-                        ui.label(self.document.bound(method).map_or("—".into(), value));
+                        ui.label(
+                            self.model
+                                .document()
+                                .bound(method)
+                                .map_or("—".into(), value),
+                        );
                     }
                     ui.end_row();
                 }
@@ -75,9 +80,14 @@ impl EditorApp {
                 if outside > 0 {
                     ui.label("outside: with λ < 0");
                     for &method in &methods {
-                        ui.label(self.document.bound(method).map_or("—".into(), |set| {
-                            set.quality.outside_negative_vertices.to_string()
-                        }));
+                        ui.label(
+                            self.model
+                                .document()
+                                .bound(method)
+                                .map_or("—".into(), |set| {
+                                    set.quality.outside_negative_vertices.to_string()
+                                }),
+                        );
                     }
                     ui.end_row();
                 }

@@ -3,8 +3,8 @@
 //! the last one saved or loaded.
 
 use crate::app::editor::EditorApp;
+use crate::app::model::Command;
 use crate::app::ui::file_dialog::FileAction;
-use glam::DVec3;
 
 /// Where quitting stands.
 #[derive(Clone, Debug, Default)]
@@ -15,8 +15,6 @@ pub struct QuitState {
     confirmed: bool,
     /// "Save pose…" was chosen in the question: quit once the pose is saved.
     after_save: bool,
-    /// The pose as last saved or loaded.
-    saved_pose: Vec<DVec3>,
     /// Close at the next frame (a save asked for by the question succeeded).
     close_next_frame: bool,
 }
@@ -24,13 +22,12 @@ pub struct QuitState {
 impl EditorApp {
     /// The pose differs from the rest pose and from the last one saved or loaded.
     pub fn pose_is_unsaved(&self) -> bool {
-        let pose = self.document.pose();
-        pose != self.document.cage().positions() && pose != self.quit.saved_pose.as_slice()
+        self.model.pose_unsaved()
     }
 
     /// The current pose is on disk (saved, loaded or bundled): quitting keeps it.
     pub(in crate::app) fn mark_pose_saved(&mut self) {
-        self.quit.saved_pose = self.document.pose().to_vec();
+        self.apply(Command::MarkSaved);
     }
 
     /// The quit question is shown.

@@ -2,17 +2,18 @@
 //! cancel), quality, the selected handle's position, and the notices.
 
 use crate::app::editor::EditorApp;
+use crate::app::model::{Command, GestureKind, POSE_EDIT};
 use crate::coords::Method;
 use std::time::Duration;
 
 impl EditorApp {
     pub(in crate::app) fn side_panel(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
-        ui.heading(self.document.title());
+        ui.heading(self.model.document().title());
         ui.label(format!(
             "{} mesh vertices, {} cage vertices",
-            self.document.mesh().positions.len(),
-            self.document.pose().len()
+            self.model.document().mesh().positions.len(),
+            self.model.document().pose().len()
         ));
         ui.separator();
         self.binding_section(ui, &ctx);
@@ -94,16 +95,16 @@ impl EditorApp {
             let unbound = self
                 .wanted_methods()
                 .into_iter()
-                .any(|m| self.document.bound(m).is_none());
+                .any(|m| self.model.document().bound(m).is_none());
             if unbound && ui.button("Bind").clicked() {
                 self.start_bind();
             }
         }
-        if let Some(set) = self.document.bound(self.active_method()) {
+        if let Some(set) = self.model.document().bound(self.active_method()) {
             ui.label(format!("Bound on {}", set.device));
         }
-        if self.document.bound_methods().next().is_some() {
-            let outside = self.document.outside().len();
+        if self.model.document().bound_methods().next().is_some() {
+            let outside = self.model.document().outside().len();
             ui.label(format!("{outside} mesh vertices outside the cage"));
             if outside > 0 {
                 ui.checkbox(&mut self.highlight_outside, "Highlight them");
@@ -112,10 +113,10 @@ impl EditorApp {
     }
 
     fn selection_section(&mut self, ui: &mut egui::Ui) {
-        let selection = self.document.selection();
+        let selection = self.model.document().selection();
         ui.label(format!("Selection: {} handle(s)", selection.len()));
         if let (1, Some(&handle)) = (selection.len(), selection.iter().next()) {
-            let mut position = self.document.pose()[handle];
+            let mut position = self.model.document().pose()[handle];
             let (mut changed, mut drag_started, mut drag_stopped) = (false, false, false);
             ui.label(format!("Handle {handle}"));
             // Fields of a fixed share of the panel: a field sized by its number
@@ -146,19 +147,20 @@ impl EditorApp {
             });
             // Dragging a field is one undo step; typing a value is one each.
             if drag_started {
-                self.numeric_drag_start = Some(self.document.pose().to_vec());
+                self.apply(Command::BeginGesture(GestureKind::NumericDrag));
             }
-            if changed && self.numeric_drag_start.is_some() {
-                let mut pose = self.document.pose().to_vec();
+            let dragging = self.model.gesture_under_way() == Some(GestureKind::NumericDrag);
+            if changed && dragging {
+                let mut pose = self.model.document().pose().to_vec();
                 pose[handle] = position;
-                self.document.preview_pose(pose);
+                self.apply(Command::PreviewGesture(pose));
             } else if changed {
                 self.set_handle_position(handle, position);
             }
-            if drag_stopped {
-                if let Some(start) = self.numeric_drag_start.take() {
-                    self.document.record_undo_point(start);
-                }
+            if drag_stopped && dragging {
+                self.apply(Command::EndGesture {
+                    action: POSE_EDIT.into(),
+                });
             }
         }
         let (can_undo, can_redo) = (self.undo_label().is_some(), self.redo_label().is_some());

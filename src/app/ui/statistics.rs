@@ -69,11 +69,11 @@ impl EditorApp {
             milliseconds(self.stats.worst()),
             self.stats.len()
         ));
-        let mesh = self.document.mesh();
+        let mesh = self.model.document().mesh();
         ui.label(format!(
             "{} triangles, {} weights",
             mesh.triangles.len(),
-            mesh.positions.len() * self.document.pose().len()
+            mesh.positions.len() * self.model.document().pose().len()
         ));
     }
 }

@@ -63,7 +63,7 @@ impl EditorApp {
     /// Which coordinate function the heatmap shows: a cage vertex's, or (Green
     /// coordinates) a cage triangle's ψ.
     fn heatmap_controls(&mut self, ui: &mut egui::Ui) {
-        let triangles = self.document.cage().triangle_count();
+        let triangles = self.model.document().cage().triangle_count();
         let mut of_triangle = self.view.heat_triangle.is_some();
         let label = ui.label("of");
         egui::ComboBox::from_id_salt("heatmap of")
@@ -89,7 +89,7 @@ impl EditorApp {
             self.view.heat_triangle = Some(triangle);
         } else {
             self.view.heat_triangle = None;
-            let last = self.document.pose().len().saturating_sub(1);
+            let last = self.model.document().pose().len().saturating_sub(1);
             let label = ui.label("i =");
             ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
                 .labelled_by(label.id)

@@ -3,6 +3,7 @@
 
 use crate::app::compare::Overlay;
 use crate::app::editor::EditorApp;
+use crate::app::model::{Command, GestureKind, Selection, POSE_EDIT};
 use egui::{Key, KeyboardShortcut, Modifiers, PointerButton, Pos2, Rect};
 use glam::{DVec3, Vec2};
 
@@ -11,10 +12,10 @@ use glam::{DVec3, Vec2};
 pub(in crate::app) enum Drag {
     Orbit,
     Pan,
-    /// Moving the selected handles: the pose when the drag began, and the total
-    /// pointer motion since then (so axis constraints can change mid-drag).
+    /// Moving the selected handles (a gesture of the model's, which keeps the
+    /// pose it began from): the total pointer motion since it began, so axis
+    /// constraints can change mid-drag.
     Move {
-        start_pose: Vec<DVec3>,
         motion: egui::Vec2,
     },
     /// Rubber-band selection from `origin`; `additive` keeps the old selection.
@@ -98,9 +99,9 @@ impl EditorApp {
                 self.view.heat_triangle = None;
             }
             match (picked, modifiers.shift) {
-                (Some(handle), true) => self.document.toggle_selected(handle),
-                (Some(handle), false) => self.document.select_only([handle]),
-                (None, false) => self.document.select_only([]),
+                (Some(handle), true) => self.select(Selection::Toggle(handle)),
+                (Some(handle), false) => self.select(Selection::only([handle])),
+                (None, false) => self.select(Selection::only([])),
                 (None, true) => {}
             }
         }
@@ -114,15 +115,15 @@ impl EditorApp {
                         additive: modifiers.shift,
                     }
                 } else if let Some(handle) = self.pick(origin) {
-                    if !self.document.selection().contains(&handle) {
+                    if !self.model.document().selection().contains(&handle) {
                         if modifiers.shift {
-                            self.document.toggle_selected(handle);
+                            self.select(Selection::Toggle(handle));
                         } else {
-                            self.document.select_only([handle]);
+                            self.select(Selection::only([handle]));
                         }
                     }
+                    self.apply(Command::BeginGesture(GestureKind::Drag));
                     Drag::Move {
-                        start_pose: self.document.pose().to_vec(),
                         motion: egui::Vec2::ZERO,
                     }
                 } else {
@@ -154,11 +155,14 @@ impl EditorApp {
                         .pan(Vec2::new(delta.x, delta.y), rect.height().min(rect.width()));
                     self.viewport.drag = Some(Drag::Pan);
                 }
-                Some(Drag::Move { start_pose, motion }) => {
-                    let motion = motion + delta;
-                    let pose = self.moved_pose(pane, &start_pose, motion, held_axis(ui), rect);
-                    self.document.preview_pose(pose);
-                    self.viewport.drag = Some(Drag::Move { start_pose, motion });
+                Some(Drag::Move { motion }) => {
+                    // A drag whose document was replaced has ended.
+                    if let Some(start) = self.model.gesture_start(GestureKind::Drag) {
+                        let motion = motion + delta;
+                        let pose = self.moved_pose(pane, start, motion, held_axis(ui), rect);
+                        self.apply(Command::PreviewGesture(pose));
+                        self.viewport.drag = Some(Drag::Move { motion });
+                    }
                 }
                 other => self.viewport.drag = other,
             }
@@ -166,8 +170,10 @@ impl EditorApp {
 
         if response.drag_stopped() {
             match self.viewport.drag.take() {
-                Some(Drag::Move { start_pose, .. }) => {
-                    self.document.record_undo_point(start_pose);
+                Some(Drag::Move { .. }) => {
+                    self.apply(Command::EndGesture {
+                        action: POSE_EDIT.into(),
+                    });
                 }
                 Some(Drag::Box { origin, additive }) => {
                     let end = response.interact_pointer_pos().unwrap_or(origin);

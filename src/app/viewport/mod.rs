@@ -175,7 +175,7 @@ impl EditorApp {
         let screen = self
             .viewport
             .projection(pane)?
-            .project_world(*self.document.pose().get(handle)?)?;
+            .project_world(*self.model.document().pose().get(handle)?)?;
         Some(Pos2::new(screen.x, screen.y))
     }
 
@@ -298,7 +298,7 @@ impl EditorApp {
         if kind
             .methods()
             .iter()
-            .any(|&m| self.document.bound(m).is_none())
+            .any(|&m| self.model.document().bound(m).is_none())
         {
             let message = if self.is_binding() {
                 "Binding… the mesh is shown at rest until the weights are ready"
@@ -327,7 +327,7 @@ impl EditorApp {
     /// "PMVC · 32² · bound in 0.41 s" and the like.
     fn pane_title(&self, kind: Pane) -> String {
         match kind {
-            Pane::Method(method) => match self.document.bound(method) {
+            Pane::Method(method) => match self.model.document().bound(method) {
                 Some(set) => {
                     let parameter = set
                         .options
@@ -353,7 +353,7 @@ impl EditorApp {
     /// does not promise positive weights and how many vertices are outside the cage (grey,
     /// and why); for ψ, that it is signed or missing.
     fn colour_bar_note(&self, colouring: Colouring, kind: Pane) -> Option<BarNote> {
-        let outside = self.document.outside().len();
+        let outside = self.model.document().outside().len();
         let method = kind.method();
         let mut notes = Vec::new();
         // The grey swatch goes with the first line, so the outside count leads.
@@ -372,8 +372,8 @@ impl EditorApp {
             notes.push(format!("{method} does not promise positive weights"));
         }
         if let Colouring::TriangleWeight(_) = colouring {
-            let has_triangle_columns =
-                method.columns(self.document.cage()) > method.vertex_columns(self.document.cage());
+            let has_triangle_columns = method.columns(self.model.document().cage())
+                > method.vertex_columns(self.model.document().cage());
             notes.push(if has_triangle_columns {
                 "ψ is signed: blue below 0, red above".to_owned()
             } else {
@@ -454,7 +454,7 @@ impl EditorApp {
         axis: Option<DVec3>,
         rect: Rect,
     ) -> Vec<DVec3> {
-        let selection = self.document.selection();
+        let selection = self.model.document().selection();
         if selection.is_empty() {
             return start_pose.to_vec();
         }

@@ -6,6 +6,7 @@
 //! step. Soft selection and symmetry apply to every edit (`pose_tools`).
 
 use crate::app::editor::EditorApp;
+use crate::app::model::{Command, GestureKind};
 use crate::app::pose_tools::{
     follow_weights, mid_plane, mirror_partners, posed, Pivot, Transform, AXIS_NAMES,
 };
@@ -37,7 +38,6 @@ impl TransformKind {
 pub struct Modal {
     kind: TransformKind,
     pane: usize,
-    start_pose: Vec<DVec3>,
     pivot: DVec3,
     start_pointer: Pos2,
     pointer: Pos2,
@@ -49,11 +49,11 @@ impl EditorApp {
     /// The pose `transform` gives `start` with the current selection, pivot,
     /// soft selection and symmetry.
     pub fn pose_transformed(&self, start: &[DVec3], transform: &Transform) -> Vec<DVec3> {
-        let rest = self.document.cage().positions();
-        let diagonal = self.document.cage().diagonal();
+        let rest = self.model.document().cage().positions();
+        let diagonal = self.model.document().cage().diagonal();
         let tools = &self.pose_tools;
         let soft = tools.soft_selection.then_some(tools.soft_radius * diagonal);
-        let weights = follow_weights(start, self.document.selection(), soft);
+        let weights = follow_weights(start, self.model.document().selection(), soft);
         let partners = tools.symmetry.map(|axis| {
             (
                 axis,
@@ -72,12 +72,12 @@ impl EditorApp {
     /// Per handle, for the cage shader: 0 idle, 1 selected, 2 hovered, and with
     /// soft selection 3 + 255·w for a handle that follows with weight w.
     pub(in crate::app) fn handle_states(&self) -> Vec<u32> {
-        let selection = self.document.selection();
-        let pose = self.document.pose();
+        let selection = self.model.document().selection();
+        let pose = self.model.document().pose();
         let soft = self
             .pose_tools
             .soft_selection
-            .then(|| self.pose_tools.soft_radius * self.document.cage().diagonal());
+            .then(|| self.pose_tools.soft_radius * self.model.document().cage().diagonal());
         let weights = follow_weights(pose, selection, soft);
         (0..pose.len())
             .map(|i| {
@@ -96,20 +96,20 @@ impl EditorApp {
 
     /// Apply `transform` to the selection as one undo step.
     pub fn transform_selection(&mut self, transform: Transform) {
-        let start = self.document.pose().to_vec();
+        let start = self.model.document().pose().to_vec();
         let pose = self.pose_transformed(&start, &transform);
-        self.document.edit_pose(pose);
+        self.apply(Command::edit_pose(pose));
     }
 
     fn pivot_of(&self, pose: &[DVec3]) -> DVec3 {
-        let selection = self.document.selection();
+        let selection = self.model.document().selection();
         match self.pose_tools.pivot {
             Pivot::Cursor => self.pose_tools.cursor,
             Pivot::SelectionCentre if !selection.is_empty() => {
                 selection.iter().filter_map(|&i| pose.get(i)).sum::<DVec3>()
                     / selection.len() as f64
             }
-            Pivot::SelectionCentre => self.document.bounding_sphere().0,
+            Pivot::SelectionCentre => self.model.document().bounding_sphere().0,
         }
     }
 
@@ -123,8 +123,8 @@ impl EditorApp {
         let Some(axis) = self.pose_tools.symmetry else {
             return 0;
         };
-        let rest = self.document.cage().positions();
-        let tolerance = MIRROR_TOLERANCE * self.document.cage().diagonal();
+        let rest = self.model.document().cage().positions();
+        let tolerance = MIRROR_TOLERANCE * self.model.document().cage().diagonal();
         mirror_partners(rest, axis, mid_plane(rest, axis), tolerance)
             .iter()
             .filter(|p| p.is_none())
@@ -137,16 +137,17 @@ impl EditorApp {
 
     /// G, R or S in view `pane` with the pointer at `pointer`.
     fn begin_transform(&mut self, kind: TransformKind, pane: usize, pointer: Pos2) {
-        if self.document.selection().is_empty() {
+        if self.model.document().selection().is_empty() {
             self.info("select handles first: G moves, R rotates and S scales the selection");
             return;
         }
-        let start_pose = self.document.pose().to_vec();
+        // The model keeps the pose the transform starts from.
+        self.apply(Command::BeginGesture(GestureKind::Transform));
+        let start_pose = self.model.document().pose();
         self.viewport.modal = Some(Modal {
             kind,
             pane,
-            pivot: self.pivot_of(&start_pose),
-            start_pose,
+            pivot: self.pivot_of(start_pose),
             start_pointer: pointer,
             pointer,
             axis: None,
@@ -237,23 +238,27 @@ impl EditorApp {
         let Some(modal) = &self.viewport.modal else {
             return;
         };
+        // A transform whose document was replaced has ended.
+        let Some(start) = self.model.gesture_start(GestureKind::Transform) else {
+            self.viewport.modal = None;
+            return;
+        };
         let transform = self.modal_transform(modal);
-        let pose = self.pose_transformed(&modal.start_pose, &transform);
-        self.document.preview_pose(pose);
+        let pose = self.pose_transformed(start, &transform);
+        self.apply(Command::PreviewGesture(pose));
     }
 
     fn confirm_transform(&mut self) {
         self.preview_transform();
         if let Some(modal) = self.viewport.modal.take() {
             let action = format!("{} handles", modal.kind.verb().to_lowercase());
-            self.document
-                .record_undo_point_as(modal.start_pose, &action);
+            self.apply(Command::EndGesture { action });
         }
     }
 
     fn cancel_transform(&mut self) {
-        if let Some(modal) = self.viewport.modal.take() {
-            self.document.preview_pose(modal.start_pose);
+        if self.viewport.modal.take().is_some() {
+            self.apply(Command::CancelGesture);
         }
     }
 
@@ -403,7 +408,7 @@ impl EditorApp {
     pub(super) fn place_cursor(&mut self, pane: usize, pointer: Pos2) {
         let handle = self
             .pick(pointer)
-            .and_then(|h| self.document.pose().get(h).copied());
+            .and_then(|h| self.model.document().pose().get(h).copied());
         let target = match handle {
             Some(at) => Some(at),
             None => self.mesh_point_under(pane, pointer),

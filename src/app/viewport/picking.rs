@@ -3,6 +3,7 @@
 
 use crate::app::compare::{self, HoverReadout};
 use crate::app::editor::EditorApp;
+use crate::app::model::Selection;
 use crate::app::widgets::hover_box;
 use egui::{Pos2, Rect};
 use glam::Vec2;
@@ -24,7 +25,8 @@ impl EditorApp {
         let pane = self.viewport.pane_at(pointer)?;
         let projection = self.viewport.projection(pane)?;
         let pointer = Vec2::new(pointer.x, pointer.y);
-        self.document
+        self.model
+            .document()
             .pose()
             .iter()
             .enumerate()
@@ -47,7 +49,8 @@ impl EditorApp {
             return;
         };
         let inside: Vec<usize> = self
-            .document
+            .model
+            .document()
             .pose()
             .iter()
             .enumerate()
@@ -59,9 +62,9 @@ impl EditorApp {
             .map(|(i, _)| i)
             .collect();
         if additive {
-            self.document.select_more(inside);
+            self.select(Selection::More(inside));
         } else {
-            self.document.select_only(inside);
+            self.select(Selection::Only(inside.into_iter().collect()));
         }
     }
 
@@ -93,8 +96,8 @@ impl EditorApp {
                 Vec2::new(pointer.x, pointer.y),
                 HOVER_RADIUS,
             )?;
-            let cage_vertices = self.document.cage().vertex_count();
-            let weights = self.document.weights(method)?;
+            let cage_vertices = self.model.document().cage().vertex_count();
+            let weights = self.model.document().weights(method)?;
             let readout = HoverReadout::new(weights, method, vertex, cage_vertices)?;
             Some((pane, pointer, readout))
         });

@@ -1,13 +1,13 @@
 //! What the editor edits: a mesh bound to a cage, the cage's pose, the selected
-//! handles, each method's weights once bound, and the undo history of poses.
+//! handles, the named poses and each method's weights once bound.
 //!
-//! The fields are private. Every mutator records what it changed in [`Changes`],
-//! which the editor takes once per frame to update the GPU, and bumps a revision
-//! that the CPU caches compare against, so no code can change the pose or the
-//! weights without the GPU copy and the caches learning about it.
+//! The fields are private and the mutators are the model's alone
+//! ([`super::Model::apply`]). Every mutator records what it changed in
+//! [`Changes`], which the editor takes once per frame to update the GPU, and
+//! bumps a revision that the CPU caches compare against, so no code can change the
+//! pose or the weights without the GPU copy and the caches learning about it.
 
-use super::history::PoseHistory;
-use super::scenes::BundledScene;
+use crate::app::scenes::BundledScene;
 use crate::coords::{BindOptions, Method, WeightQuality, Weights};
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use glam::DVec3;
@@ -45,25 +45,6 @@ pub struct NamedPose {
     pub positions: Vec<DVec3>,
 }
 
-/// What one undo step restores: the pose and the named poses, and the action
-/// that changed them from this state ("pose edit", "store pose wave").
-#[derive(Clone, Debug, PartialEq)]
-pub struct PoseSnapshot {
-    pose: Vec<DVec3>,
-    named_poses: Arc<Vec<NamedPose>>,
-    action: String,
-}
-
-impl PoseSnapshot {
-    /// The action that undo (or redo) of this step reverses (or repeats).
-    pub fn action(&self) -> &str {
-        &self.action
-    }
-}
-
-/// What undo calls a plain pose change.
-const POSE_EDIT: &str = "pose edit";
-
 /// A mesh, its cage, the pose and the weights.
 #[derive(Clone, Debug)]
 pub struct Document {
@@ -80,7 +61,6 @@ pub struct Document {
     weight_sets: BTreeMap<Method, WeightSet>,
     /// Mesh vertices outside the cage, ascending; known once classified.
     outside: Arc<[u32]>,
-    history: PoseHistory,
     changes: Changes,
     /// Bumped by every pose change, so caches of deformed positions can tell.
     pose_revision: u64,
@@ -104,7 +84,6 @@ impl Document {
             selection: BTreeSet::new(),
             weight_sets: BTreeMap::new(),
             outside: Arc::from([]),
-            history: PoseHistory::default(),
             changes: Changes {
                 scene: true,
                 pose: true,
@@ -197,10 +176,6 @@ impl Document {
         &self.outside
     }
 
-    pub fn history(&self) -> &PoseHistory {
-        &self.history
-    }
-
     /// The bundled scene this is, if it is one and unchanged.
     pub fn bundled(&self) -> Option<BundledScene> {
         self.bundled
@@ -255,15 +230,9 @@ impl Document {
         self.edits
     }
 
-    /// Drop the poses undo has put aside: a document being replaced keeps only
-    /// what can be undone.
-    pub fn forget_redo(&mut self) {
-        self.history.clear_redo();
-    }
-
     /// Everything is new to the GPU copy: the document is coming back from the
     /// scene history.
-    pub fn mark_all_changed(&mut self) {
+    pub(in crate::app::model) fn mark_all_changed(&mut self) {
         self.changes = Changes {
             scene: true,
             pose: true,
@@ -273,93 +242,44 @@ impl Document {
     }
 
     /// What changed since the last call; the editor applies it to the GPU.
-    pub fn take_changes(&mut self) -> Changes {
+    pub(in crate::app::model) fn take_changes(&mut self) -> Changes {
         std::mem::take(&mut self.changes)
     }
 
     // ---- pose -----------------------------------------------------------------
 
-    /// Show `pose` without recording an undo step (a drag in progress, whose
-    /// start is recorded once with [`Self::record_undo_point`]).
-    pub fn preview_pose(&mut self, pose: Vec<DVec3>) {
-        if pose.len() == self.pose.len() && pose != self.pose {
+    /// Show `pose`, whose length the model has checked.
+    pub(in crate::app::model) fn set_pose(&mut self, pose: Vec<DVec3>) {
+        if pose != self.pose {
             self.pose = pose;
             self.pose_changed();
         }
     }
 
-    /// Change the pose as one undo step.
-    pub fn edit_pose(&mut self, pose: Vec<DVec3>) {
-        if pose.len() == self.pose.len() && pose != self.pose {
-            self.record(self.pose.clone(), POSE_EDIT);
-            self.pose = pose;
-            self.pose_changed();
-        }
+    /// Bring back a pose and the named poses beside it (undo, redo).
+    pub(in crate::app::model) fn restore_poses(
+        &mut self,
+        pose: Vec<DVec3>,
+        named_poses: Arc<Vec<NamedPose>>,
+    ) {
+        self.named_poses = named_poses;
+        self.set_pose(pose);
     }
 
-    /// Record `before` as the pose to return to: the start of a drag that has
-    /// since moved the pose with [`Self::preview_pose`].
-    pub fn record_undo_point(&mut self, before: Vec<DVec3>) {
-        self.record_undo_point_as(before, POSE_EDIT);
+    /// The named poses, shared with the undo step that keeps them.
+    pub(in crate::app::model) fn named_poses_shared(&self) -> Arc<Vec<NamedPose>> {
+        Arc::clone(&self.named_poses)
     }
 
-    /// [`Self::record_undo_point`] with the name undo gives the step.
-    pub fn record_undo_point_as(&mut self, before: Vec<DVec3>, action: &str) {
-        if before != self.pose {
-            self.record(before, action);
-        }
-    }
-
-    fn record(&mut self, pose: Vec<DVec3>, action: &str) {
-        self.history.record(PoseSnapshot {
-            pose,
-            named_poses: Arc::clone(&self.named_poses),
-            action: action.to_owned(),
-        });
+    /// One more pose edit was recorded for undo.
+    pub(in crate::app::model) fn count_edit(&mut self) {
         self.edits += 1;
-    }
-
-    /// The current state, to be put on the other stack by undo or redo of a step
-    /// named `action`.
-    fn snapshot(&self, action: &str) -> PoseSnapshot {
-        PoseSnapshot {
-            pose: self.pose.clone(),
-            named_poses: Arc::clone(&self.named_poses),
-            action: action.to_owned(),
-        }
-    }
-
-    fn restore(&mut self, snapshot: PoseSnapshot) {
-        self.named_poses = snapshot.named_poses;
-        if snapshot.pose != self.pose {
-            self.pose = snapshot.pose;
-            self.pose_changed();
-        }
-    }
-
-    pub fn undo(&mut self) {
-        let Some(action) = self.history.last().map(|s| s.action.clone()) else {
-            return;
-        };
-        if let Some(snapshot) = self.history.undo(self.snapshot(&action)) {
-            self.restore(snapshot);
-        }
-    }
-
-    pub fn redo(&mut self) {
-        let Some(action) = self.history.next().map(|s| s.action.clone()) else {
-            return;
-        };
-        if let Some(snapshot) = self.history.redo(self.snapshot(&action)) {
-            self.restore(snapshot);
-        }
     }
 
     // ---- named poses ----------------------------------------------------------
 
-    /// Keep the current pose as `name` (replacing a pose of that name), as one
-    /// undo step.
-    pub fn store_named_pose(&mut self, name: &str) {
+    /// Keep the current pose as `name` (replacing a pose of that name).
+    pub(in crate::app::model) fn store_named_pose(&mut self, name: &str) {
         let mut named = (*self.named_poses).clone();
         let pose = NamedPose {
             name: name.to_owned(),
@@ -369,58 +289,24 @@ impl Document {
             Some(existing) => *existing = pose,
             None => named.push(pose),
         }
-        self.change_named_poses(named, &format!("store pose {name}"));
-    }
-
-    /// Forget the named pose at `index`, as one undo step.
-    pub fn delete_named_pose(&mut self, index: usize) {
-        let mut named = (*self.named_poses).clone();
-        if index < named.len() {
-            let removed = named.remove(index);
-            self.change_named_poses(named, &format!("delete pose {}", removed.name));
-        }
-    }
-
-    /// Rename the named pose at `index`, as one undo step; false when another
-    /// pose has that name.
-    pub fn rename_named_pose(&mut self, index: usize, name: &str) -> bool {
-        let mut named = (*self.named_poses).clone();
-        if named
-            .iter()
-            .enumerate()
-            .any(|(i, n)| i != index && n.name == name)
-        {
-            return false;
-        }
-        let Some(pose) = named.get_mut(index) else {
-            return false;
-        };
-        if pose.name != name {
-            let action = format!("rename pose {} to {name}", pose.name);
-            pose.name = name.to_owned();
-            self.change_named_poses(named, &action);
-        }
-        true
-    }
-
-    fn change_named_poses(&mut self, named: Vec<NamedPose>, action: &str) {
-        self.record(self.pose.clone(), action);
         self.named_poses = Arc::new(named);
     }
 
-    pub fn reset_pose(&mut self) {
-        let rest = self.cage.positions().to_vec();
-        self.edit_pose(rest);
+    /// Forget the named pose at `index`.
+    pub(in crate::app::model) fn delete_named_pose(&mut self, index: usize) {
+        let mut named = (*self.named_poses).clone();
+        if index < named.len() {
+            named.remove(index);
+            self.named_poses = Arc::new(named);
+        }
     }
 
-    /// Move one handle to `position` as one undo step.
-    pub fn set_handle_position(&mut self, handle: usize, position: DVec3) {
-        if let Some(&current) = self.pose.get(handle) {
-            if current != position {
-                let mut pose = self.pose.clone();
-                pose[handle] = position;
-                self.edit_pose(pose);
-            }
+    /// Rename the named pose at `index` (the model checks the name is free).
+    pub(in crate::app::model) fn rename_named_pose(&mut self, index: usize, name: &str) {
+        let mut named = (*self.named_poses).clone();
+        if let Some(pose) = named.get_mut(index) {
+            pose.name = name.to_owned();
+            self.named_poses = Arc::new(named);
         }
     }
 
@@ -431,7 +317,7 @@ impl Document {
 
     // ---- selection ------------------------------------------------------------
 
-    pub fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
+    pub(in crate::app::model) fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
         let count = self.pose.len();
         let selection: BTreeSet<usize> = handles.into_iter().filter(|&h| h < count).collect();
         if selection != self.selection {
@@ -441,14 +327,14 @@ impl Document {
     }
 
     /// Add `handles` to the selection.
-    pub fn select_more(&mut self, handles: impl IntoIterator<Item = usize>) {
+    pub(in crate::app::model) fn select_more(&mut self, handles: impl IntoIterator<Item = usize>) {
         let mut selection = self.selection.clone();
         selection.extend(handles);
         self.select_only(selection);
     }
 
     /// Select `handle` if it is not selected, else deselect it.
-    pub fn toggle_selected(&mut self, handle: usize) {
+    pub(in crate::app::model) fn toggle_selected(&mut self, handle: usize) {
         let mut selection = self.selection.clone();
         if !selection.remove(&handle) {
             selection.insert(handle);
@@ -460,7 +346,12 @@ impl Document {
 
     /// Install `method`'s weights, if they fit this document's mesh and cage
     /// (a bind for a scene that has since been replaced does not).
-    pub fn install_weights(&mut self, method: Method, set: WeightSet, outside: Arc<[u32]>) -> bool {
+    pub(in crate::app::model) fn install_weights(
+        &mut self,
+        method: Method,
+        set: WeightSet,
+        outside: Arc<[u32]>,
+    ) -> bool {
         let fits = set.weights.rows == self.mesh.positions.len()
             && set.weights.cols == method.columns(&self.cage);
         if fits {
@@ -485,40 +376,6 @@ mod tests {
         let mut document = Document::new("test", mesh, cube_cage(1.0));
         document.take_changes();
         document
-    }
-
-    #[test]
-    fn every_pose_change_is_reported_and_bumps_the_revision() {
-        let mut document = document();
-        let mut pose = document.pose().to_vec();
-        pose[0] += DVec3::X;
-        document.edit_pose(pose);
-        assert!(document.take_changes().pose);
-        assert_eq!(document.pose_revision(), 1);
-        document.undo();
-        assert!(document.take_changes().pose);
-        assert_eq!(document.pose(), document.cage().positions());
-        document.redo();
-        assert_eq!(document.pose_revision(), 3);
-        assert!(document.take_changes().pose);
-        // A no-op edit changes nothing and records no undo step.
-        document.edit_pose(document.pose().to_vec());
-        assert_eq!(document.take_changes(), Changes::default());
-    }
-
-    #[test]
-    fn a_drag_is_one_undo_step() {
-        let mut document = document();
-        let start = document.pose().to_vec();
-        for step in 1..=5 {
-            let mut pose = start.clone();
-            pose[2].y += f64::from(step);
-            document.preview_pose(pose);
-        }
-        document.record_undo_point(start.clone());
-        document.undo();
-        assert_eq!(document.pose(), start.as_slice());
-        assert!(!document.history().can_undo());
     }
 
     #[test]

@@ -1,0 +1,465 @@
+//! The editor's model: everything undoable — the document, the one undo log, the
+//! gesture under way and the save point. It changes only through
+//! [`Model::apply`], the single caller of the document's mutators: lengths are
+//! checked there, undo steps are made there, and replacing the document ends any
+//! gesture, so no step of one cage can be undone onto another.
+
+pub mod document;
+mod undo_log;
+
+use super::compare::ViewSettings;
+use super::viewport::ViewCameras;
+use crate::coords::{BindOptions, Method};
+use document::{Changes, Document, WeightSet};
+use glam::DVec3;
+use std::collections::BTreeSet;
+use std::sync::Arc;
+use undo_log::{Step, UndoLog};
+
+/// What undo calls a plain pose change.
+pub const POSE_EDIT: &str = "pose edit";
+
+/// One pose change that is previewed while it lasts and is one undo step when it
+/// ends: a handle drag, a G/R/S transform, a drag on a position field, a drag of
+/// the blend slider.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GestureKind {
+    Drag,
+    Transform,
+    NumericDrag,
+    Blend,
+}
+
+#[derive(Debug)]
+struct Gesture {
+    kind: GestureKind,
+    start_pose: Vec<DVec3>,
+}
+
+/// The view settings a session sets beside its document: undoing the opening
+/// of a session brings back the ones it replaced.
+#[derive(Clone, Copy, Debug)]
+pub struct SessionView {
+    pub bind_options: BindOptions,
+    pub view: ViewSettings,
+    pub cameras: ViewCameras,
+}
+
+/// A change of the selection.
+#[derive(Clone, Debug)]
+pub enum Selection {
+    Only(BTreeSet<usize>),
+    More(Vec<usize>),
+    Toggle(usize),
+}
+
+impl Selection {
+    pub fn only(handles: impl IntoIterator<Item = usize>) -> Self {
+        Selection::Only(handles.into_iter().collect())
+    }
+}
+
+/// Every change of the model.
+#[derive(Debug)]
+pub enum Command {
+    /// Change the pose as one undo step called `action`.
+    EditPose {
+        pose: Vec<DVec3>,
+        action: String,
+    },
+    /// Start a gesture from the current pose (ending one under way first).
+    BeginGesture(GestureKind),
+    /// Show `pose` while the gesture lasts; no undo step.
+    PreviewGesture(Vec<DVec3>),
+    /// The gesture ends as one undo step called `action` (none if the pose is
+    /// back where it started).
+    EndGesture {
+        action: String,
+    },
+    /// The gesture ends with the pose it started from.
+    CancelGesture,
+    Select(Selection),
+    StoreNamedPose(String),
+    DeleteNamedPose(usize),
+    RenameNamedPose {
+        index: usize,
+        name: String,
+    },
+    /// A bind's weights, if they fit the document's mesh and cage.
+    InstallWeights {
+        method: Method,
+        set: WeightSet,
+        outside: Arc<[u32]>,
+    },
+    /// Replace the whole document by `action` ("open cage.obj"), as one undo
+    /// step; `view` is the view settings it replaces, when it replaces them.
+    ReplaceDocument {
+        document: Box<Document>,
+        action: String,
+        view: Option<SessionView>,
+    },
+    /// Make `document` current with nothing to undo (the start-up scene).
+    InstallDocument(Box<Document>),
+    /// Forget every step (what start-up opened is where editing begins).
+    ForgetHistory,
+    /// Undo or redo, given the view settings now, which a scene step keeps for
+    /// the way back.
+    Undo(SessionView),
+    Redo(SessionView),
+    /// The current pose is saved (the quit dialog compares against it).
+    MarkSaved,
+}
+
+impl Command {
+    /// A plain pose change as one undo step.
+    pub fn edit_pose(pose: Vec<DVec3>) -> Self {
+        Command::EditPose {
+            pose,
+            action: POSE_EDIT.into(),
+        }
+    }
+}
+
+/// A whole document came back from the undo log.
+#[derive(Debug)]
+pub struct Swapped {
+    /// What was undone or redone ("open cage.obj").
+    pub action: String,
+    pub undone: bool,
+    /// The mesh stayed (a cage edit): the cameras need not frame it again.
+    pub same_mesh: bool,
+    /// The view settings to show with it, when the step kept them.
+    pub view: Option<SessionView>,
+}
+
+/// What applying a command did.
+#[derive(Debug, PartialEq)]
+pub enum Outcome {
+    Unchanged,
+    Changed,
+    /// Refused, with why (a pose of another length, a name in use).
+    Refused(String),
+}
+
+/// The result of [`Model::apply`]: the outcome, and the document swapped in by
+/// undo or redo, which the views and the GPU copy must follow.
+#[derive(Debug)]
+pub struct Applied {
+    pub outcome: Outcome,
+    pub swapped: Option<Swapped>,
+}
+
+impl Applied {
+    fn of(outcome: Outcome) -> Self {
+        Self {
+            outcome,
+            swapped: None,
+        }
+    }
+
+    pub fn changed(&self) -> bool {
+        self.outcome == Outcome::Changed
+    }
+}
+
+#[derive(Debug)]
+pub struct Model {
+    document: Document,
+    log: UndoLog,
+    gesture: Option<Gesture>,
+    /// The pose last saved (a session or a pose file), or opened as saved.
+    saved_pose: Vec<DVec3>,
+}
+
+impl Model {
+    pub fn new(document: Document) -> Self {
+        Self {
+            document,
+            log: UndoLog::default(),
+            gesture: None,
+            saved_pose: Vec::new(),
+        }
+    }
+
+    pub fn document(&self) -> &Document {
+        &self.document
+    }
+
+    /// The pose a gesture of `kind` under way started from.
+    pub fn gesture_start(&self, kind: GestureKind) -> Option<&[DVec3]> {
+        (self.gesture.as_ref())
+            .filter(|g| g.kind == kind)
+            .map(|g| g.start_pose.as_slice())
+    }
+
+    pub fn gesture_under_way(&self) -> Option<GestureKind> {
+        self.gesture.as_ref().map(|g| g.kind)
+    }
+
+    /// What Undo would reverse, for its menu entry.
+    pub fn undo_label(&self) -> Option<&str> {
+        self.log.undo_action()
+    }
+
+    pub fn redo_label(&self) -> Option<&str> {
+        self.log.redo_action()
+    }
+
+    /// The pose differs from the rest pose and from the one last saved.
+    pub fn pose_unsaved(&self) -> bool {
+        let pose = self.document.pose();
+        pose != self.document.cage().positions() && pose != self.saved_pose.as_slice()
+    }
+
+    /// What changed since the last call, for the GPU copy and the caches.
+    pub fn take_changes(&mut self) -> Changes {
+        self.document.take_changes()
+    }
+
+    pub fn apply(&mut self, command: Command) -> Applied {
+        match command {
+            Command::EditPose { pose, action } => Applied::of(self.edit_pose(pose, &action)),
+            Command::BeginGesture(kind) => {
+                self.end_gesture(POSE_EDIT);
+                self.gesture = Some(Gesture {
+                    kind,
+                    start_pose: self.document.pose().to_vec(),
+                });
+                Applied::of(Outcome::Changed)
+            }
+            Command::PreviewGesture(pose) => Applied::of(self.preview(pose)),
+            Command::EndGesture { action } => Applied::of(self.end_gesture(&action)),
+            Command::CancelGesture => Applied::of(self.cancel_gesture()),
+            Command::Select(selection) => {
+                match selection {
+                    Selection::Only(handles) => self.document.select_only(handles),
+                    Selection::More(handles) => self.document.select_more(handles),
+                    Selection::Toggle(handle) => self.document.toggle_selected(handle),
+                }
+                Applied::of(Outcome::Changed)
+            }
+            Command::StoreNamedPose(name) => {
+                self.record_pose_step(&format!("store pose {name}"));
+                self.document.store_named_pose(&name);
+                Applied::of(Outcome::Changed)
+            }
+            Command::DeleteNamedPose(index) => {
+                let Some(name) = self
+                    .document
+                    .named_poses()
+                    .get(index)
+                    .map(|n| n.name.clone())
+                else {
+                    return Applied::of(Outcome::Unchanged);
+                };
+                self.record_pose_step(&format!("delete pose {name}"));
+                self.document.delete_named_pose(index);
+                Applied::of(Outcome::Changed)
+            }
+            Command::RenameNamedPose { index, name } => Applied::of(self.rename(index, &name)),
+            Command::InstallWeights {
+                method,
+                set,
+                outside,
+            } => Applied::of(if self.document.install_weights(method, set, outside) {
+                Outcome::Changed
+            } else {
+                Outcome::Unchanged
+            }),
+            Command::ReplaceDocument {
+                document,
+                action,
+                view,
+            } => {
+                self.cancel_gesture();
+                let before = std::mem::replace(&mut self.document, *document);
+                self.log.record(Step::Scene {
+                    document: Box::new(before),
+                    view,
+                    action,
+                });
+                Applied::of(Outcome::Changed)
+            }
+            Command::InstallDocument(document) => {
+                self.gesture = None;
+                self.document = *document;
+                self.log.clear();
+                Applied::of(Outcome::Changed)
+            }
+            Command::ForgetHistory => {
+                self.log.clear();
+                Applied::of(Outcome::Changed)
+            }
+            Command::Undo(view) => self.step_back_or_forth(true, view),
+            Command::Redo(view) => self.step_back_or_forth(false, view),
+            Command::MarkSaved => {
+                self.saved_pose = self.document.pose().to_vec();
+                Applied::of(Outcome::Changed)
+            }
+        }
+    }
+
+    /// Why `pose` cannot be the document's, if it cannot.
+    fn refuse_length(&self, pose: &[DVec3]) -> Option<Outcome> {
+        let count = self.document.pose().len();
+        (pose.len() != count).then(|| {
+            Outcome::Refused(format!(
+                "a pose of {} positions for a cage of {count} vertices",
+                pose.len()
+            ))
+        })
+    }
+
+    fn edit_pose(&mut self, pose: Vec<DVec3>, action: &str) -> Outcome {
+        if let Some(refused) = self.refuse_length(&pose) {
+            return refused;
+        }
+        if pose == self.document.pose() {
+            return Outcome::Unchanged;
+        }
+        self.record_pose_step(action);
+        self.document.set_pose(pose);
+        Outcome::Changed
+    }
+
+    fn preview(&mut self, pose: Vec<DVec3>) -> Outcome {
+        if self.gesture.is_none() {
+            return Outcome::Refused("no gesture under way".into());
+        }
+        if let Some(refused) = self.refuse_length(&pose) {
+            return refused;
+        }
+        if pose == self.document.pose() {
+            return Outcome::Unchanged;
+        }
+        self.document.set_pose(pose);
+        Outcome::Changed
+    }
+
+    fn end_gesture(&mut self, action: &str) -> Outcome {
+        let Some(gesture) = self.gesture.take() else {
+            return Outcome::Unchanged;
+        };
+        if gesture.start_pose == self.document.pose() {
+            return Outcome::Unchanged;
+        }
+        let named_poses = self.document.named_poses_shared();
+        self.record(Step::Pose {
+            pose: gesture.start_pose,
+            named_poses,
+            action: action.into(),
+        });
+        Outcome::Changed
+    }
+
+    fn cancel_gesture(&mut self) -> Outcome {
+        let Some(gesture) = self.gesture.take() else {
+            return Outcome::Unchanged;
+        };
+        if gesture.start_pose == self.document.pose() {
+            return Outcome::Unchanged;
+        }
+        self.document.set_pose(gesture.start_pose);
+        Outcome::Changed
+    }
+
+    fn rename(&mut self, index: usize, name: &str) -> Outcome {
+        let named = self.document.named_poses();
+        if named
+            .iter()
+            .enumerate()
+            .any(|(i, n)| i != index && n.name == name)
+        {
+            return Outcome::Refused(format!("a pose is already called \"{name}\""));
+        }
+        let Some(old) = named.get(index).map(|n| n.name.clone()) else {
+            return Outcome::Refused(format!("no stored pose {}", index + 1));
+        };
+        if old == name {
+            return Outcome::Unchanged;
+        }
+        self.record_pose_step(&format!("rename pose {old} to {name}"));
+        self.document.rename_named_pose(index, name);
+        Outcome::Changed
+    }
+
+    /// Record the pose and named poses now, which `action` is about to change.
+    fn record_pose_step(&mut self, action: &str) {
+        self.record(Step::Pose {
+            pose: self.document.pose().to_vec(),
+            named_poses: self.document.named_poses_shared(),
+            action: action.into(),
+        });
+    }
+
+    fn record(&mut self, step: Step) {
+        self.log.record(step);
+        self.document.count_edit();
+    }
+
+    /// Undo (`back`) or redo the last step; `view` is what is shown now.
+    fn step_back_or_forth(&mut self, back: bool, view: SessionView) -> Applied {
+        self.cancel_gesture();
+        let step = if back {
+            self.log.take_undo()
+        } else {
+            self.log.take_redo()
+        };
+        let Some(step) = step else {
+            return Applied::of(Outcome::Unchanged);
+        };
+        let (reverse, applied) = match step {
+            Step::Pose {
+                pose,
+                named_poses,
+                action,
+            } => {
+                if let Some(refused) = self.refuse_length(&pose) {
+                    // Cannot happen while steps are made here; refused all the same.
+                    return Applied::of(refused);
+                }
+                let reverse = Step::Pose {
+                    pose: self.document.pose().to_vec(),
+                    named_poses: self.document.named_poses_shared(),
+                    action,
+                };
+                self.document.restore_poses(pose, named_poses);
+                (reverse, Applied::of(Outcome::Changed))
+            }
+            Step::Scene {
+                document,
+                view: kept_view,
+                action,
+            } => {
+                let same_mesh = Arc::ptr_eq(document.mesh(), self.document.mesh());
+                let mut after = std::mem::replace(&mut self.document, *document);
+                after.mark_all_changed();
+                self.document.mark_all_changed();
+                let reverse = Step::Scene {
+                    document: Box::new(after),
+                    view: kept_view.map(|_| view),
+                    action: action.clone(),
+                };
+                let applied = Applied {
+                    outcome: Outcome::Changed,
+                    swapped: Some(Swapped {
+                        action,
+                        undone: back,
+                        same_mesh,
+                        view: kept_view,
+                    }),
+                };
+                (reverse, applied)
+            }
+        };
+        if back {
+            self.log.push_redo(reverse);
+        } else {
+            self.log.push_undo(reverse);
+        }
+        applied
+    }
+}
+
+#[cfg(test)]
+mod tests;
