@@ -9,6 +9,7 @@ use super::model::Command;
 use crate::coords::{Method, Parameter};
 use crate::geometry::subdivide_midpoint;
 use crate::gpu::Backend;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// `options` with the parameters `pmvc edit` was given put over them, each
@@ -212,22 +213,6 @@ impl EditorApp {
             }
         };
         let method = options.method;
-        let uploaded = self.with_renderer(|renderer, device, queue| {
-            renderer.set_outside(
-                queue,
-                &self.model.document().mesh().positions,
-                &outcome.outside,
-            );
-            renderer.set_weights(
-                device,
-                method,
-                Some(&outcome.weights),
-                outcome.resident.as_ref(),
-            )
-        });
-        if let Some(Err(error)) = uploaded {
-            self.error(error.to_string());
-        }
         if self.screenshot.is_some() {
             // A scripted run's record of the bind, for benchmarks.
             eprintln!(
@@ -239,6 +224,7 @@ impl EditorApp {
                 outcome.elapsed.as_secs_f64()
             );
         }
+        let weights = Arc::clone(&outcome.weights);
         let set = WeightSet {
             weights: outcome.weights,
             options,
@@ -246,11 +232,17 @@ impl EditorApp {
             device: outcome.device,
             quality: outcome.quality,
         };
-        self.apply(Command::InstallWeights {
+        let installed = self.apply(Command::InstallWeights {
             method,
             set,
             outside: outcome.outside,
         });
+        // The upload that follows (`sync_gpu`) uses the bind's copy on the device.
+        if let (true, Some(gpu), Some(buffer)) =
+            (installed.changed(), self.gpu.as_mut(), outcome.resident)
+        {
+            gpu.resident_weights = Some((weights, buffer));
+        }
         self.viewport.hover_readout = None;
     }
 

@@ -23,10 +23,10 @@ use super::ui::quit_dialog::QuitState;
 use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
-use crate::coords::{BindOptions, Method};
+use crate::coords::{BindOptions, Method, Weights};
 use crate::gpu::{Backend, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
-use crate::render::{OrbitCamera, SceneOrigin, SceneUpload, ViewportRenderer};
+use crate::render::{OrbitCamera, ViewportRenderer};
 use eframe::egui_wgpu;
 use glam::DVec3;
 use std::path::PathBuf;
@@ -37,6 +37,9 @@ pub(super) struct GpuHandles {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
+    /// A bind's weights and their copy already on this device, for the upload
+    /// of those weights once the model has them.
+    pub resident_weights: Option<(Arc<Weights>, wgpu::Buffer)>,
 }
 
 /// Which kind of file is being opened.
@@ -117,6 +120,7 @@ impl EditorApp {
                 device: state.device.clone(),
                 queue: state.queue.clone(),
                 renderer: Arc::clone(&state.renderer),
+                resident_weights: None,
             }
         });
         let backend = usable_state.map_or(Backend::Cpu, |state| {
@@ -397,14 +401,9 @@ impl EditorApp {
         self.sync_gpu();
     }
 
-    /// What the viewport draws this document relative to: positions on the GPU,
-    /// cameras and projections are taken from there ([`SceneOrigin::of_cage`]).
-    fn document_origin(&self) -> SceneOrigin {
-        SceneOrigin::of_cage(self.model.document().cage().positions())
-    }
-
-    /// Show a document back from the undo log with the weights it had, without
-    /// binding again, and the view settings its step kept.
+    /// Show a document back from the undo log with the weights it had (uploaded
+    /// by [`Self::sync_gpu`], as every change is), without binding again, and the
+    /// view settings its step kept.
     fn reinstate_document(&mut self, swapped: &Swapped) {
         self.document_swapped(!swapped.same_mesh);
         if let Some(view) = swapped.view {
@@ -412,57 +411,7 @@ impl EditorApp {
             self.view = view.view;
             self.viewport.set_cameras(view.cameras);
         }
-        let document = self.model.document();
-        let rest = document.mesh().positions.clone();
-        let outside = document.outside().to_vec();
-        let sets: Vec<_> = Method::ALL
-            .iter()
-            .filter_map(|&m| document.bound(m).map(|set| (m, Arc::clone(&set.weights))))
-            .collect();
-        let uploaded = self.with_renderer(|renderer, device, queue| {
-            renderer.set_outside(queue, &rest, &outside);
-            sets.iter().try_for_each(|(method, weights)| {
-                renderer.set_weights(device, *method, Some(weights), None)
-            })
-        });
-        if let Some(Err(error)) = uploaded {
-            self.error(error.to_string());
-        }
         self.sync_parameters_with_weights();
-    }
-
-    /// Apply what changed in the document to the GPU copy and the caches.
-    pub fn sync_gpu(&mut self) {
-        let changes = self.model.take_changes();
-        if changes.scene {
-            let origin = self.document_origin();
-            self.viewport.set_origin(origin);
-            let mesh = Arc::clone(self.model.document().mesh());
-            let cage = Arc::clone(self.model.document().cage());
-            self.with_renderer(|renderer, device, _| {
-                renderer.upload_scene(
-                    device,
-                    &SceneUpload {
-                        rest_positions: &mesh.positions,
-                        triangles: &mesh.triangles,
-                        cage: &cage,
-                        origin,
-                    },
-                )
-            });
-        }
-        if changes.scene || changes.pose {
-            let pose = self.model.document().pose().to_vec();
-            self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
-        }
-        if changes.scene || changes.pose || !changes.weights.is_empty() {
-            self.readouts.invalidate(&changes);
-        }
-        let hover_changed = self.viewport.take_hover_changed();
-        if changes.scene || changes.selection || hover_changed || self.pose_tools.soft_selection {
-            let states = self.handle_states();
-            self.with_renderer(|renderer, _, queue| renderer.set_handle_states(queue, &states));
-        }
     }
 
     // ---- pose editing -----------------------------------------------------------

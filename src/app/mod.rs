@@ -24,6 +24,7 @@ mod files;
 mod focus;
 mod frame;
 mod gpu_readback;
+mod gpu_sync;
 pub mod model;
 mod offscreen;
 pub mod pose_tools;
