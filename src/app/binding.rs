@@ -4,7 +4,7 @@
 
 use super::bind_queue::{Finished, JobError, JobStatus};
 use super::document::WeightSet;
-use super::editor::EditorApp;
+use super::editor::{EditorApp, Replacement};
 use super::model::Command;
 use crate::coords::{Method, Parameter};
 use crate::geometry::subdivide_midpoint;
@@ -264,13 +264,10 @@ impl EditorApp {
             self.model.document().cage_path().map(Into::into),
             subdivided.pose,
         );
-        let camera = self.viewport.cameras();
-        self.replace_document(document, "subdivide the cage");
-        self.viewport.set_cameras(camera);
+        self.replace_document_then_bind(Replacement::in_place(document, "subdivide the cage"));
         self.info(format!(
             "subdivided the cage: {before} -> {after} vertices; rebinding"
         ));
-        self.start_bind();
         true
     }
 }

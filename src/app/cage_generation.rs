@@ -6,7 +6,7 @@
 //! mesh changes meanwhile (undo, another file), the proposal is dropped.
 
 use super::document::Document;
-use super::editor::EditorApp;
+use super::editor::{EditorApp, Replacement};
 use crate::geometry::autocage::{
     generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
     DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
@@ -420,15 +420,14 @@ impl EditorApp {
         let vertices = cage.vertex_count();
         let rest = cage.positions().to_vec();
         let document = self.model.document().with_cage(cage, None, rest);
-        self.replace_document(
+        self.replace_document_then_bind(Replacement::framed(
             document,
             format!("use the generated {vertices}-vertex cage"),
-        );
+        ));
         self.info(format!(
             "using the generated cage of {vertices} vertices; binding"
         ));
         self.cage_generation.open = false;
-        self.start_bind();
         true
     }
 
@@ -445,7 +444,7 @@ impl EditorApp {
     }
 
     /// Make `file`, read from `path`, the document's mesh in a loose box cage
-    /// (one undo step), and open the Generate cage window.
+    /// (one undo step) and bind it, and open the Generate cage window.
     pub(super) fn open_mesh_in_box(&mut self, path: &Path, file: MeshFile) -> bool {
         let Some(cage) = loose_box_cage(&file.mesh) else {
             self.error(format!(
@@ -457,7 +456,7 @@ impl EditorApp {
         let title = super::files::file_title(path);
         let document =
             Document::new(title.clone(), file.mesh.clone(), cage).with_files(Some(file), None);
-        self.replace_document(document, format!("open {title}"));
+        self.replace_document_then_bind(Replacement::framed(document, format!("open {title}")));
         self.info(format!(
             "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
             shown_path(path)

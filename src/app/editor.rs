@@ -42,6 +42,46 @@ pub(super) struct GpuHandles {
     pub resident_weights: Option<(Arc<Weights>, wgpu::Buffer)>,
 }
 
+/// Where the cameras go when the document is replaced.
+pub(super) enum Cameras {
+    /// Frame the new document.
+    Frame,
+    /// Stay where they are (a cage edit on the same mesh).
+    Keep,
+    /// A session's cameras.
+    Session(Vec<OrbitCamera>),
+}
+
+/// A whole-document replacement and what comes with it.
+pub(super) struct Replacement {
+    pub document: Document,
+    /// What undo calls it ("open cage.obj").
+    pub action: String,
+    pub cameras: Cameras,
+    /// A session's bind options and view settings.
+    pub settings: Option<(BindOptions, ViewSettings)>,
+}
+
+impl Replacement {
+    /// `document` replacing the current one by `action`, framed.
+    pub(super) fn framed(document: Document, action: impl Into<String>) -> Self {
+        Self {
+            document,
+            action: action.into(),
+            cameras: Cameras::Frame,
+            settings: None,
+        }
+    }
+
+    /// `document` replacing the current one by `action`, the cameras kept.
+    pub(super) fn in_place(document: Document, action: impl Into<String>) -> Self {
+        Self {
+            cameras: Cameras::Keep,
+            ..Self::framed(document, action)
+        }
+    }
+}
+
 /// Which kind of file is being opened.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FileRole {
@@ -218,9 +258,9 @@ impl EditorApp {
                 app.view.heat_triangle.unwrap_or(0)
             ));
         }
-        // A session opened above has started its binds; starting again would
+        // What was opened above has started its binds; starting again would
         // cancel them, and a cancel pauses binding until the user asks.
-        if options.session.is_none() || !opened {
+        if !opened {
             app.start_bind();
         }
         app
@@ -335,26 +375,37 @@ impl EditorApp {
         self.document_swapped(true);
     }
 
-    /// Replace the document by `action` ("open cage.obj"), which undo reverses.
-    pub(super) fn replace_document(&mut self, document: Document, action: impl Into<String>) {
-        self.replace_document_and_view(document, action, false);
-    }
-
-    /// [`Self::replace_document`], and with `view_too` the view settings the
-    /// caller is about to change (a session's), which undo brings back as well.
-    pub(super) fn replace_document_and_view(
-        &mut self,
-        document: Document,
-        action: impl Into<String>,
-        view_too: bool,
-    ) {
-        let view = view_too.then(|| self.session_view());
-        self.model.apply(Command::ReplaceDocument {
+    /// Replace the whole document, as one undo step, and bind it: the one way
+    /// opening files, sessions and scenes and editing the cage change it.
+    pub(super) fn replace_document_then_bind(&mut self, replacement: Replacement) {
+        let Replacement {
+            document,
+            action,
+            cameras,
+            settings,
+        } = replacement;
+        let kept = self.viewport.cameras();
+        // Undo brings back the view settings a session replaces, too.
+        let view = settings.is_some().then(|| self.session_view());
+        self.apply(Command::ReplaceDocument {
             document: Box::new(document),
-            action: action.into(),
+            action,
             view,
         });
         self.document_swapped(true);
+        match cameras {
+            Cameras::Frame => {}
+            Cameras::Keep => self.viewport.set_cameras(kept),
+            // Relative to the origin the new document set.
+            Cameras::Session(cameras) => self.viewport.set_first_cameras(&cameras),
+        }
+        if let Some((bind_options, view)) = settings {
+            self.bind_options = bind_options;
+            self.view = view;
+            // A session's pose is on disk: quitting keeps it.
+            self.apply(Command::MarkSaved);
+        }
+        self.start_bind();
     }
 
     /// The view settings a session holds, as shown now.

@@ -3,7 +3,7 @@
 
 use super::cage_generation::cage_reaches;
 use super::document::Document;
-use super::editor::{EditorApp, FileRole};
+use super::editor::{Cameras, EditorApp, FileRole, Replacement};
 use super::model::Command;
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
@@ -35,13 +35,7 @@ impl EditorApp {
     pub fn open_recent(&mut self, entry: &RecentEntry) -> bool {
         let opened = match entry {
             RecentEntry::Session(path) => self.open_session(path),
-            RecentEntry::Scene { mesh, cage } => {
-                let opened = self.open_pair(mesh, cage);
-                if opened {
-                    self.start_bind();
-                }
-                opened
-            }
+            RecentEntry::Scene { mesh, cage } => self.open_pair(mesh, cage),
             RecentEntry::Mesh(path) => self.open_file(FileRole::Mesh, path),
             RecentEntry::Cage(path) => self.open_file(FileRole::Cage, path),
         };
@@ -64,22 +58,16 @@ impl EditorApp {
         for note in opened.notes {
             self.info(note);
         }
-        // Undo brings back the view settings the session replaces, too.
-        self.replace_document_and_view(
-            opened.document,
-            format!("open session {}", file_title(path)),
-            true,
-        );
         let settings = opened.settings;
-        self.bind_options = settings.bind_options;
-        self.view = settings.view;
-        // The session's cameras are relative to the origin `replace_document` set.
-        self.viewport.set_first_cameras(&settings.cameras);
-        self.mark_pose_saved();
+        self.replace_document_then_bind(Replacement {
+            document: opened.document,
+            action: format!("open session {}", file_title(path)),
+            cameras: Cameras::Session(settings.cameras),
+            settings: Some((settings.bind_options, settings.view)),
+        });
         self.session_path = Some(path.to_owned());
         self.remember(RecentEntry::Session(path.to_owned()));
         self.info(format!("opened session {}", shown_path(path)));
-        self.start_bind();
         true
     }
 
@@ -155,7 +143,8 @@ impl EditorApp {
         }
     }
 
-    /// Open a mesh and cage together; on any failure the current scene stays.
+    /// Open a mesh and cage together and bind them; on any failure the current
+    /// scene stays.
     pub(super) fn open_pair(&mut self, mesh_path: &Path, cage_path: &Path) -> bool {
         let mesh = match load_mesh(mesh_path) {
             Ok(mesh) => mesh,
@@ -181,7 +170,7 @@ impl EditorApp {
             file_title(mesh_path),
             file_title(cage_path)
         );
-        self.replace_document(document, action);
+        self.replace_document_then_bind(Replacement::framed(document, action));
         self.remember(RecentEntry::Scene {
             mesh: mesh_path.to_owned(),
             cage: cage_path.to_owned(),
@@ -200,7 +189,6 @@ impl EditorApp {
                     let opened = self.open_mesh_in_box(path, file);
                     if opened {
                         self.remember(RecentEntry::Mesh(path.to_owned()));
-                        self.start_bind();
                     }
                     return opened;
                 }
@@ -238,13 +226,13 @@ impl EditorApp {
             FileRole::Mesh => "mesh",
             FileRole::Cage => "cage",
         };
-        self.replace_document(document, format!("open {role_name} {}", file_title(path)));
+        let action = format!("open {role_name} {}", file_title(path));
+        self.replace_document_then_bind(Replacement::framed(document, action));
         self.remember(match role {
             FileRole::Mesh => RecentEntry::Mesh(path.to_owned()),
             FileRole::Cage => RecentEntry::Cage(path.to_owned()),
         });
         self.info(format!("opened {}", shown_path(path)));
-        self.start_bind();
         true
     }
 
@@ -254,8 +242,7 @@ impl EditorApp {
             Ok((mesh, cage)) => {
                 let action = format!("open the {} scene", bundled.title());
                 let document = Document::new(bundled.title(), mesh, cage).bundled_as(bundled);
-                self.replace_document(document, action);
-                self.start_bind();
+                self.replace_document_then_bind(Replacement::framed(document, action));
             }
             Err(error) => self.error(error.to_string()),
         }
@@ -402,12 +389,9 @@ impl EditorApp {
             self.model.document().mesh_file().cloned(),
             self.model.document().cage_path().map(Into::into),
         );
-        let camera = self.viewport.cameras();
-        self.replace_document(document, "use pose as rest shape");
-        self.viewport.set_cameras(camera);
+        self.replace_document_then_bind(Replacement::in_place(document, "use pose as rest shape"));
         self.info(format!(
             "the mesh now rests as {method} deformed it, in the posed cage; rebinding"
         ));
-        self.start_bind();
     }
 }

@@ -58,9 +58,7 @@ impl EditorApp {
                 } else {
                     (first, second)
                 };
-                if self.open_pair(mesh, cage) {
-                    self.start_bind();
-                }
+                self.open_pair(mesh, cage);
             }
             _ => self.error(format!(
                 "{} files dropped: drop one file, or a mesh and its cage",
