@@ -107,32 +107,6 @@ impl EditorApp {
         }
     }
 
-    /// Ctrl+O, Ctrl+S and Ctrl+Shift+S, as in Blender; not while a dialog or a
-    /// text field has the keyboard.
-    pub(super) fn file_shortcuts(&mut self, ctx: &egui::Context) {
-        if ctx.egui_wants_keyboard_input() || self.modal_dialog_open() {
-            return;
-        }
-        let command = egui::Modifiers::COMMAND;
-        let save_as = egui::KeyboardShortcut::new(command | egui::Modifiers::SHIFT, egui::Key::S);
-        let save = egui::KeyboardShortcut::new(command, egui::Key::S);
-        let open = egui::KeyboardShortcut::new(command, egui::Key::O);
-        let (save_as, save, open) = ctx.input_mut(|i| {
-            (
-                i.consume_shortcut(&save_as),
-                i.consume_shortcut(&save),
-                i.consume_shortcut(&open),
-            )
-        });
-        if save_as {
-            self.ask_for_file(FileAction::SaveSession);
-        } else if save {
-            self.save_session_again();
-        } else if open {
-            self.ask_for_file(FileAction::OpenSession);
-        }
-    }
-
     /// File > Save session: where it was last saved or opened, else ask.
     pub fn save_session_again(&mut self) {
         match self.session_path.clone() {

@@ -12,8 +12,7 @@ impl eframe::App for EditorApp {
         self.poll_bind();
         self.poll_cage_generation();
         self.handle_dropped_files(&ctx);
-        self.handle_shortcuts(&ctx);
-        self.file_shortcuts(&ctx);
+        self.run_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         if self.first_run_hint {

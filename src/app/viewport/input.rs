@@ -1,10 +1,10 @@
-//! Mouse and keyboard in the viewport: the drag state machine (orbit, pan, move
-//! handles, box select), the wheel, clicks, and the editor's shortcuts.
+//! The mouse in the viewport: the drag state machine (orbit, pan, move handles,
+//! box select), the wheel and clicks. Keys are in `shortcuts.rs`.
 
 use crate::app::compare::Overlay;
 use crate::app::editor::EditorApp;
 use crate::app::model::{Command, GestureKind, Selection, POSE_EDIT};
-use egui::{Key, KeyboardShortcut, Modifiers, PointerButton, Pos2, Rect};
+use egui::{Key, PointerButton, Pos2, Rect};
 use glam::{DVec3, Vec2};
 
 /// What a mouse drag in the viewport is doing.
@@ -181,59 +181,6 @@ impl EditorApp {
                 }
                 _ => {}
             }
-        }
-    }
-
-    pub(in crate::app) fn handle_shortcuts(&mut self, ctx: &egui::Context) {
-        let quit = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
-        if ctx.input_mut(|i| i.consume_shortcut(&quit)) {
-            self.request_quit(ctx);
-        }
-        // A dialog's fields and keys are its own; M or F typed into a path must not
-        // switch the method or move the camera.
-        if ctx.egui_wants_keyboard_input() || self.modal_dialog_open() {
-            return;
-        }
-        if self.transform_keys(ctx) {
-            return;
-        }
-        let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
-        let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
-        let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
-        let (redo, undo, escape, frame, next_method, frame_all, toggle_cage) = ctx.input_mut(|i| {
-            (
-                i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y),
-                i.consume_shortcut(&undo),
-                i.key_pressed(Key::Escape),
-                i.key_pressed(Key::F) && i.modifiers.is_none(),
-                i.key_pressed(Key::M) && i.modifiers.is_none(),
-                i.key_pressed(Key::Home),
-                i.key_pressed(Key::H) && i.modifiers.is_none(),
-            )
-        });
-        if ctx.input(|i| i.key_pressed(Key::O) && i.modifiers.is_none()) {
-            self.pose_tools.soft_selection = !self.pose_tools.soft_selection;
-        }
-        if next_method {
-            self.toggle_method();
-        }
-        if redo {
-            self.redo();
-        }
-        if undo {
-            self.undo();
-        }
-        if escape {
-            self.select_only([]);
-        }
-        if frame {
-            self.frame_selection();
-        }
-        if frame_all {
-            self.frame_scene();
-        }
-        if toggle_cage {
-            self.view.show_cage = !self.view.show_cage;
         }
     }
 }

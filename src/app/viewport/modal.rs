@@ -155,25 +155,26 @@ impl EditorApp {
         });
     }
 
-    /// The keys of a transform: begin one, or steer the one under way. True when
-    /// the keys were the transform's (the other shortcuts then wait).
-    pub(super) fn transform_keys(&mut self, ctx: &egui::Context) -> bool {
+    /// G, R or S pressed: begin a transform in the view under the pointer. True
+    /// when the pointer is over a view (the other shortcuts then wait).
+    pub(in crate::app) fn begin_transform_at_pointer(
+        &mut self,
+        ctx: &egui::Context,
+        kind: TransformKind,
+    ) -> bool {
+        let pointer = ctx.input(|i| i.pointer.hover_pos());
+        let pane = pointer.and_then(|p| self.viewport.pane_at(p));
+        if let (Some(pointer), Some(pane)) = (pointer, pane) {
+            self.begin_transform(kind, pane, pointer);
+            return true;
+        }
+        false
+    }
+
+    /// The keys of the transform under way, its own keymap as in Blender: an
+    /// axis, a typed amount, Enter and Esc. False when none is under way.
+    pub(in crate::app) fn steer_transform(&mut self, ctx: &egui::Context) -> bool {
         let Some(modal) = &mut self.viewport.modal else {
-            let pressed = |key| ctx.input(|i| i.key_pressed(key) && i.modifiers.is_none());
-            let kind = [
-                (Key::G, TransformKind::Grab),
-                (Key::R, TransformKind::Rotate),
-                (Key::S, TransformKind::Scale),
-            ]
-            .into_iter()
-            .find(|&(key, _)| pressed(key))
-            .map(|(_, kind)| kind);
-            let pointer = ctx.input(|i| i.pointer.hover_pos());
-            let pane = pointer.and_then(|p| self.viewport.pane_at(p));
-            if let (Some(kind), Some(pointer), Some(pane)) = (kind, pointer, pane) {
-                self.begin_transform(kind, pane, pointer);
-                return true;
-            }
             return false;
         };
         let (escape, enter, backspace, events) = ctx.input(|i| {
