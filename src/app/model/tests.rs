@@ -103,3 +103,36 @@ fn replacing_the_document_cancels_the_gesture_under_way() {
     );
     assert_eq!(model.document().pose(), start.as_slice());
 }
+
+#[test]
+fn the_oldest_steps_go_first_so_no_pose_step_outlives_its_document() {
+    let mut model = model();
+    // A pose edit on the first document, then nine replacements by cages of
+    // growing size: only the last eight documents are kept, and the pose edit
+    // of the first one, which no longer can come back, is gone with it.
+    let pose = moved(model.document().pose(), 0, 1.0);
+    model.apply(Command::edit_pose(pose));
+    for size in 2..=10 {
+        let other = Document::new("other", TriMesh::default(), cube_cage(f64::from(size)));
+        model.apply(Command::ReplaceDocument {
+            document: Box::new(other),
+            action: format!("open cube {size}"),
+            view: None,
+        });
+    }
+    let mut undone = Vec::new();
+    while let Some(swapped) = model.apply(Command::Undo(view())).swapped {
+        undone.push(swapped.action);
+    }
+    let expected: Vec<String> = (3..=10).rev().map(|s| format!("open cube {s}")).collect();
+    assert_eq!(undone, expected);
+    assert_eq!(model.undo_label(), None);
+    assert_pose_fits(&model);
+}
+
+fn assert_pose_fits(model: &Model) {
+    assert_eq!(
+        model.document().pose().len(),
+        model.document().cage().vertex_count()
+    );
+}

@@ -65,11 +65,9 @@ impl EditorApp {
         }
     }
 
-    /// A pose save asked for from the question ended: quit if it was written.
+    /// A pose save asked for from the question ended: quit if it was written
+    /// (`save_pose` has moved the save point).
     pub(in crate::app) fn pose_save_finished(&mut self, saved: bool) {
-        if saved {
-            self.mark_pose_saved();
-        }
         if std::mem::take(&mut self.quit.after_save) && saved {
             self.quit.confirmed = true;
             self.quit.close_next_frame = true;
