@@ -125,7 +125,6 @@ impl Command {
 pub struct Swapped {
     /// What was undone or redone ("open cage.obj").
     pub action: String,
-    pub undone: bool,
     /// The mesh stayed (a cage edit): the cameras need not frame it again.
     pub same_mesh: bool,
     /// The view settings to show with it, when the step kept them.
@@ -444,7 +443,6 @@ impl Model {
                     outcome: Outcome::Changed,
                     swapped: Some(Swapped {
                         action,
-                        undone: back,
                         same_mesh,
                         view: kept_view,
                     }),
