@@ -162,35 +162,28 @@ fn deform_applies_stored_or_fresh_green_coordinates_and_keeps_similarities() {
     // A .npz for another cage is refused with both shapes.
     let small = dir.path().join("small.obj");
     std::fs::write(&small, "v 0.5 0.5 0\n").unwrap();
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&small),
-        "--cage",
-        path_str(&cage_path),
-        "--deformed-cage",
-        path_str(&pose_path),
-        "--weights",
-        path_str(&weights),
-        "--out",
-        path_str(&stored),
-    ]);
-    assert_clean_failure(&output, "w.json", "rows is");
+    let deform_small = || {
+        pmvc(&[
+            "deform",
+            "--mesh",
+            path_str(&small),
+            "--cage",
+            path_str(&cage_path),
+            "--deformed-cage",
+            path_str(&pose_path),
+            "--weights",
+            path_str(&weights),
+            "--out",
+            path_str(&stored),
+        ])
+    };
+    assert_clean_failure(&deform_small(), "w.json", "rows is");
     std::fs::remove_file(weights.with_extension("json")).unwrap();
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&small),
-        "--cage",
-        path_str(&cage_path),
-        "--deformed-cage",
-        path_str(&pose_path),
-        "--weights",
+    assert_clean_failure(
+        &deform_small(),
         path_str(&weights),
-        "--out",
-        path_str(&stored),
-    ]);
-    assert_clean_failure(&output, path_str(&weights), "but the mesh has 1 vertices");
+        "but the mesh has 1 vertices",
+    );
 }
 
 #[test]

@@ -99,6 +99,23 @@ pub fn assert_clean_failure(output: &Output, file: &str, what: &str) {
     );
 }
 
+/// Whether a `--backend gpu` command found an adapter. Without one it must have
+/// failed cleanly, naming the adapter, and that fails the test under
+/// `PMVC_REQUIRE_GPU=1` (CI, on lavapipe); elsewhere the caller skips its GPU part.
+pub fn ran_on_gpu(output: &Output) -> bool {
+    if output.status.success() {
+        return true;
+    }
+    assert!(
+        std::env::var("PMVC_REQUIRE_GPU").as_deref() != Ok("1"),
+        "no GPU adapter: {}",
+        stderr(output)
+    );
+    assert_clean_failure(output, "--backend gpu", "adapter");
+    println!("GPU part not run: no adapter");
+    false
+}
+
 /// A version 1.0 `.npy` of little-endian float32, parsed by hand (independent of
 /// the library's reader): its shape, values and header text.
 pub fn parse_npy_f32(bytes: &[u8]) -> (Vec<usize>, Vec<f32>, String) {
