@@ -221,21 +221,7 @@ fn deform_with_stored_weights_matches_deform_that_binds() {
     // their shape.
     let small = dir.path().join("small.obj");
     std::fs::write(&small, "v 0.5 0.5 0\n").unwrap();
-    let deform_small = || {
-        pmvc(&[
-            "deform",
-            "--mesh",
-            path_str(&small),
-            "--cage",
-            path_str(&cage_path),
-            "--deformed-cage",
-            path_str(&pose_path),
-            "--weights",
-            path_str(&weights),
-            "--out",
-            path_str(&a),
-        ])
-    };
+    let deform_small = || deform_with_weights(&small, &cage_path, &pose_path, &weights, &a);
     let json = weights.with_extension("json");
     assert_clean_failure(
         &deform_small(),

@@ -162,21 +162,7 @@ fn deform_applies_stored_or_fresh_green_coordinates_and_keeps_similarities() {
     // A .npz for another cage is refused with both shapes.
     let small = dir.path().join("small.obj");
     std::fs::write(&small, "v 0.5 0.5 0\n").unwrap();
-    let deform_small = || {
-        pmvc(&[
-            "deform",
-            "--mesh",
-            path_str(&small),
-            "--cage",
-            path_str(&cage_path),
-            "--deformed-cage",
-            path_str(&pose_path),
-            "--weights",
-            path_str(&weights),
-            "--out",
-            path_str(&stored),
-        ])
-    };
+    let deform_small = || deform_with_weights(&small, &cage_path, &pose_path, &weights, &stored);
     assert_clean_failure(&deform_small(), "w.json", "rows is");
     std::fs::remove_file(weights.with_extension("json")).unwrap();
     assert_clean_failure(

@@ -67,6 +67,29 @@ pub fn pmvc(args: &[&str]) -> Output {
         .expect("run pmvc")
 }
 
+/// `pmvc deform` of `mesh` in `cage` to `pose` with stored `weights`, into `out`.
+pub fn deform_with_weights(
+    mesh: &Path,
+    cage: &Path,
+    pose: &Path,
+    weights: &Path,
+    out: &Path,
+) -> Output {
+    pmvc(&[
+        "deform",
+        "--mesh",
+        path_str(mesh),
+        "--cage",
+        path_str(cage),
+        "--deformed-cage",
+        path_str(pose),
+        "--weights",
+        path_str(weights),
+        "--out",
+        path_str(out),
+    ])
+}
+
 pub fn path_str(path: &Path) -> &str {
     path.to_str().unwrap()
 }

@@ -13,18 +13,18 @@ use crate::geometry::{shown_path, Cage, OutputSet, PointClass, WriteError};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
+
+mod classes;
+pub use classes::{
+    class_code, class_codes, classes_path, read_classes_npy, write_classes_npy_to, CLASS_INSIDE,
+    CLASS_ON_CAGE, CLASS_OUTSIDE,
+};
 
 /// The `format` field of every metadata file.
 pub const FORMAT: &str = "pmvc-weights";
 /// Raised when a field changes meaning; readers refuse versions they do not know.
 pub const FORMAT_VERSION: u32 = 1;
-
-/// Class codes in `W.classes.npy` (int8).
-pub const CLASS_INSIDE: i8 = 0;
-pub const CLASS_ON_CAGE: i8 = 1;
-pub const CLASS_OUTSIDE: i8 = 2;
 
 /// A metadata file is a few kilobytes plus Green's triangle list; more than this
 /// is not one.
@@ -33,23 +33,6 @@ const METADATA_LIMIT: u64 = 64 << 20;
 /// `W.json` for weights `W.npy` or `W.npz`.
 pub fn metadata_path(weights: &Path) -> PathBuf {
     weights.with_extension("json")
-}
-
-/// `W.classes.npy` for weights `W.npy` or `W.npz`.
-pub fn classes_path(weights: &Path) -> PathBuf {
-    weights.with_extension("classes.npy")
-}
-
-pub fn class_code(class: &PointClass) -> i8 {
-    match class {
-        PointClass::Inside => CLASS_INSIDE,
-        PointClass::OnSurface { .. } => CLASS_ON_CAGE,
-        PointClass::Outside => CLASS_OUTSIDE,
-    }
-}
-
-pub fn class_codes(classes: &[PointClass]) -> Vec<i8> {
-    classes.iter().map(class_code).collect()
 }
 
 /// A content digest of positions (FNV-1a, 64 bits, over their f64 little-endian
@@ -442,66 +425,6 @@ pub fn read_metadata(path: &Path) -> Result<WeightsMetadata, MetadataError> {
         })?;
     metadata.check_consistent(path)?;
     Ok(metadata)
-}
-
-/// The bytes of the class mask: a 1-D int8 `.npy` of `codes`.
-pub fn write_classes_npy_to(out: &mut dyn Write, codes: &[i8]) -> std::io::Result<()> {
-    // A 1-D header is well under 64 KiB, whatever the length.
-    let preamble = super::npy_header::header_bytes("|i1", &[codes.len() as u64])
-        .map_err(std::io::Error::other)?;
-    out.write_all(&preamble)?;
-    let bytes: Vec<u8> = codes.iter().map(|&c| c as u8).collect();
-    out.write_all(&bytes)
-}
-
-/// Read a class mask of `rows` rows: a 1-D int8 (or uint8) `.npy` whose values
-/// are class codes.
-pub fn read_classes_npy(path: &Path, rows: usize) -> Result<Vec<i8>, MetadataError> {
-    let classes = |reason: String| MetadataError::Classes {
-        path: path.to_owned(),
-        reason,
-    };
-    let read_error = |source| MetadataError::Read {
-        path: path.to_owned(),
-        source,
-    };
-    // The header (at most a few kilobytes) plus one byte a row.
-    let limit = rows as u64 + 65_536 + 16;
-    let bytes = crate::geometry::budget::read_limited(path, limit).map_err(read_error)?;
-    let header = super::npy_header::read_header(&mut bytes.as_slice(), Some(bytes.len() as u64))
-        .map_err(|error| classes(error.to_string()))?;
-    if !matches!(header.descr.as_str(), "|i1" | "|u1" | "i1" | "u1") {
-        return Err(classes(format!(
-            "expected an int8 class mask ('|i1'), found dtype '{}'",
-            header.descr.escape_debug()
-        )));
-    }
-    if header.shape != [rows as u64] {
-        return Err(classes(format!(
-            "expected shape ({rows},), one class per weights row, found {}",
-            super::npy_header::shape_text(&header.shape)
-        )));
-    }
-    let start = usize::try_from(header.data_offset).unwrap_or(usize::MAX);
-    let values = bytes.get(start..).unwrap_or_default();
-    if values.len() != rows {
-        return Err(classes(format!(
-            "holds {} class values after its header; its shape needs {rows}",
-            values.len()
-        )));
-    }
-    let codes: Vec<i8> = values.iter().map(|&b| b as i8).collect();
-    if let Some(row) = codes
-        .iter()
-        .position(|c| !(CLASS_INSIDE..=CLASS_OUTSIDE).contains(c))
-    {
-        return Err(classes(format!(
-            "row {}: class {} is none of 0 (inside), 1 (on the cage), 2 (outside)",
-            row + 1,
-            codes[row]
-        )));
-    }
-    Ok(codes)
 }
 
 /// Write weights, their class mask and their metadata together: all three
