@@ -3,7 +3,9 @@
 // Follows src/coords/cubemap.rs and src/coords/pmvc.rs exactly: one ray per texel
 // centre, first hit at t > 0 on either side of a triangle, weight Ω/r, spread by the
 // hit's barycentrics. A face is rasterised in bands of rows that fit the
-// workgroup-shared depth buffer; invocations own triangles. Per band:
+// workgroup-shared depth buffer; invocations own triangles. A triangle that cannot
+// reach a face (a cheap test against the face's four bounding planes) is skipped
+// before its set-up, so a large cage costs little on the faces it misses. Per band:
 //   1. keep the largest inverse depth q per texel (atomicMax on its bits: q > 0, so
 //      the u32 order of the bits is the float order);
 //   2. every triangle reaching that depth claims the texel (atomicMin of its index,
@@ -88,6 +90,24 @@ fn triangle_at(t: u32, x: vec3<f32>) -> Triangle {
 }
 
 #import cube_faces
+
+// False only when no ray through the face can reach triangle t: all three corners
+// lie outside one of the four planes that bound the face's pyramid (n·p ≥ |r·p|,
+// n·p ≥ |u·p|). Texel centres lie strictly inside, so rounding here cannot drop a
+// hit. A few loads and multiplies instead of a full set-up: most triangles of a
+// large cage miss most faces.
+fn may_reach_face(t: u32, x: vec3<f32>, axes: mat3x3<f32>) -> bool {
+    var outside = 15u;
+    for (var k = 0u; k < 3u; k++) {
+        let p = cage_positions[topology[3u * t + k]].xyz - x;
+        let r = dot(p, axes[0]);
+        let u = dot(p, axes[1]);
+        let n = dot(p, axes[2]);
+        outside &= select(0u, 1u, n - r < 0.0) | select(0u, 2u, n + r < 0.0)
+            | select(0u, 4u, n - u < 0.0) | select(0u, 8u, n + u < 0.0);
+    }
+    return outside == 0u;
+}
 
 // Conservative texel bounds of the triangle's projection on the face, widened by a
 // texel against rounding, as in the CPU's `texel_bounds`.
@@ -174,6 +194,10 @@ fn next_texel(part: vec4<u32>, at: vec2<u32>, step: vec2<u32>) -> vec2<u32> {
     return next;
 }
 
+fn reaches(reaching: vec2<u32>, owned: u32) -> bool {
+    return owned >= 64u || (reaching[owned / 32u] & (1u << (owned % 32u))) != 0u;
+}
+
 // Computed rather than loaded: storage loads dominate the inner loop on lavapipe.
 // The same expression for every triangle, so shared edges still cancel exactly.
 fn texel_centre(index: u32) -> f32 {
@@ -241,12 +265,21 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             // 1. Nearest inverse depth per texel. Bit k of `shared_mask`: this
             // invocation's k-th triangle is shared.
             var shared_mask = 0u;
+            // Bit k: this invocation's k-th triangle may reach the face (only the
+            // first 64 are tested; the rest of a huge cage count as reaching).
+            var reaching = vec2<u32>(0u, 0u);
             var k = 0u;
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
-                let setup = face_setup(triangle_at(t, x), axes);
-                let part = band_part(setup, band_start, band_end);
                 let owned = k;
                 k++;
+                if owned < 64u {
+                    if !may_reach_face(t, x, axes) {
+                        continue;
+                    }
+                    reaching[owned / 32u] |= 1u << (owned % 32u);
+                }
+                let setup = face_setup(triangle_at(t, x), axes);
+                let part = band_part(setup, band_start, band_end);
                 if owned < 32u && texel_count(part) > SHARED_TEXELS {
                     let slot = atomicAdd(&shared_count, 1u);
                     if slot < MAX_SHARED {
@@ -285,6 +318,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
                 let owned = k;
                 k++;
+                if !reaches(reaching, owned) {
+                    continue;
+                }
                 if owned < 32u && (shared_mask & (1u << owned)) != 0u {
                     continue;
                 }
@@ -328,7 +364,13 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             let any_tie = workgroupUniformLoad(&tied) != 0u;
 
             // 3. Add the band's sums; after a tie, only the lowest claimant's texels.
+            k = 0u;
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
+                let owned = k;
+                k++;
+                if !reaches(reaching, owned) {
+                    continue;
+                }
                 var sums = vec3<f32>(
                     triangle_sums[band_base + 3u * t],
                     triangle_sums[band_base + 3u * t + 1u],

@@ -11,8 +11,10 @@ use crate::gpu::GpuError;
 use glam::DVec3;
 use std::time::Instant;
 
-/// Largest share of the device limits one batch buffer may take.
-const MAX_BATCH_BUFFER_BYTES: u64 = 64 << 20;
+/// Largest share of the device limits one batch buffer may take. PMVC keeps 6 floats
+/// per cage triangle per row, so a 3,000-triangle cage fits about 3,600 rows: few
+/// enough batches that their round trips stay a small part of a bind.
+const MAX_BATCH_BUFFER_BYTES: u64 = 256 << 20;
 
 /// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
 /// the same row loop as a CPU bind.
@@ -483,12 +485,15 @@ impl<'a> GpuBind<'a> {
             if let (Some(readback), Some(weights)) =
                 (&self.weights_readback, weights.as_deref_mut())
             {
-                let block: Vec<f32> = read_back(self, readback, block_bytes)?;
-                for &row in &inside {
-                    let local = row - range.start;
-                    weights.values[row * cols..(row + 1) * cols]
-                        .copy_from_slice(&block[local * cols..(local + 1) * cols]);
-                }
+                // Straight from the mapped buffer into the rows: a large cage's
+                // matrix is hundreds of MiB, and a second copy cost more than the kernel.
+                with_mapped(self, readback, block_bytes, |block: &[f32]| {
+                    for &row in &inside {
+                        let local = row - range.start;
+                        weights.values[row * cols..(row + 1) * cols]
+                            .copy_from_slice(&block[local * cols..(local + 1) * cols]);
+                    }
+                })?;
             }
             Ok(inside
                 .iter()
@@ -542,6 +547,16 @@ fn read_back<T: bytemuck::Pod>(
     buffer: &wgpu::Buffer,
     bytes: u64,
 ) -> Result<Vec<T>, GpuError> {
+    with_mapped(bind, buffer, bytes, |values: &[T]| values.to_vec())
+}
+
+/// Map `buffer`, wait for the device, and hand its first `bytes` to `read` as `T`s.
+fn with_mapped<T: bytemuck::Pod, R>(
+    bind: &GpuBind<'_>,
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+    read: impl FnOnce(&[T]) -> R,
+) -> Result<R, GpuError> {
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..bytes, move |result| {
         let _ = sender.send(result);
@@ -552,12 +567,16 @@ fn read_back<T: bytemuck::Pod>(
         Ok(Err(error)) => return Err(GpuError::Readback(error.to_string())),
         Err(_) => return Err(GpuError::Readback("the map callback never ran".into())),
     }
-    let values = {
+    let result = {
         let view = buffer
             .get_mapped_range(0..bytes)
             .map_err(|e| GpuError::Readback(e.to_string()))?;
-        bytemuck::pod_collect_to_vec::<u8, T>(&view)
+        // Mapped ranges are aligned for any `T` a kernel writes; copy if one is not.
+        match bytemuck::try_cast_slice::<u8, T>(&view) {
+            Ok(values) => read(values),
+            Err(_) => read(&bytemuck::pod_collect_to_vec::<u8, T>(&view)),
+        }
     };
     buffer.unmap();
-    Ok(values)
+    Ok(result)
 }
