@@ -245,10 +245,13 @@ const INTEGRATED_VS_DISCRETE: f64 = 8.0;
 /// Compiling the three binding kernels, in seconds: (no cache, cache hit).
 /// Hardware: the H200's whole `--backend gpu` process took 0.30–0.36 s against
 /// 0.10–0.14 s for `cpu`, `pmvc info` (listing and opening) 0.09–0.1 s.
-/// Software: lavapipe on the 2-core machine (docs/benchmarks.md, "Start-up and
-/// the pipeline cache").
+/// The warm figure is a guess until measured on hardware. Software: lavapipe on
+/// the 2-core machine, a one-point bind's whole process 0.15–0.19 s against
+/// 0.008 s on the CPU, 0.05 s of it opening the device; Mesa 22.3's lavapipe
+/// keeps nothing in its pipeline cache, so a hit saves nothing there
+/// (docs/benchmarks.md, "Start-up and the pipeline cache").
 const COMPILE_HARDWARE_S: (f64, f64) = (0.15, 0.03);
-const COMPILE_SOFTWARE_S: (f64, f64) = (0.25, 0.05);
+const COMPILE_SOFTWARE_S: (f64, f64) = (0.14, 0.14);
 
 /// The model's two predictions for a bind, in seconds, and its choice.
 #[derive(Clone, Copy, Debug, PartialEq)]
