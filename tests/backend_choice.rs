@@ -2,7 +2,8 @@
 //! the cost model does not favour (lavapipe on CI), a job binds on the CPU and
 //! leaves no resident GPU copy, so the viewport uploads the CPU weights; with
 //! `gpu` the same device binds and keeps its copy. Without an adapter the test
-//! prints "not run", unless `PMVC_REQUIRE_GPU=1`.
+//! prints "not run", unless `PMVC_REQUIRE_GPU=1`. And `pmvc info` lists the native
+//! backends only, unless `WGPU_BACKEND` names others.
 #![cfg(feature = "editor")]
 
 use pmvc::app::bind_queue::{BindQueue, Finished};
@@ -63,5 +64,51 @@ fn auto_binds_on_the_cpu_where_the_model_says_so_and_gpu_keeps_the_device() {
     assert!(
         outcome.resident.is_some(),
         "a GPU bind leaves its copy on the device"
+    );
+}
+
+fn info(backend: Option<&str>) -> String {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"));
+    command.arg("info").env_remove("WGPU_BACKEND");
+    if let Some(backend) = backend {
+        command.env("WGPU_BACKEND", backend);
+    }
+    let output = command.output().expect("run pmvc info");
+    assert_eq!(output.status.code(), Some(0));
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// The adapters `pmvc info` lists, each line's backend.
+fn listed_backends(report: &str) -> Vec<String> {
+    report
+        .lines()
+        .filter_map(|line| line.strip_prefix("  - "))
+        // "NAME (TYPE, BACKEND, driver …)"
+        .filter_map(|adapter| {
+            let head = &adapter[..adapter.find(", driver")?];
+            head.rsplit(", ").next().map(str::to_owned)
+        })
+        .collect()
+}
+
+#[test]
+fn only_native_backends_are_listed_unless_wgpu_backend_says_otherwise() {
+    let native = info(None);
+    assert!(
+        native.contains("unset: Vulkan, Metal, DX12; not GL"),
+        "{native}"
+    );
+    let backends = listed_backends(&native);
+    assert!(
+        backends
+            .iter()
+            .all(|backend| ["Vulkan", "Metal", "Dx12"].contains(&backend.as_str())),
+        "{native}"
+    );
+    let gl = info(Some("gl"));
+    assert!(gl.contains("WGPU_BACKEND=gl,"), "{gl}");
+    assert!(
+        listed_backends(&gl).iter().all(|backend| backend == "Gl"),
+        "{gl}"
     );
 }
