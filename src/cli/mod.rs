@@ -222,7 +222,8 @@ pub struct EditArgs {
     /// frames on the GPU that wgpu finds (a server, a CI machine).
     #[arg(long, requires = "screenshot")]
     pub offscreen: bool,
-    /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
+    /// Where binding runs: auto puts each bind on the editor's GPU or the CPU,
+    /// whichever a cost model predicts faster for it.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
     /// What the viewport shows: one method (give its name, e.g. `mvc`), methods

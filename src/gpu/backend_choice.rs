@@ -273,6 +273,9 @@ impl Prediction {
 
     /// One line: both predictions and what they rest on.
     pub fn explain(&self) -> String {
+        if self.gpu_s.is_none() {
+            return format!("{} has no GPU kernel", self.work.method.name());
+        }
         let seconds =
             |s: Option<f64>| s.map_or_else(|| "not modelled".into(), |s| format!("{s:.3} s"));
         let pipelines = match self.gpu.pipelines {

@@ -85,6 +85,11 @@ fn harmonic_coordinates_always_bind_on_the_cpu() {
     );
     assert_eq!(prediction.gpu_s, None);
     assert!(!prediction.gpu_wins());
+    assert!(
+        prediction.explain().contains("no GPU kernel"),
+        "{}",
+        prediction.explain()
+    );
 }
 
 #[test]

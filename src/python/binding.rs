@@ -192,8 +192,9 @@ fn bind_options(
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
 /// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
-/// its family). ``backend`` is ``"auto"`` (a hardware GPU when there is one),
-/// ``"cpu"`` or ``"gpu"``; families without a GPU kernel bind on the CPU.
+/// its family). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
+/// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
+/// a GPU kernel bind on the CPU.
 /// ``progress``, if given, is called with ``(done, total)`` rows, from
 /// ``(0, total)`` to ``(total, total)``. The GIL is released while binding;
 /// Ctrl-C cancels within about a second.
