@@ -136,7 +136,9 @@ pub(super) fn bind_rows(
     backend: &Backend,
     bar: &indicatif::ProgressBar,
 ) -> Result<BoundRows> {
-    let decision = decide_on(input, range.len(), choice, backend);
+    // Decided on the whole bind, so that every block of a streamed one binds
+    // on the same device.
+    let decision = decide_on(input, input.mesh.mesh.positions.len(), choice, backend);
     if choice.verbose && range.start == 0 {
         warn_line!("pmvc: {}", decision.explain());
     }
@@ -224,7 +226,7 @@ pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
     Ok(device.map_or(Backend::Cpu, Backend::Gpu))
 }
 
-/// Where `range.len()` rows of `input` bind, by the one rule of
+/// Where a bind of `rows` rows of `input` runs, by the one rule of
 /// [`crate::gpu::backend_choice`], on the device [`choose_backend`] opened.
 pub(super) fn decide_on(
     input: &BoundInput,
