@@ -10,6 +10,7 @@
 
 use crate::coords::{BindOptions, BindProgress, Method, WeightQuality, Weights};
 use crate::geometry::{Cage, PointClass};
+use crate::gpu::backend_choice::{decide, BackendRequest, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder};
 use crate::render::weight_chunks::ChunkLimits;
 use glam::DVec3;
@@ -52,6 +53,8 @@ pub enum JobError {
 pub struct Finished {
     pub options: BindOptions,
     pub result: Result<BindOutcome, JobError>,
+    /// Whether it ran on the GPU (`auto` may put a job on the CPU).
+    pub on_gpu: bool,
 }
 
 /// Each point's class and the points outside, shared by every job of a scene.
@@ -68,6 +71,7 @@ struct Prepared {
 
 struct Running {
     options: BindOptions,
+    on_gpu: bool,
     progress: Arc<BindProgress>,
     started: Instant,
     receiver: mpsc::Receiver<Result<BindOutcome, JobError>>,
@@ -89,7 +93,9 @@ pub struct JobStatus {
 type Wake = Arc<dyn Fn() + Send + Sync>;
 
 pub struct BindQueue {
+    /// The editor's device, or the CPU (asked for, none usable, or after a failure).
     backend: Backend,
+    request: BackendRequest,
     wake: Wake,
     prepared: Option<Prepared>,
     running: Option<Running>,
@@ -101,11 +107,18 @@ pub struct BindQueue {
 }
 
 impl BindQueue {
-    /// A queue binding on `backend`; `wake` is called from a job's thread when it
-    /// ends (the editor passes its repaint request).
-    pub fn new(backend: Backend, wake: impl Fn() + Send + Sync + 'static) -> Self {
+    /// A queue binding on `backend` as `request` says: for `auto`, each job on
+    /// the device or the CPU, whichever [`crate::gpu::backend_choice`] predicts
+    /// faster for it. `wake` is called from a job's thread when it ends (the
+    /// editor passes its repaint request).
+    pub fn new(
+        backend: Backend,
+        request: BackendRequest,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) -> Self {
         Self {
             backend,
+            request,
             wake: Arc::new(wake),
             prepared: None,
             running: None,
@@ -252,6 +265,7 @@ impl BindQueue {
         let finished = Finished {
             options: running.options,
             result,
+            on_gpu: running.on_gpu,
         };
         if !matches!(finished.result, Err(JobError::Failed { .. })) {
             // After a failure the editor decides (it may retry on the CPU first).
@@ -272,7 +286,14 @@ impl BindQueue {
         let progress = Arc::new(BindProgress::new(prepared.points.len()));
         let (sender, receiver) = mpsc::channel();
         let worker_progress = Arc::clone(&progress);
-        let backend = self.backend.clone();
+        let device = match &self.backend {
+            Backend::Gpu(context) => Some(context),
+            Backend::Cpu => None,
+        };
+        let work = Work::of(options, prepared.points.len(), &prepared.cage);
+        let decision = decide(self.request, device, &work);
+        let on_gpu = decision.on_gpu(options.method);
+        let backend = decision.backend;
         let wake = Arc::clone(&self.wake);
         let started = Instant::now();
         let spawned = std::thread::Builder::new()
@@ -294,6 +315,7 @@ impl BindQueue {
         self.started += 1;
         self.running = Some(Running {
             options,
+            on_gpu,
             progress,
             started,
             receiver,
@@ -333,7 +355,7 @@ fn run(
     }
     // CPU weights serve export and hover read-outs; on a GPU the renderer reads the
     // resident copy when it fits one storage binding, and uploads the CPU weights in
-    // chunks when it does not.
+    // chunks when it does not, or when the job ran on the CPU.
     let gpu_buffer = match &backend {
         Backend::Gpu(context) => {
             let columns = options.method.columns(&prepared.cage);

@@ -8,7 +8,6 @@ use super::editor::{EditorApp, Replacement};
 use super::model::Command;
 use crate::coords::{Method, Parameter};
 use crate::geometry::subdivide_midpoint;
-use crate::gpu::Backend;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -187,7 +186,11 @@ impl EditorApp {
     }
 
     fn finish_bind(&mut self, finished: Finished) {
-        let Finished { options, result } = finished;
+        let Finished {
+            options,
+            result,
+            on_gpu,
+        } = finished;
         let outcome = match result {
             Ok(outcome) => outcome,
             Err(JobError::Cancelled) => {
@@ -197,7 +200,7 @@ impl EditorApp {
                 return;
             }
             Err(error) => {
-                if matches!(self.queue.backend(), Backend::Gpu(_)) {
+                if on_gpu {
                     // The CPU path always works; use it from now on. Not an error of
                     // the run: the weights still come, from the CPU.
                     self.queue.fall_back_to_cpu();

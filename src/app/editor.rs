@@ -24,7 +24,7 @@ use super::ui::statistics::FrameStats;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
-use crate::gpu::{Backend, GpuContext};
+use crate::gpu::{Backend, BackendRequest, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
 use crate::render::{OrbitCamera, ViewportRenderer};
 use eframe::egui_wgpu;
@@ -163,9 +163,12 @@ impl EditorApp {
                 resident_weights: None,
             }
         });
-        let backend = usable_state.map_or(Backend::Cpu, |state| {
-            bind_backend_for(state, options.bind_on)
-        });
+        let request = match options.bind_on {
+            BindOn::Auto => BackendRequest::Auto,
+            BindOn::Cpu => BackendRequest::Cpu,
+            BindOn::Gpu => BackendRequest::Gpu,
+        };
+        let backend = usable_state.map_or(Backend::Cpu, |state| bind_device(state, request));
         let wake_ctx = cc.egui_ctx.clone();
         // The comb is generated, so it cannot fail to load.
         let (mesh, cage) = (scenes::comb_mesh(), scenes::comb_cage());
@@ -177,7 +180,7 @@ impl EditorApp {
                 Document::new(BundledScene::Comb.title(), mesh, cage)
                     .bundled_as(BundledScene::Comb),
             ),
-            queue: BindQueue::new(backend, move || wake_ctx.request_repaint()),
+            queue: BindQueue::new(backend, request, move || wake_ctx.request_repaint()),
             bind_options,
             view: options.view,
             viewport: ViewportState::default(),
@@ -557,21 +560,16 @@ impl EditorApp {
     }
 }
 
-/// With [`BindOn::Auto`], bind on the editor's own device when it is a hardware
-/// GPU; a software adapter binds faster on the CPU path (docs/benchmarks.md).
-fn bind_backend_for(state: &egui_wgpu::RenderState, bind_on: BindOn) -> Backend {
-    let info = state.adapter.get_info();
-    let use_gpu = match bind_on {
-        BindOn::Gpu => true,
-        BindOn::Cpu => false,
-        BindOn::Auto => info.device_type != wgpu::DeviceType::Cpu,
-    };
-    if !use_gpu {
+/// The editor's own device, which binds without a start-up of its own, unless
+/// the CPU is asked for; for `auto` the queue decides per job whether to use it
+/// ([`crate::gpu::backend_choice`]).
+fn bind_device(state: &egui_wgpu::RenderState, request: BackendRequest) -> Backend {
+    if request == BackendRequest::Cpu {
         return Backend::Cpu;
     }
     Backend::Gpu(Arc::new(GpuContext::from_device(
         state.device.clone(),
         state.queue.clone(),
-        info,
+        state.adapter.get_info(),
     )))
 }

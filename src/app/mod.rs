@@ -100,7 +100,8 @@ impl EditorOptions {
 /// vertex shader reads the weights where the bind left them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BindOn {
-    /// A hardware GPU if the editor runs on one, else the CPU.
+    /// Each bind on the editor's GPU or the CPU, whichever is predicted faster
+    /// for it (`gpu::backend_choice`).
     #[default]
     Auto,
     Cpu,

@@ -6,7 +6,8 @@ use crate::geometry::{
     self, classify_points, extension_warning, refuse_same_file, shown_path, Cage, MeshFile,
     OutputSet, PointClasses,
 };
-use crate::gpu::{Backend, BindInput, Binder, GpuContext};
+use crate::gpu::backend_choice::{decide, device_for, BackendRequest, Decision, Work};
+use crate::gpu::{Backend, BindInput, Binder};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::DVec3;
 use std::io::Write as _;
@@ -135,6 +136,14 @@ pub(super) fn bind_rows(
     backend: &Backend,
     bar: &indicatif::ProgressBar,
 ) -> Result<BoundRows> {
+    // Decided on the whole bind, so that every block of a streamed one binds
+    // on the same device.
+    let decision = decide_on(input, input.mesh.mesh.positions.len(), choice, backend);
+    if choice.verbose && range.start == 0 {
+        warn_line!("pmvc: {}", decision.explain());
+    }
+    let on_gpu = decision.on_gpu(choice.method);
+    let backend = &decision.backend;
     let bind_input = BindInput {
         points: input.mesh.mesh.positions[range.clone()].into(),
         classes: input.classes.classes[range.clone()].into(),
@@ -143,20 +152,24 @@ pub(super) fn bind_rows(
     };
     let output = if bar.is_hidden() {
         // Nothing to show: wait on the bind directly, not in steps of the poll below.
-        Binder::new(backend.clone()).bind_blocking(&bind_input, &BindProgress::default())?
+        Binder::new(backend.clone()).bind_blocking(&bind_input, &BindProgress::default())
     } else {
         let handle = Binder::new(backend.clone()).start(bind_input);
         while !handle.is_finished() {
             bar.set_position((range.start + handle.progress().done()) as u64);
             std::thread::sleep(Duration::from_millis(50));
         }
-        handle.wait()?
+        handle.wait()
     };
+    if let Backend::Gpu(context) = backend {
+        for notice in context.take_notices() {
+            warn_line!("pmvc: {notice}");
+        }
+    }
+    let output = output?;
     let weights = output
         .weights
         .context("internal error: the bind returned no CPU weights")?;
-    let on_gpu = matches!(backend, Backend::Gpu(_))
-        && crate::gpu::kernels::Kernel::of(choice.method).is_some();
     Ok(BoundRows {
         weights,
         device: output.stats.device,
@@ -191,20 +204,42 @@ pub(super) fn outside_note(input: &BoundInput) -> String {
     }
 }
 
-/// `auto` binds on a hardware GPU when there is one. With only a software adapter
-/// (lavapipe, llvmpipe) the CPU path is faster (docs/benchmarks.md), so it uses that.
-pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
-    match choice {
-        BackendArg::Cpu => Ok(Backend::Cpu),
-        BackendArg::Gpu => {
-            let context = GpuContext::new().context("--backend gpu")?;
-            Ok(Backend::Gpu(Arc::new(context)))
+impl From<BackendArg> for BackendRequest {
+    fn from(choice: BackendArg) -> Self {
+        match choice {
+            BackendArg::Auto => BackendRequest::Auto,
+            BackendArg::Cpu => BackendRequest::Cpu,
+            BackendArg::Gpu => BackendRequest::Gpu,
         }
-        BackendArg::Auto => match GpuContext::new_hardware() {
-            Ok(Some(context)) => Ok(Backend::Gpu(Arc::new(context))),
-            _ => Ok(Backend::Cpu),
-        },
     }
+}
+
+/// The device `--backend` may bind on ([`device_for`]): none for `cpu`, a hardware
+/// adapter's or none for `auto`, the adapter policy's for `gpu`. Run while the
+/// inputs load; [`bind_rows`] then decides, once the work is known, whether
+/// `auto` uses it.
+pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
+    let device = device_for(choice.into()).map_err(|error| match choice {
+        BackendArg::Gpu => anyhow!(error).context("--backend gpu"),
+        _ => anyhow!(error),
+    })?;
+    Ok(device.map_or(Backend::Cpu, Backend::Gpu))
+}
+
+/// Where a bind of `rows` rows of `input` runs, by the one rule of
+/// [`crate::gpu::backend_choice`], on the device [`choose_backend`] opened.
+pub(super) fn decide_on(
+    input: &BoundInput,
+    rows: usize,
+    choice: &MethodChoice,
+    device: &Backend,
+) -> Decision {
+    let device = match device {
+        Backend::Gpu(context) => Some(context),
+        Backend::Cpu => None,
+    };
+    let work = Work::of(choice.options(), rows, &input.cage);
+    decide(choice.backend.into(), device, &work)
 }
 
 /// A progress bar on stderr when it is a terminal; hidden otherwise.

@@ -84,8 +84,9 @@ impl ValueEnum for crate::coords::Method {
 /// Where binding runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {
-    /// The faster path for this machine: a hardware GPU when there is one, else the
-    /// CPU (without loading the GPU drivers where the system has no GPU device).
+    /// The faster path for this bind: the CPU, or a hardware GPU where a cost model
+    /// predicts it faster for the work, start-up included (see --verbose). Without
+    /// a GPU device on the system the GPU drivers are not even loaded.
     Auto,
     /// Rayon-parallel CPU reference.
     Cpu,
@@ -118,6 +119,11 @@ pub struct MethodChoice {
     /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
+    /// Print where the bind runs and why: for `auto`, the CPU's and the GPU's
+    /// predicted times; on a GPU, how long the device took to open and whether
+    /// the compiled kernels came from the pipeline cache.
+    #[arg(long)]
+    pub verbose: bool,
     /// Treat mesh vertices outside the cage as an error instead of binding them by
     /// the family's outside policy (MVC weights for MVC, PMVC and harmonic
     /// coordinates; Green's exterior extension for Green coordinates).
@@ -216,7 +222,8 @@ pub struct EditArgs {
     /// frames on the GPU that wgpu finds (a server, a CI machine).
     #[arg(long, requires = "screenshot")]
     pub offscreen: bool,
-    /// Where binding runs: auto uses the editor's GPU if it is a hardware one.
+    /// Where binding runs: auto puts each bind on the editor's GPU or the CPU,
+    /// whichever a cost model predicts faster for it.
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
     /// What the viewport shows: one method (give its name, e.g. `mvc`), methods

@@ -2,9 +2,11 @@
 //! editor so that the weights stay in its GPU memory.
 
 use super::kernels::Kernels;
+use super::pipeline_cache::{self, CacheLoad};
 use super::GpuError;
 use std::fmt::Write as _;
 use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
 
 /// A wgpu device and queue with the facts a bind needs about them.
 pub struct GpuContext {
@@ -15,6 +17,13 @@ pub struct GpuContext {
     /// Set by the device-lost callback and by uncaptured errors on devices made here.
     failure: Arc<Mutex<Option<GpuError>>>,
     kernels: OnceLock<Result<Kernels, GpuError>>,
+    /// The pipeline cache found on disk when the device opened; `Unsupported`
+    /// where the device was opened without the feature (the editor's).
+    pipeline_cache: CacheLoad,
+    /// From listing the adapters to the device ready; zero for a device handed in.
+    opened_in: Duration,
+    /// Lines for the user about the pipeline cache (ignored or unwritable files).
+    notices: Mutex<Vec<String>>,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -31,9 +40,10 @@ impl GpuContext {
     /// limits the backends, `WGPU_ADAPTER_NAME` picks by name, otherwise the best
     /// hardware adapter, and a software one (`DeviceType::Cpu`) only when there is none.
     pub fn new() -> Result<Self, GpuError> {
+        let started = Instant::now();
         let instance = make_instance();
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
-        Self::open(choose_adapter(adapters)?)
+        Self::open(choose_adapter(adapters)?, started)
     }
 
     /// [`GpuContext::new`], or `None` when the adapter it would choose is a software
@@ -44,21 +54,40 @@ impl GpuContext {
         if !may_have_hardware_adapter(std::path::Path::new("/dev")) {
             return Ok(None);
         }
+        let started = Instant::now();
         let instance = make_instance();
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         let adapter = choose_adapter(adapters)?;
         if adapter.get_info().device_type == wgpu::DeviceType::Cpu {
             return Ok(None);
         }
-        Self::open(adapter).map(Some)
+        Self::open(adapter, started).map(Some)
     }
 
-    fn open(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+    fn open(adapter: wgpu::Adapter, started: Instant) -> Result<Self, GpuError> {
         let info = adapter.get_info();
         let wanted = adapter.limits();
+        let caches = adapter.features().contains(wgpu::Features::PIPELINE_CACHE);
+        let pipeline_cache = if caches {
+            pipeline_cache::load(&info)
+        } else {
+            CacheLoad::Unsupported
+        };
+        let mut notices = Vec::new();
+        if let CacheLoad::Ignored(path, why) = &pipeline_cache {
+            notices.push(format!(
+                "GPU pipeline cache {}: ignored ({why}); the kernels are compiled and it is rewritten",
+                path.display()
+            ));
+        }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pmvc"),
             required_limits: wanted,
+            required_features: if caches {
+                wgpu::Features::PIPELINE_CACHE
+            } else {
+                wgpu::Features::empty()
+            },
             ..Default::default()
         }))
         .map_err(|e| GpuError::RequestDevice(e.to_string()))?;
@@ -84,6 +113,9 @@ impl GpuContext {
             limits,
             failure,
             kernels: OnceLock::new(),
+            pipeline_cache,
+            opened_in: started.elapsed(),
+            notices: Mutex::new(notices),
         })
     }
 
@@ -98,6 +130,9 @@ impl GpuContext {
             limits,
             failure: Arc::default(),
             kernels: OnceLock::new(),
+            pipeline_cache: CacheLoad::Unsupported,
+            opened_in: Duration::ZERO,
+            notices: Mutex::default(),
         }
     }
 
@@ -116,11 +151,88 @@ impl GpuContext {
         describe(&self.info)
     }
 
+    /// What was found of the pipeline cache when the device opened.
+    pub fn pipeline_cache(&self) -> &CacheLoad {
+        &self.pipeline_cache
+    }
+
+    /// How long listing the adapters and opening the device took in this process.
+    pub fn opened_in(&self) -> Duration {
+        self.opened_in
+    }
+
+    /// Whether the binding kernels are compiled already (no start cost left).
+    pub fn kernels_ready(&self) -> bool {
+        self.kernels.get().is_some_and(Result::is_ok)
+    }
+
+    /// The notices about the pipeline cache since the last call, for the user.
+    pub fn take_notices(&self) -> Vec<String> {
+        self.notices
+            .lock()
+            .map(|mut notices| std::mem::take(&mut *notices))
+            .unwrap_or_default()
+    }
+
+    fn notice(&self, line: String) {
+        if let Ok(mut notices) = self.notices.lock() {
+            notices.push(line);
+        }
+    }
+
     pub(super) fn kernels(&self) -> Result<&Kernels, GpuError> {
         self.kernels
-            .get_or_init(|| Kernels::new(&self.device))
+            .get_or_init(|| self.compile_kernels())
             .as_ref()
             .map_err(Clone::clone)
+    }
+
+    /// Compile the kernels through the pipeline cache where the device keeps one,
+    /// then write the cache back when the driver added to it.
+    fn compile_kernels(&self) -> Result<Kernels, GpuError> {
+        let Some(path) = self.pipeline_cache.path() else {
+            return Kernels::new(&self.device, None);
+        };
+        let known = match &self.pipeline_cache {
+            CacheLoad::Hit(_, data) => Some(data.as_slice()),
+            _ => None,
+        };
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        // SAFETY: `known` passed `pipeline_cache::decode`: our header with this
+        // adapter's key and wgpu release, and a matching checksum, so it is data
+        // `PipelineCache::get_data` returned for this adapter (wgpu checks its own
+        // header again; `fallback` starts empty if the driver refuses it).
+        let cache = unsafe {
+            self.device
+                .create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
+                    label: Some("pmvc bind"),
+                    data: known,
+                    fallback: true,
+                })
+        };
+        let cache = match pollster::block_on(scope.pop()) {
+            None => Some(cache),
+            Some(error) => {
+                self.notice(format!(
+                    "GPU pipeline cache {}: not used ({error})",
+                    path.display()
+                ));
+                None
+            }
+        };
+        let kernels = Kernels::new(&self.device, cache.as_ref())?;
+        let fresh = cache.and_then(|cache| cache.get_data());
+        if let (Some(data), Some(key)) = (fresh, pipeline_cache::adapter_key(&self.info)) {
+            if known != Some(data.as_slice()) {
+                if let Err(why) = pipeline_cache::store(path, &key, &data) {
+                    self.notice(format!(
+                        "GPU pipeline cache {}: not written ({why}); the bind goes on",
+                        path.display()
+                    ));
+                }
+            }
+        }
+        Ok(kernels)
     }
 }
 
@@ -149,9 +261,15 @@ fn record(slot: &Mutex<Option<GpuError>>, error: GpuError) {
     }
 }
 
+/// The backends listed without `WGPU_BACKEND`: the native APIs only. GL through
+/// EGL adds a slow driver load and, where a native backend exists, nothing usable.
+pub const DEFAULT_BACKENDS: wgpu::Backends = wgpu::Backends::PRIMARY;
+
 fn make_instance() -> wgpu::Instance {
-    // Reads WGPU_BACKEND (and the other WGPU_* instance variables).
-    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+    descriptor.backends = DEFAULT_BACKENDS;
+    // `WGPU_BACKEND` (and the other WGPU_* instance variables) override it.
+    wgpu::Instance::new(descriptor.with_env())
 }
 
 /// Lower is better: discrete, integrated, virtual, unknown, then software.
@@ -217,7 +335,8 @@ pub fn adapters_report() -> String {
     let instance = make_instance();
     let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
     let mut report = String::new();
-    let backend_env = std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "(unset)".into());
+    let backend_env = std::env::var("WGPU_BACKEND")
+        .unwrap_or_else(|_| "(unset: Vulkan, Metal, DX12; not GL)".into());
     let name_env = std::env::var("WGPU_ADAPTER_NAME").unwrap_or_else(|_| "(unset)".into());
     let _ = writeln!(
         report,
@@ -237,7 +356,14 @@ pub fn adapters_report() -> String {
     match choose_adapter(adapters) {
         Ok(adapter) => {
             let limits = adapter.limits();
-            let _ = writeln!(report, "chosen: {}", describe(&adapter.get_info()));
+            let info = adapter.get_info();
+            let _ = writeln!(report, "chosen: {}", describe(&info));
+            let cache = if adapter.features().contains(wgpu::Features::PIPELINE_CACHE) {
+                pipeline_cache::load(&info)
+            } else {
+                CacheLoad::Unsupported
+            };
+            let _ = writeln!(report, "  pipeline cache: {}", cache.describe());
             let _ = writeln!(
                 report,
                 "  max storage buffer binding size: {} bytes ({} MiB)",

@@ -84,7 +84,11 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl Kernels {
-    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+    /// Compile the kernels, through `cache` where the device keeps a pipeline cache.
+    pub fn new(
+        device: &wgpu::Device,
+        cache: Option<&wgpu::PipelineCache>,
+    ) -> Result<Self, GpuError> {
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -126,7 +130,7 @@ impl Kernels {
                 module: &module,
                 entry_point: Some("main"),
                 compilation_options: Default::default(),
-                cache: None,
+                cache,
             })
         };
         let pmvc = pipeline("bind_pmvc", pmvc_source);

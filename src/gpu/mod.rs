@@ -5,18 +5,24 @@
 //!   adapter policy in its doc) or handed in ([`GpuContext::from_device`]).
 //! - [`Binder`]: a bind on a background thread, CPU or GPU, with progress and cancel;
 //!   [`Binder::bind_blocking`] for synchronous callers and benchmarks.
+//! - [`backend_choice`]: where a bind runs (`auto`, `cpu`, `gpu`), one rule for the
+//!   command line, Python and the editor, with `auto`'s cost model.
+//! - [`pipeline_cache`]: the compiled kernels kept on disk between runs.
 //! - Kernels in `shaders/bind_pmvc.wgsl` and `shaders/bind_mvc.wgsl`.
 
+pub mod backend_choice;
 mod binder;
 mod context;
 pub mod kernels;
+pub mod pipeline_cache;
 pub mod shader_source;
 
+pub use backend_choice::{BackendRequest, Decision};
 pub use binder::{
     Backend, BatchSize, BindConfig, BindError, BindHandle, BindInput, BindOutput, BindStats,
     Binder, GpuWeights,
 };
-pub use context::{adapters_report, GpuContext};
+pub use context::{adapters_report, GpuContext, DEFAULT_BACKENDS};
 
 /// Why a GPU operation failed. Device loss and out-of-memory end up here, never in a panic.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

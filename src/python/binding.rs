@@ -11,13 +11,14 @@ use super::weights::PyWeights;
 use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::coords::{BindOptions, BindProgress, Method, Parameter};
 use crate::geometry::classify_points;
-use crate::gpu::{Backend, BindError, BindInput, Binder, GpuContext};
+use crate::gpu::backend_choice::{decide, device_for, BackendRequest, Decision, Work};
+use crate::gpu::{Backend, BindError, BindInput, Binder};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// How often a waiting call reports progress and checks for signals.
@@ -102,43 +103,30 @@ pub(super) fn run_interruptible<T: Send>(
     Ok(result)
 }
 
-/// The backend for "auto", "cpu" or "gpu", as the command line chooses it:
-/// `auto` binds on a hardware GPU when there is one, on the CPU otherwise (a
-/// software adapter is slower than the CPU path). Devices are opened once per
-/// process.
-// The command line's `choose_backend` (src/cli/commands.rs) makes the same
-// choice; both could call one function in `gpu`.
-fn choose_backend(py: Python<'_>, choice: &str) -> PyResult<Backend> {
-    static ANY: OnceLock<Result<Arc<GpuContext>, String>> = OnceLock::new();
-    static HARDWARE: OnceLock<Option<Arc<GpuContext>>> = OnceLock::new();
-    match choice {
-        "cpu" => Ok(Backend::Cpu),
-        "gpu" => {
-            let context = py.detach(|| {
-                ANY.get_or_init(|| {
-                    GpuContext::new()
-                        .map(Arc::new)
-                        .map_err(|cause| cause.to_string())
-                })
-                .clone()
-            });
-            context
-                .map(Backend::Gpu)
-                .map_err(|cause| error(Kind::Backend, format!("backend \"gpu\": {cause}")))
-        }
-        "auto" => {
-            let context = py.detach(|| {
-                HARDWARE
-                    .get_or_init(|| GpuContext::new_hardware().ok().flatten().map(Arc::new))
-                    .clone()
-            });
-            Ok(context.map_or(Backend::Cpu, Backend::Gpu))
-        }
-        other => Err(error(
+/// Where a bind of `points` to `cage` runs for "auto", "cpu" or "gpu": the
+/// command line's rule ([`crate::gpu::backend_choice`]). Devices are opened once
+/// per process.
+fn choose_backend(
+    py: Python<'_>,
+    choice: &str,
+    options: BindOptions,
+    points: usize,
+    cage: &PyCage,
+) -> PyResult<Decision> {
+    let request = BackendRequest::from_name(choice).ok_or_else(|| {
+        error(
             Kind::Parameter,
-            format!("backend \"{other}\" is not one of \"auto\", \"cpu\", \"gpu\""),
-        )),
-    }
+            format!("backend \"{choice}\" is not one of \"auto\", \"cpu\", \"gpu\""),
+        )
+    })?;
+    let device = py
+        .detach(|| device_for(request))
+        .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))?;
+    Ok(decide(
+        request,
+        device.as_ref(),
+        &Work::of(options, points, &cage.cage),
+    ))
 }
 
 /// The family named `id`, or an error listing the known ones.
@@ -204,8 +192,9 @@ fn bind_options(
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
 /// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
-/// its family). ``backend`` is ``"auto"`` (a hardware GPU when there is one),
-/// ``"cpu"`` or ``"gpu"``; families without a GPU kernel bind on the CPU.
+/// its family). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
+/// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
+/// a GPU kernel bind on the CPU.
 /// ``progress``, if given, is called with ``(done, total)`` rows, from
 /// ``(0, total)`` to ``(total, total)``. The GIL is released while binding;
 /// Ctrl-C cancels within about a second.
@@ -240,9 +229,10 @@ pub(super) fn bind_points(
     backend: &str,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyWeights> {
-    let backend = choose_backend(py, backend)?;
-    let on_gpu = matches!(backend, Backend::Gpu(_))
-        && crate::gpu::kernels::Kernel::of(options.method).is_some();
+    let decision = choose_backend(py, backend, options, points.len(), cage)?;
+    let on_gpu = decision.on_gpu(options.method);
+    let backend = decision.backend;
+    let device = backend.clone();
     let rows = points.len();
     let columns = options.method.columns(&cage.cage);
     crate::geometry::budget::check_memory(
@@ -270,6 +260,12 @@ pub(super) fn bind_points(
         let result = Binder::new(backend).bind_blocking(&input, &shared);
         (classes, result)
     })?;
+    if let Backend::Gpu(context) = &device {
+        for notice in context.take_notices() {
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), "pmvc: {notice}");
+        }
+    }
     let output = result.map_err(|cause| bind_error(&cause))?;
     let weights = output
         .weights

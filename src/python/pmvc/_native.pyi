@@ -138,8 +138,8 @@ def bind(
 
     ``resolution`` is PMVC's cube-map resolution, ``grid`` harmonic
     coordinates' grid; each is read only by its family and checked against its
-    range. ``backend``: "auto" (a hardware GPU when there is one), "cpu" or
-    "gpu". The GIL is released; Ctrl-C cancels within about a second."""
+    range. ``backend``: "auto" (the CPU, or a hardware GPU where it is
+    predicted faster for this bind), "cpu" or "gpu". The GIL is released; Ctrl-C cancels within about a second."""
     ...
 
 def deform(

@@ -1,0 +1,395 @@
+//! Where a bind runs: the device each request may use, and for `auto` a cost
+//! model that predicts the CPU's and the GPU's time for the work and takes the
+//! faster. The command line, Python and the editor all decide here.
+
+use super::kernels::Kernel;
+use super::{Backend, GpuContext, GpuError};
+use crate::coords::{BindOptions, Method};
+use crate::geometry::Cage;
+use std::sync::{Arc, OnceLock};
+
+/// What the user asked for: `auto`, `cpu` or `gpu`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BackendRequest {
+    /// The faster of the two by [`predict`], on a hardware adapter only.
+    Auto,
+    Cpu,
+    /// Any adapter, a software one included.
+    Gpu,
+}
+
+impl BackendRequest {
+    pub const NAMES: [&'static str; 3] = ["auto", "cpu", "gpu"];
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "auto" => Some(Self::Auto),
+            "cpu" => Some(Self::Cpu),
+            "gpu" => Some(Self::Gpu),
+            _ => None,
+        }
+    }
+}
+
+/// The device a request may bind on, opened once per process: none for `cpu`;
+/// for `auto` a hardware adapter's, or none (without listing the adapters where
+/// the system has no GPU device node, [`GpuContext::new_hardware`]); for `gpu`
+/// the adapter policy's choice or its error.
+pub fn device_for(request: BackendRequest) -> Result<Option<Arc<GpuContext>>, GpuError> {
+    static ANY: OnceLock<Result<Arc<GpuContext>, GpuError>> = OnceLock::new();
+    static HARDWARE: OnceLock<Option<Arc<GpuContext>>> = OnceLock::new();
+    match request {
+        BackendRequest::Cpu => Ok(None),
+        BackendRequest::Gpu => ANY
+            .get_or_init(|| GpuContext::new().map(Arc::new))
+            .clone()
+            .map(Some),
+        BackendRequest::Auto => Ok(HARDWARE
+            .get_or_init(|| GpuContext::new_hardware().ok().flatten().map(Arc::new))
+            .clone()),
+    }
+}
+
+/// The adapter's kind, as far as speed goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AdapterClass {
+    Discrete,
+    /// Integrated, virtual or unknown hardware.
+    Integrated,
+    /// A rasteriser on the CPU's own cores (lavapipe, llvmpipe, WARP).
+    Software,
+}
+
+impl AdapterClass {
+    pub fn of(device_type: wgpu::DeviceType) -> Self {
+        match device_type {
+            wgpu::DeviceType::DiscreteGpu => Self::Discrete,
+            wgpu::DeviceType::Cpu => Self::Software,
+            _ => Self::Integrated,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::Discrete => "discrete",
+            Self::Integrated => "integrated",
+            Self::Software => "software",
+        }
+    }
+}
+
+/// The size of a bind, as the model reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    pub method: Method,
+    pub points: usize,
+    /// PMVC's cube-map texels per point (6·R²); 0 for the other families.
+    pub texels: usize,
+    pub cage_triangles: usize,
+    pub cage_vertices: usize,
+    pub cpu_threads: usize,
+}
+
+impl Work {
+    /// `points` bound to `cage` with `options`, on this process's CPU threads.
+    pub fn of(options: BindOptions, points: usize, cage: &Cage) -> Self {
+        let texels = if options.method == Method::Pmvc {
+            let side = options.resolution as usize;
+            6 * side * side
+        } else {
+            0
+        };
+        Self {
+            method: options.method,
+            points,
+            texels,
+            cage_triangles: cage.triangles().len(),
+            cage_vertices: cage.vertex_count(),
+            cpu_threads: rayon::current_num_threads(),
+        }
+    }
+}
+
+/// How much of the GPU's start is still to pay before its first batch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipelines {
+    /// Compiled in this process already.
+    Ready,
+    /// To compile, from a pipeline cache found on disk.
+    CacheHit,
+    /// To compile from nothing.
+    Cold,
+}
+
+/// The device's side of the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuState {
+    pub class: AdapterClass,
+    pub pipelines: Pipelines,
+    /// Seconds still to pay to open the device: 0 once it is open (it always is
+    /// when the model runs: the editor's, or the one opened while inputs loaded).
+    pub start_s: f64,
+}
+
+impl GpuState {
+    pub fn of(context: &GpuContext) -> Self {
+        let pipelines = if context.kernels_ready() {
+            Pipelines::Ready
+        } else if context.pipeline_cache().is_hit() {
+            Pipelines::CacheHit
+        } else {
+            Pipelines::Cold
+        };
+        Self {
+            class: AdapterClass::of(context.info.device_type),
+            pipelines,
+            start_s: 0.0,
+        }
+    }
+}
+
+/// Microseconds per point: `fixed + per_texel·texels + per_triangle·triangles`.
+#[derive(Clone, Copy, Debug)]
+struct PointCost {
+    fixed: f64,
+    per_texel: f64,
+    per_triangle: f64,
+}
+
+impl PointCost {
+    fn micros(&self, work: &Work) -> f64 {
+        self.fixed
+            + self.per_texel * work.texels as f64
+            + self.per_triangle * work.cage_triangles as f64
+    }
+}
+
+/// One family's costs: the CPU path on one effective thread, a discrete GPU,
+/// and a software adapter's time as a multiple of the CPU path's.
+#[derive(Clone, Copy, Debug)]
+struct FamilyCosts {
+    kernel: Kernel,
+    cpu: PointCost,
+    discrete: PointCost,
+    software_vs_cpu: f64,
+}
+
+// The model's coefficients, all in one place; recalibrate here when a kernel
+// changes (docs/gpu-binding.md, "Device policy", shows the same table).
+//
+// Sources: `pmvc bench --runs 5` medians, uploads and readbacks included, on an
+// NVIDIA H200 with 16 CPU threads (2026-11-26: PMVC 32² Armadillo size 0.087 s
+// CPU / 0.035 s GPU, Horse size 0.187 / 0.077, Hand size 0.245 / 0.092, Table 2
+// sphere 1523 0.774 / 0.252, MVC Horse size 0.050 / 0.014), the H100 rows of
+// docs/benchmarks.md for PMVC 64², and the 2-core rows there for the CPU path
+// (Armadillo size PMVC 32² 0.465 s, MVC 0.199 s) and for lavapipe (Armadillo
+// size: PMVC 13.5× the CPU path's time, MVC 0.73×). Least-squares by eye over
+// those rows; each prediction is within about ±30% of them.
+// Green's GPU kernel has no measurement yet: taken as twice MVC's per triangle;
+// its CPU path costs about what MVC's does (docs/benchmarks.md, 2026-11-25).
+const COSTS: [FamilyCosts; 3] = [
+    FamilyCosts {
+        kernel: Kernel::Pmvc,
+        cpu: PointCost {
+            fixed: 22.0,
+            per_texel: 0.0027,
+            per_triangle: 0.077,
+        },
+        discrete: PointCost {
+            fixed: 0.4,
+            per_texel: 0.000_22,
+            per_triangle: 0.0025,
+        },
+        software_vs_cpu: 13.5,
+    },
+    FamilyCosts {
+        kernel: Kernel::Mvc,
+        cpu: PointCost {
+            fixed: 1.0,
+            per_texel: 0.0,
+            per_triangle: 0.092,
+        },
+        discrete: PointCost {
+            fixed: 0.02,
+            per_texel: 0.0,
+            per_triangle: 0.0028,
+        },
+        // Measured 0.73 in one run ("about as fast on either"); taken as 1 so
+        // that a tie stays on the CPU path, whose cores lavapipe would share.
+        software_vs_cpu: 1.0,
+    },
+    FamilyCosts {
+        kernel: Kernel::Green,
+        cpu: PointCost {
+            fixed: 1.0,
+            per_texel: 0.0,
+            per_triangle: 0.095,
+        },
+        discrete: PointCost {
+            fixed: 0.04,
+            per_texel: 0.0,
+            per_triangle: 0.0056,
+        },
+        software_vs_cpu: 1.0,
+    },
+];
+
+/// CPU threads scale as `threads^0.8` (16 threads of the H200 host did about
+/// 9.2 times one thread's work; 2 threads about 1.7 times).
+const CPU_THREAD_EXPONENT: f64 = 0.8;
+/// A discrete GPU's time per bind besides its points (buffers, first batch).
+const GPU_BIND_FIXED_S: f64 = 0.003;
+/// An integrated GPU's time per point, in discrete ones' (not measured: a
+/// guess to recalibrate when one is).
+const INTEGRATED_VS_DISCRETE: f64 = 8.0;
+/// Compiling the three binding kernels, in seconds: (no cache, cache hit).
+/// Hardware: the H200's whole `--backend gpu` process took 0.30–0.36 s against
+/// 0.10–0.14 s for `cpu`, `pmvc info` (listing and opening) 0.09–0.1 s.
+/// The warm figure is a guess until measured on hardware. Software: lavapipe on
+/// the 2-core machine, a one-point bind's whole process 0.15–0.19 s against
+/// 0.008 s on the CPU, 0.05 s of it opening the device; Mesa 22.3's lavapipe
+/// keeps nothing in its pipeline cache, so a hit saves nothing there
+/// (docs/benchmarks.md, "Start-up and the pipeline cache").
+const COMPILE_HARDWARE_S: (f64, f64) = (0.15, 0.03);
+const COMPILE_SOFTWARE_S: (f64, f64) = (0.14, 0.14);
+
+/// The model's two predictions for a bind, in seconds, and its choice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prediction {
+    /// The CPU path; `None` for a family the model has no figures for.
+    pub cpu_s: Option<f64>,
+    /// The GPU, start still to pay included; `None` for a family without a kernel.
+    pub gpu_s: Option<f64>,
+    pub work: Work,
+    pub gpu: GpuState,
+}
+
+impl Prediction {
+    /// Whether the GPU is predicted faster. A family without a kernel or without
+    /// figures binds on the CPU.
+    pub fn gpu_wins(&self) -> bool {
+        matches!((self.cpu_s, self.gpu_s), (Some(cpu), Some(gpu)) if gpu < cpu)
+    }
+
+    /// One line: both predictions and what they rest on.
+    pub fn explain(&self) -> String {
+        if self.gpu_s.is_none() {
+            return format!("{} has no GPU kernel", self.work.method.name());
+        }
+        let seconds =
+            |s: Option<f64>| s.map_or_else(|| "not modelled".into(), |s| format!("{s:.3} s"));
+        let pipelines = match self.gpu.pipelines {
+            Pipelines::Ready => "kernels compiled",
+            Pipelines::CacheHit => "pipeline cache hit",
+            Pipelines::Cold => "no pipeline cache: kernels compiled from nothing",
+        };
+        format!(
+            "predicted CPU {} ({} threads), GPU {} ({}, {pipelines})",
+            seconds(self.cpu_s),
+            self.work.cpu_threads,
+            seconds(self.gpu_s),
+            self.gpu.class.name(),
+        )
+    }
+}
+
+/// The model: the CPU's and the GPU's time for `work` on a device in `gpu`'s state.
+pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
+    let costs = Kernel::of(work.method)
+        .and_then(|kernel| COSTS.iter().find(|costs| costs.kernel == kernel));
+    let Some(costs) = costs else {
+        return Prediction {
+            cpu_s: None,
+            gpu_s: None,
+            work: *work,
+            gpu: *gpu,
+        };
+    };
+    let points = work.points as f64;
+    let threads = (work.cpu_threads.max(1) as f64).powf(CPU_THREAD_EXPONENT);
+    let cpu_s = points * costs.cpu.micros(work) * 1e-6 / threads;
+    let (cold, warm) = match gpu.class {
+        AdapterClass::Software => COMPILE_SOFTWARE_S,
+        _ => COMPILE_HARDWARE_S,
+    };
+    let compile_s = match gpu.pipelines {
+        Pipelines::Ready => 0.0,
+        Pipelines::CacheHit => warm,
+        Pipelines::Cold => cold,
+    };
+    let run_s = match gpu.class {
+        AdapterClass::Discrete => GPU_BIND_FIXED_S + points * costs.discrete.micros(work) * 1e-6,
+        AdapterClass::Integrated => {
+            GPU_BIND_FIXED_S + INTEGRATED_VS_DISCRETE * points * costs.discrete.micros(work) * 1e-6
+        }
+        AdapterClass::Software => costs.software_vs_cpu * cpu_s,
+    };
+    Prediction {
+        cpu_s: Some(cpu_s),
+        gpu_s: Some(gpu.start_s + compile_s + run_s),
+        work: *work,
+        gpu: *gpu,
+    }
+}
+
+/// Where a bind runs, and for `auto` with a device the prediction behind it.
+#[derive(Clone, Debug)]
+pub struct Decision {
+    pub backend: Backend,
+    pub prediction: Option<Prediction>,
+}
+
+impl Decision {
+    /// Whether GPU kernels compute the weights (a family without one binds on
+    /// the CPU on every backend).
+    pub fn on_gpu(&self, method: Method) -> bool {
+        matches!(self.backend, Backend::Gpu(_)) && Kernel::of(method).is_some()
+    }
+
+    /// One line for the user: where and, for `auto`, why.
+    pub fn explain(&self) -> String {
+        let place = match &self.backend {
+            Backend::Gpu(context) => format!(
+                "GPU {} (device opened in {:.3} s; pipeline cache: {})",
+                context.info.name,
+                context.opened_in().as_secs_f64(),
+                context.pipeline_cache().describe()
+            ),
+            Backend::Cpu => "CPU".to_owned(),
+        };
+        match &self.prediction {
+            Some(prediction) => format!("binding on the {place}: {}", prediction.explain()),
+            None => format!("binding on the {place}"),
+        }
+    }
+}
+
+/// The one rule: `cpu` binds on the CPU, `gpu` on `device`, `auto` on `device`
+/// only where [`predict`] says it is faster than the CPU path for `work`.
+pub fn decide(request: BackendRequest, device: Option<&Arc<GpuContext>>, work: &Work) -> Decision {
+    let Some(context) = device.filter(|_| request != BackendRequest::Cpu) else {
+        return Decision {
+            backend: Backend::Cpu,
+            prediction: None,
+        };
+    };
+    if request == BackendRequest::Gpu {
+        return Decision {
+            backend: Backend::Gpu(Arc::clone(context)),
+            prediction: None,
+        };
+    }
+    let prediction = predict(work, &GpuState::of(context));
+    Decision {
+        backend: if prediction.gpu_wins() {
+            Backend::Gpu(Arc::clone(context))
+        } else {
+            Backend::Cpu
+        },
+        prediction: Some(prediction),
+    }
+}
+
+#[cfg(test)]
+#[path = "backend_choice_tests.rs"]
+mod tests;

@@ -1,0 +1,123 @@
+//! The cost model's choices on given figures (not timings).
+
+use super::*;
+
+fn work(method: Method, points: usize, cage_vertices: usize, cpu_threads: usize) -> Work {
+    Work {
+        method,
+        points,
+        texels: if method == Method::Pmvc {
+            6 * 32 * 32
+        } else {
+            0
+        },
+        cage_triangles: 2 * cage_vertices - 4,
+        cage_vertices,
+        cpu_threads,
+    }
+}
+
+fn device(class: AdapterClass, pipelines: Pipelines) -> GpuState {
+    GpuState {
+        class,
+        pipelines,
+        start_s: 0.0,
+    }
+}
+
+#[test]
+fn a_tiny_bind_goes_to_the_cpu_and_a_large_one_to_a_discrete_gpu() {
+    let cold = device(AdapterClass::Discrete, Pipelines::Cold);
+    let tiny = predict(&work(Method::Pmvc, 500, 110, 16), &cold);
+    assert!(!tiny.gpu_wins(), "{}", tiny.explain());
+    let large = predict(&work(Method::Pmvc, 200_000, 110, 16), &cold);
+    assert!(large.gpu_wins(), "{}", large.explain());
+}
+
+#[test]
+fn the_pipeline_cache_and_compiled_kernels_move_the_break_even_down() {
+    // Armadillo size on 16 threads: the start decides it.
+    let scene = work(Method::Pmvc, 15_002, 110, 16);
+    let cold = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Cold));
+    let hit = predict(&scene, &device(AdapterClass::Discrete, Pipelines::CacheHit));
+    let ready = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Ready));
+    assert!(!cold.gpu_wins(), "{}", cold.explain());
+    assert!(hit.gpu_wins(), "{}", hit.explain());
+    assert!(ready.gpu_wins(), "{}", ready.explain());
+    assert!(ready.gpu_s < hit.gpu_s && hit.gpu_s < cold.gpu_s);
+    assert_eq!(cold.cpu_s, hit.cpu_s, "the CPU's side has no start");
+}
+
+#[test]
+fn a_device_still_to_open_counts_its_start() {
+    let scene = work(Method::Pmvc, 40_000, 110, 16);
+    let open = device(AdapterClass::Discrete, Pipelines::Ready);
+    let closed = GpuState {
+        start_s: 1.0,
+        ..open
+    };
+    assert!(predict(&scene, &open).gpu_wins());
+    assert!(!predict(&scene, &closed).gpu_wins());
+}
+
+#[test]
+fn a_software_adapter_never_wins_pmvc_against_two_cpu_threads() {
+    for pipelines in [Pipelines::Ready, Pipelines::CacheHit, Pipelines::Cold] {
+        for points in [1, 1_000, 15_002, 1_000_000] {
+            for vertices in [8, 110, 1_523] {
+                for threads in [2, 4, 16] {
+                    let prediction = predict(
+                        &work(Method::Pmvc, points, vertices, threads),
+                        &device(AdapterClass::Software, pipelines),
+                    );
+                    assert!(!prediction.gpu_wins(), "{}", prediction.explain());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn harmonic_coordinates_always_bind_on_the_cpu() {
+    let prediction = predict(
+        &work(Method::Harmonic, 10_000_000, 1_523, 1),
+        &device(AdapterClass::Discrete, Pipelines::Ready),
+    );
+    assert_eq!(prediction.gpu_s, None);
+    assert!(!prediction.gpu_wins());
+    assert!(
+        prediction.explain().contains("no GPU kernel"),
+        "{}",
+        prediction.explain()
+    );
+}
+
+#[test]
+fn more_cpu_threads_keep_more_binds_on_the_cpu() {
+    let gpu = device(AdapterClass::Discrete, Pipelines::CacheHit);
+    let two = predict(&work(Method::Mvc, 20_000, 51, 2), &gpu);
+    let many = predict(&work(Method::Mvc, 20_000, 51, 64), &gpu);
+    assert!(two.gpu_wins(), "{}", two.explain());
+    assert!(!many.gpu_wins(), "{}", many.explain());
+}
+
+#[test]
+fn an_integrated_gpu_needs_more_work_than_a_discrete_one() {
+    let scene = work(Method::Pmvc, 30_000, 110, 8);
+    let discrete = predict(&scene, &device(AdapterClass::Discrete, Pipelines::CacheHit));
+    let integrated = predict(
+        &scene,
+        &device(AdapterClass::Integrated, Pipelines::CacheHit),
+    );
+    assert!(discrete.gpu_wins(), "{}", discrete.explain());
+    assert!(!integrated.gpu_wins(), "{}", integrated.explain());
+}
+
+#[test]
+fn requests_parse_from_their_names_only() {
+    for name in BackendRequest::NAMES {
+        assert!(BackendRequest::from_name(name).is_some(), "{name}");
+    }
+    assert_eq!(BackendRequest::from_name("GPU"), None);
+    assert_eq!(BackendRequest::from_name(""), None);
+}
