@@ -6,7 +6,9 @@ use crate::geometry::{
     self, classify_points, extension_warning, refuse_same_file, shown_path, Cage, MeshFile,
     OutputSet, PointClasses,
 };
-use crate::gpu::backend_choice::{decide, device_for, BackendRequest, Decision, Work};
+use crate::gpu::backend_choice::{
+    decide, decide_and_open, device_for, BackendRequest, Decision, Work,
+};
 use crate::gpu::{Backend, BindInput, Binder};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::DVec3;
@@ -138,7 +140,7 @@ pub(super) fn bind_rows(
 ) -> Result<BoundRows> {
     // Decided on the whole bind, so that every block of a streamed one binds
     // on the same device.
-    let decision = decide_on(input, input.mesh.mesh.positions.len(), choice, backend);
+    let decision = decide_on(input, input.mesh.mesh.positions.len(), choice, backend)?;
     if choice.verbose && range.start == 0 {
         warn_line!("pmvc: {}", decision.explain());
     }
@@ -214,32 +216,32 @@ impl From<BackendArg> for BackendRequest {
     }
 }
 
-/// The device `--backend` may bind on ([`device_for`]): none for `cpu`, a hardware
-/// adapter's or none for `auto`, the adapter policy's for `gpu`. Run while the
-/// inputs load; [`bind_rows`] then decides, once the work is known, whether
-/// `auto` uses it.
+/// The device `--backend gpu` binds on, opened while the inputs load. `cpu` and
+/// `auto` open nothing here: `auto` loads a driver only once the work is known
+/// and a GPU could win it ([`decide_on`]).
 pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
-    let device = device_for(choice.into()).map_err(|error| match choice {
-        BackendArg::Gpu => anyhow!(error).context("--backend gpu"),
-        _ => anyhow!(error),
-    })?;
+    if choice != BackendArg::Gpu {
+        return Ok(Backend::Cpu);
+    }
+    let device =
+        device_for(BackendRequest::Gpu).map_err(|error| anyhow!(error).context("--backend gpu"))?;
     Ok(device.map_or(Backend::Cpu, Backend::Gpu))
 }
 
 /// Where a bind of `rows` rows of `input` runs, by the one rule of
-/// [`crate::gpu::backend_choice`], on the device [`choose_backend`] opened.
+/// [`crate::gpu::backend_choice`]: on the device [`choose_backend`] opened, or,
+/// for `auto`, on one opened now when a hardware GPU could beat the CPU.
 pub(super) fn decide_on(
     input: &BoundInput,
     rows: usize,
     choice: &MethodChoice,
     device: &Backend,
-) -> Decision {
-    let device = match device {
-        Backend::Gpu(context) => Some(context),
-        Backend::Cpu => None,
-    };
+) -> Result<Decision> {
     let work = Work::of(choice.options(), rows, &input.cage);
-    decide(choice.backend.into(), device, &work)
+    Ok(match device {
+        Backend::Gpu(context) => decide(choice.backend.into(), Some(context), &work),
+        Backend::Cpu => decide_and_open(choice.backend.into(), &work)?,
+    })
 }
 
 /// A progress bar on stderr when it is a terminal; hidden otherwise.

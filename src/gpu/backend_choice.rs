@@ -237,20 +237,23 @@ const COSTS: [FamilyCosts; 3] = [
 /// CPU threads scale as `threads^0.8` (16 threads of the H200 host did about
 /// 9.2 times one thread's work; 2 threads about 1.7 times).
 const CPU_THREAD_EXPONENT: f64 = 0.8;
-/// A discrete GPU's time per bind besides its points (buffers, first batch).
-const GPU_BIND_FIXED_S: f64 = 0.003;
+/// A discrete GPU's time per bind besides its points, its device and its
+/// kernels: buffers, the first batch's round trip, and giving the device back at
+/// exit. With the two below it makes the 0.18–0.25 s by which the H200's whole
+/// `--backend gpu` process exceeded `--backend cpu` on scenes whose binds take
+/// 0.02–0.1 s (2026-11-26, docs/benchmarks.md, "Start-up and the pipeline cache").
+const GPU_BIND_FIXED_S: f64 = 0.03;
 /// An integrated GPU's time per point, in discrete ones' (not measured: a
 /// guess to recalibrate when one is).
 const INTEGRATED_VS_DISCRETE: f64 = 8.0;
 /// Compiling the three binding kernels, in seconds: (no cache, cache hit).
-/// Hardware: the H200's whole `--backend gpu` process took 0.30–0.36 s against
-/// 0.10–0.14 s for `cpu`, `pmvc info` (listing and opening) 0.09–0.1 s.
-/// The warm figure is a guess until measured on hardware. Software: lavapipe on
-/// the 2-core machine, a one-point bind's whole process 0.15–0.19 s against
-/// 0.008 s on the CPU, 0.05 s of it opening the device; Mesa 22.3's lavapipe
-/// keeps nothing in its pipeline cache, so a hit saves nothing there
-/// (docs/benchmarks.md, "Start-up and the pipeline cache").
-const COMPILE_HARDWARE_S: (f64, f64) = (0.15, 0.03);
+/// Hardware: the H200 machine's first one-point `--backend gpu` bind took 0.75 s,
+/// later ones 0.25–0.30 s with the pipeline cache hit, 0.14–0.18 s of each
+/// opening the device. Software: lavapipe on the 2-core machine, a one-point
+/// bind's whole process 0.15–0.19 s against 0.008 s on the CPU, 0.05 s of it
+/// opening the device; Mesa 22.3's lavapipe keeps nothing in its pipeline cache,
+/// so a hit saves nothing there (docs/benchmarks.md).
+const COMPILE_HARDWARE_S: (f64, f64) = (0.45, 0.05);
 const COMPILE_SOFTWARE_S: (f64, f64) = (0.14, 0.14);
 
 /// The model's two predictions for a bind, in seconds, and its choice.
@@ -283,8 +286,16 @@ impl Prediction {
             Pipelines::CacheHit => "pipeline cache hit",
             Pipelines::Cold => "no pipeline cache: kernels compiled from nothing",
         };
+        let start = if self.gpu.start_s > 0.0 {
+            format!(
+                "; at best, with {:.2} s to open the device",
+                self.gpu.start_s
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "predicted CPU {} ({} threads), GPU {} ({}, {pipelines})",
+            "predicted CPU {} ({} threads), GPU {} ({}, {pipelines}{start})",
             seconds(self.cpu_s),
             self.work.cpu_threads,
             seconds(self.gpu_s),
@@ -362,6 +373,42 @@ impl Decision {
             None => format!("binding on the {place}"),
         }
     }
+}
+
+/// Seconds to list the adapters and open a hardware device, before any kernel
+/// compiles: 0.14–0.18 s on the H200 machine (`pmvc bind --verbose`, 2026-11-26).
+pub const HARDWARE_START_S: f64 = 0.15;
+
+/// The best a hardware GPU could do for `work` with its device still to open: a
+/// discrete adapter whose kernels are in the pipeline cache.
+pub fn best_gpu_case(work: &Work) -> Prediction {
+    predict(
+        work,
+        &GpuState {
+            class: AdapterClass::Discrete,
+            pipelines: Pipelines::CacheHit,
+            start_s: HARDWARE_START_S,
+        },
+    )
+}
+
+/// The one rule, device included, for callers that have none open yet (the
+/// command line, Python): `cpu` loads no driver; `gpu` opens the adapter
+/// policy's choice; `auto` binds on the CPU without loading any driver when even
+/// [`best_gpu_case`] loses, and otherwise opens a hardware device and [`decide`]s
+/// on its real state.
+pub fn decide_and_open(request: BackendRequest, work: &Work) -> Result<Decision, GpuError> {
+    if request == BackendRequest::Auto {
+        let best = best_gpu_case(work);
+        if !best.gpu_wins() {
+            return Ok(Decision {
+                backend: Backend::Cpu,
+                prediction: Some(best),
+            });
+        }
+    }
+    let device = device_for(request)?;
+    Ok(decide(request, device.as_ref(), work))
 }
 
 /// The one rule: `cpu` binds on the CPU, `gpu` on `device`, `auto` on `device`

@@ -36,8 +36,9 @@ fn a_tiny_bind_goes_to_the_cpu_and_a_large_one_to_a_discrete_gpu() {
 
 #[test]
 fn the_pipeline_cache_and_compiled_kernels_move_the_break_even_down() {
-    // Armadillo size on 16 threads: the start decides it.
-    let scene = work(Method::Pmvc, 15_002, 110, 16);
+    // Four times Armadillo size on 16 threads: the start decides it (at Armadillo
+    // size the H200's whole process lost to the CPU even with the cache hit).
+    let scene = work(Method::Pmvc, 60_000, 110, 16);
     let cold = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Cold));
     let hit = predict(&scene, &device(AdapterClass::Discrete, Pipelines::CacheHit));
     let ready = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Ready));
@@ -120,4 +121,15 @@ fn requests_parse_from_their_names_only() {
     }
     assert_eq!(BackendRequest::from_name("GPU"), None);
     assert_eq!(BackendRequest::from_name(""), None);
+}
+
+#[test]
+fn auto_decides_a_bind_the_best_gpu_would_lose_before_opening_any_device() {
+    let tiny = work(Method::Pmvc, 100, 110, 16);
+    let decision = decide_and_open(BackendRequest::Auto, &tiny).expect("no device needed");
+    assert!(matches!(decision.backend, Backend::Cpu));
+    // Decided on the best case, device still to open: no driver was loaded.
+    let prediction = decision.prediction.expect("the model's figures");
+    assert_eq!(prediction.gpu.start_s, HARDWARE_START_S);
+    assert!(!prediction.gpu_wins(), "{}", prediction.explain());
 }

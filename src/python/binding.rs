@@ -11,7 +11,7 @@ use super::weights::PyWeights;
 use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::coords::{BindOptions, BindProgress, Method, Parameter};
 use crate::geometry::classify_points;
-use crate::gpu::backend_choice::{decide, device_for, BackendRequest, Decision, Work};
+use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindError, BindInput, Binder};
 use numpy::PyArray2;
 use pyo3::prelude::*;
@@ -119,14 +119,9 @@ fn choose_backend(
             format!("backend \"{choice}\" is not one of \"auto\", \"cpu\", \"gpu\""),
         )
     })?;
-    let device = py
-        .detach(|| device_for(request))
-        .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))?;
-    Ok(decide(
-        request,
-        device.as_ref(),
-        &Work::of(options, points, &cage.cage),
-    ))
+    let work = Work::of(options, points, &cage.cage);
+    py.detach(|| decide_and_open(request, &work))
+        .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))
 }
 
 /// The family named `id`, or an error listing the known ones.
