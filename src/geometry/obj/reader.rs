@@ -1,49 +1,13 @@
-//! Wavefront OBJ, read in one pass over the text, keeping the file's vertex order.
-//!
-//! Read: `v` (x y z, x y z w, or x y z r g b; the coordinates in f64), `f` with
-//! `v`, `v/vt`, `v//vn` and `v/vt/vn` corners and negative (relative) indices,
-//! polygons (cut by [`triangulate_polygon`]). Checked, then dropped: `vt`, `vn`,
-//! `o`/`g` groups and `usemtl`. Skipped: comments, `l` polylines, `mtllib` and
-//! unknown keywords. OBJ has no line continuations here, as it had none in tobj.
-//!
-//! This reader replaced tobj, which made a copy of the text and a hash map per
-//! group; it accepts and refuses the same files, tobj's rules included
-//! (tests/obj_reader.rs compares the two on the bundled and shared meshes and on
-//! mutated files), and names the line in every message:
-//! - a `vt` line has two or three numbers;
-//! - a corner's texture and normal parts, when written, are integers, and a
-//!   corner has at most three parts;
-//! - indices are checked against what the file has defined by the end of the
-//!   face's group (`o` or `g` after faces, or the end of the file): a face may
-//!   refer ahead within its group, not past it. Texture and normal indices are
-//!   checked only where the file has any, and index 0, or a relative one just
-//!   past the start, means "none", as tobj read them;
-//! - `usemtl` names a material (after the first space, as tobj split it).
-//!
-//! tobj stays as the reference of those tests, not as a fallback: nothing it read
-//! is left to it.
+//! One piece of an OBJ file's text, read line by line (see the parent module for
+//! what is read and the rules kept from tobj).
 
-use super::{triangulate_polygon, LoadError, MeshFile, MeshFormat, TriMesh};
+use super::super::{triangulate_polygon, LoadError, TriMesh};
 use glam::DVec3;
 use std::path::Path;
-
-/// The most vertices a mesh file may have (so that every index fits a `u32`
-/// with room, and as many as pmvc has always read).
-pub(super) const MAX_VERTICES: usize = 1 << 24;
 
 /// What tobj read a corner part of `0` (or a relative index one before the
 /// first element) as: no index.
 const NO_INDEX: usize = usize::MAX;
-
-pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError> {
-    let mesh = Reader::new(path, &text).read()?;
-    Ok(MeshFile {
-        path: path.to_owned(),
-        format: MeshFormat::Obj,
-        mesh,
-        obj_text: Some(text),
-    })
-}
 
 /// What a face refers to, for the checks made when its group ends.
 #[derive(Clone, Copy)]
@@ -54,7 +18,7 @@ enum Element {
 }
 
 /// An index a face wrote ahead of what the file had defined at its line.
-struct Ahead {
+pub(super) struct Ahead {
     line: usize,
     /// 1-based.
     face: usize,
@@ -64,25 +28,91 @@ struct Ahead {
     written: i64,
 }
 
-struct Reader<'a> {
+/// Elements defined so far in the file.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Counts {
+    pub vertices: usize,
+    pub texture_coordinates: usize,
+    pub normals: usize,
+}
+
+/// What comes before a piece of text: its lines, elements and faces.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Start {
+    pub lines: usize,
+    pub counts: Counts,
+    pub faces: usize,
+}
+
+/// An `o` or `g` line: where a group ends, with the counts there.
+pub(super) struct GroupEnd {
+    pub line: usize,
+    pub counts: Counts,
+}
+
+/// A piece read: its share of the mesh, and what is left to check against the
+/// pieces after it.
+#[derive(Default)]
+pub(super) struct Piece {
+    pub mesh: TriMesh,
+    /// Quads, cut once every position is known: their first triangle's slot in
+    /// `mesh.triangles` and their corners.
+    pub quads: Vec<(usize, [u32; 4])>,
+    /// The piece's first `o` or `g` line, where indices written ahead before
+    /// the piece are checked.
+    pub first_group_end: Option<GroupEnd>,
+    /// Indices written ahead after the piece's last `o` or `g` line.
+    pub carried: Vec<Ahead>,
+    /// The first error by tobj's rules, and the line where tobj met it (a
+    /// group's end for an index past it); errors of the checks made at each
+    /// line come before any of these, as they did when they ran before tobj.
+    pub group_error: Option<(usize, LoadError)>,
+}
+
+/// The first of `ahead` past what `counts` has, as an error.
+pub(super) fn check_ahead(path: &Path, ahead: &[Ahead], counts: Counts) -> Option<LoadError> {
+    ahead.iter().find_map(|ahead| {
+        let (count, what) = match ahead.element {
+            Element::Vertex => (counts.vertices, "vertex"),
+            Element::TextureCoordinate => (counts.texture_coordinates, "texture coordinate"),
+            Element::Normal => (counts.normals, "normal"),
+        };
+        // Texture and normal indices count only where the file has any.
+        let checked = matches!(ahead.element, Element::Vertex) || count > 0;
+        (checked && ahead.index >= count).then(|| LoadError::Parse {
+            path: path.to_owned(),
+            line: ahead.line,
+            message: format!(
+                "face {} refers to {what} {}, but only {count} are defined by the end of its group",
+                ahead.face, ahead.written
+            ),
+        })
+    })
+}
+
+/// The first word of `line`: what kind of line it is.
+pub(super) fn keyword(line: &str, ascii: bool) -> Option<&str> {
+    words(line, ascii).next()
+}
+
+fn words(line: &str, ascii: bool) -> Words<'_> {
+    if ascii {
+        Words::Ascii(line, 0)
+    } else {
+        Words::Unicode(line.split_whitespace())
+    }
+}
+
+pub(super) struct Reader<'a> {
     path: &'a Path,
-    text: &'a str,
-    mesh: TriMesh,
+    start: Start,
+    /// `v` lines in the whole file.
+    total_vertices: usize,
+    piece: Piece,
+    /// Counts within the piece.
+    local: Counts,
     faces: usize,
-    texture_coordinates: usize,
-    normals: usize,
-    /// `v` lines in the whole file, counted when a face first refers past the
-    /// vertices read so far.
-    total_vertices: Option<usize>,
-    /// Faces since the last group started.
-    group_faces: usize,
     ahead: Vec<Ahead>,
-    /// Quads referring to vertices not read yet: their two triangles' slot and
-    /// corners, cut once every position is known.
-    quads_ahead: Vec<(usize, [u32; 4])>,
-    /// The first error by tobj's rules; errors of the checks made at each line
-    /// come first, as they did when those checks ran before tobj.
-    group_error: Option<LoadError>,
     corners: Vec<u32>,
 }
 
@@ -127,20 +157,33 @@ impl<'a> Iterator for Words<'a> {
 }
 
 impl<'a> Reader<'a> {
-    fn new(path: &'a Path, text: &'a str) -> Self {
+    /// A reader of the text after `start`, in a file of `total_vertices`;
+    /// `holds` is what the piece's lines hold, counted before.
+    pub fn new(path: &'a Path, start: Start, total_vertices: usize, holds: &Start) -> Self {
+        let mut piece = Piece::default();
+        piece.mesh.positions.reserve_exact(holds.counts.vertices);
+        // Each face makes at least a triangle.
+        piece.mesh.triangles.reserve(holds.faces);
+        piece.mesh.triangle_faces.reserve(holds.faces);
         Reader {
             path,
-            text,
-            mesh: TriMesh::default(),
+            start,
+            total_vertices,
+            piece,
+            local: Counts::default(),
             faces: 0,
-            texture_coordinates: 0,
-            normals: 0,
-            total_vertices: None,
-            group_faces: 0,
             ahead: Vec::new(),
-            quads_ahead: Vec::new(),
-            group_error: None,
             corners: Vec::new(),
+        }
+    }
+
+    /// What the file has defined so far.
+    fn counts(&self) -> Counts {
+        let (start, local) = (self.start.counts, self.local);
+        Counts {
+            vertices: start.vertices + local.vertices,
+            texture_coordinates: start.texture_coordinates + local.texture_coordinates,
+            normals: start.normals + local.normals,
         }
     }
 
@@ -152,60 +195,40 @@ impl<'a> Reader<'a> {
         }
     }
 
-    fn read(mut self) -> Result<TriMesh, LoadError> {
-        let text = self.text;
+    /// Read `text`, the piece, checking every line; an error of the checks made
+    /// at each line ends it.
+    pub fn read(mut self, text: &str) -> Result<Piece, LoadError> {
         let ascii = text.is_ascii();
         for (line_index, line) in text.lines().enumerate() {
-            let line_number = line_index + 1;
-            let mut words = if ascii {
-                Words::Ascii(line, 0)
-            } else {
-                Words::Unicode(line.split_whitespace())
-            };
+            let line_number = self.start.lines + line_index + 1;
+            let mut words = words(line, ascii);
             match words.next() {
                 Some("v") => self.vertex(line_number, words)?,
                 Some("f") => self.face(line_number, words)?,
                 Some(keyword @ ("vn" | "vt")) => self.attribute(line_number, keyword, words)?,
-                Some("o" | "g") if self.group_faces > 0 => self.end_group(),
-                Some("usemtl") if self.group_error.is_none() => {
+                // Indices written ahead exist only where the group has faces, and
+                // tobj ended a group with faces at any `o` or `g` line.
+                Some("o" | "g") => self.end_group(line_number),
+                Some("usemtl") => {
                     // tobj took the name after the first space, and refused none.
                     let name = line.split_once(' ').unwrap_or_default().1.trim();
                     if name.is_empty() {
-                        self.group_error = Some(
-                            self.parse_error(line_number, "usemtl names no material".to_owned()),
+                        self.refuse_by_group_rules(
+                            line_number,
+                            line_number,
+                            "usemtl names no material".to_owned(),
                         );
                     }
                 }
                 _ => {}
             }
         }
-        self.end_group();
-        if self.mesh.positions.is_empty() {
-            return Err(LoadError::NoVertices {
-                path: self.path.to_owned(),
-            });
-        }
-        if self.mesh.positions.len() > MAX_VERTICES {
-            return Err(LoadError::TooLarge {
-                path: self.path.to_owned(),
-                count: self.mesh.positions.len(),
-                limit: MAX_VERTICES,
-            });
-        }
-        if let Some(error) = self.group_error {
-            return Err(error);
-        }
-        let mut triangles = Vec::with_capacity(2);
-        for &(slot, quad) in &self.quads_ahead {
-            triangles.clear();
-            triangulate_polygon(&quad, &self.mesh.positions, &mut triangles);
-            self.mesh.triangles[slot..slot + 2].copy_from_slice(&triangles);
-        }
-        Ok(self.mesh)
+        self.piece.carried = std::mem::take(&mut self.ahead);
+        Ok(self.piece)
     }
 
     fn vertex(&mut self, line_number: usize, mut words: Words) -> Result<(), LoadError> {
-        let vertex = self.mesh.positions.len();
+        let vertex = self.counts().vertices;
         let mut coordinate = [0.0f64; 3];
         for (axis, value) in coordinate.iter_mut().enumerate() {
             let word = words.next().ok_or_else(|| {
@@ -255,7 +278,11 @@ impl<'a> Reader<'a> {
                 vertex: vertex + 1,
             });
         }
-        self.mesh.positions.push(DVec3::from_array(coordinate));
+        self.piece
+            .mesh
+            .positions
+            .push(DVec3::from_array(coordinate));
+        self.local.vertices += 1;
         Ok(())
     }
 
@@ -282,39 +309,53 @@ impl<'a> Reader<'a> {
             ));
         }
         if keyword == "vn" {
-            self.normals += 1;
-        } else if count == 1 {
-            self.refuse_by_group_rules(
-                line_number,
-                "texture coordinate has 1 number; expected u v or u v w".to_owned(),
-            );
+            self.local.normals += 1;
         } else {
-            self.texture_coordinates += 1;
+            if count == 1 {
+                self.refuse_by_group_rules(
+                    line_number,
+                    line_number,
+                    "texture coordinate has 1 number; expected u v or u v w".to_owned(),
+                );
+            }
+            // Counted as the census before reading counts it.
+            self.local.texture_coordinates += 1;
         }
         Ok(())
     }
 
-    /// Record the first error of tobj's rules; reading goes on, as the checks
-    /// made at each line came first.
-    fn refuse_by_group_rules(&mut self, line_number: usize, message: String) {
-        if self.group_error.is_none() {
-            self.group_error = Some(self.parse_error(line_number, message));
+    /// Record the first error of tobj's rules, met at `at`; reading goes on, as
+    /// the checks made at each line came first.
+    fn refuse_by_group_rules(&mut self, at: usize, line_number: usize, message: String) {
+        if self.piece.group_error.is_none() {
+            let error = LoadError::Parse {
+                path: self.path.to_owned(),
+                line: line_number,
+                message,
+            };
+            self.piece.group_error = Some((at, error));
         }
     }
 
-    /// `v` lines in the whole file.
-    fn total_vertices(&mut self) -> usize {
-        let text = self.text;
-        *self.total_vertices.get_or_insert_with(|| {
-            text.lines()
-                .filter(|line| line.split_whitespace().next() == Some("v"))
-                .count()
-        })
+    /// An `o` or `g` line: what the group's faces wrote ahead must be defined
+    /// by now.
+    fn end_group(&mut self, line_number: usize) {
+        let counts = self.counts();
+        self.piece.first_group_end.get_or_insert(GroupEnd {
+            line: line_number,
+            counts,
+        });
+        let ahead = std::mem::take(&mut self.ahead);
+        if self.piece.group_error.is_none() {
+            if let Some(error) = check_ahead(self.path, &ahead, counts) {
+                self.piece.group_error = Some((line_number, error));
+            }
+        }
     }
 
     fn face(&mut self, line_number: usize, words: Words) -> Result<(), LoadError> {
         // The face's number in messages, from 1; its triangles' face from 0.
-        let face = self.faces + 1;
+        let face = self.start.faces + self.faces + 1;
         let corner_count = words.clone().count();
         if corner_count < 3 {
             return Err(self.parse_error(
@@ -322,7 +363,7 @@ impl<'a> Reader<'a> {
                 format!("face {face} has {corner_count} corners; a face needs at least 3"),
             ));
         }
-        let read = self.mesh.positions.len();
+        let read = self.counts().vertices;
         self.corners.clear();
         for word in words {
             let mut parts = word.split('/');
@@ -345,7 +386,7 @@ impl<'a> Reader<'a> {
             };
             let behind = index != 0 && resolved >= 0 && (index < 0 || resolved < read as i64);
             if !behind {
-                let count = self.total_vertices();
+                let count = self.total_vertices;
                 if index == 0 || resolved < 0 || resolved >= count as i64 {
                     return Err(LoadError::IndexOutOfRange {
                         path: self.path.to_owned(),
@@ -364,25 +405,25 @@ impl<'a> Reader<'a> {
                 });
             }
             self.corners.push(resolved as u32);
-            if self.group_error.is_none() {
+            if self.piece.group_error.is_none() {
                 self.corner_parts(line_number, face, word, parts);
             }
         }
         self.faces += 1;
-        self.group_faces += 1;
-        let first = self.mesh.triangles.len();
-        let corners = std::mem::take(&mut self.corners);
-        match corners[..] {
-            [a, b, c, d] if [a, b, c, d].iter().any(|&i| i as usize >= read) => {
-                // Cut once the positions it needs are read.
-                self.quads_ahead.push((first, [a, b, c, d]));
-                self.mesh.triangles.extend([[a, b, c], [a, c, d]]);
+        let triangles = &mut self.piece.mesh.triangles;
+        let first = triangles.len();
+        match self.corners[..] {
+            // Cut once every position is known: it may refer to any vertex.
+            [a, b, c, d] => {
+                self.piece.quads.push((first, [a, b, c, d]));
+                triangles.extend([[a, b, c], [a, c, d]]);
             }
-            _ => triangulate_polygon(&corners, &self.mesh.positions, &mut self.mesh.triangles),
+            // Triangles and fans need no positions.
+            _ => triangulate_polygon(&self.corners, &[], triangles),
         }
-        self.corners = corners;
-        let added = self.mesh.triangles.len() - first;
-        self.mesh
+        let added = triangles.len() - first;
+        self.piece
+            .mesh
             .triangle_faces
             .extend(std::iter::repeat_n((face - 1) as u32, added));
         Ok(())
@@ -405,12 +446,13 @@ impl<'a> Reader<'a> {
             let (element, count, what) = match part {
                 0 => (
                     Element::TextureCoordinate,
-                    self.texture_coordinates,
+                    self.counts().texture_coordinates,
                     "texture coordinate",
                 ),
-                1 => (Element::Normal, self.normals, "normal"),
+                1 => (Element::Normal, self.counts().normals, "normal"),
                 _ => {
                     return self.refuse_by_group_rules(
+                        line_number,
                         line_number,
                         format!(
                             "face {face}: '{}' has more than three parts (v/vt/vn)",
@@ -421,6 +463,7 @@ impl<'a> Reader<'a> {
             };
             let Ok(written) = text.parse::<isize>() else {
                 return self.refuse_by_group_rules(
+                    line_number,
                     line_number,
                     format!(
                         "face {face}: '{}' has a {what} index that is not an integer",
@@ -442,36 +485,6 @@ impl<'a> Reader<'a> {
                     index,
                     written: written as i64,
                 });
-            }
-        }
-    }
-
-    /// An `o` or `g` line after faces, or the end of the file: what the group's
-    /// faces referred to ahead must be defined by now.
-    fn end_group(&mut self) {
-        self.group_faces = 0;
-        let ahead = std::mem::take(&mut self.ahead);
-        if self.group_error.is_some() {
-            return;
-        }
-        for ahead in ahead {
-            let (count, what) = match ahead.element {
-                Element::Vertex => (self.mesh.positions.len(), "vertex"),
-                Element::TextureCoordinate => (self.texture_coordinates, "texture coordinate"),
-                Element::Normal => (self.normals, "normal"),
-            };
-            // Texture and normal indices count only where the file has any.
-            let checked = matches!(ahead.element, Element::Vertex) || count > 0;
-            if checked && ahead.index >= count {
-                let error = self.parse_error(
-                    ahead.line,
-                    format!(
-                        "face {} refers to {what} {}, but only {count} are defined by the end of its group",
-                        ahead.face, ahead.written
-                    ),
-                );
-                self.group_error = Some(error);
-                return;
             }
         }
     }
