@@ -123,7 +123,7 @@ fn hand_written_edge_cases_read_as_tobj_read_them() {
         ("v/vt", format!("{TETRA}vt 0 0 0\nf 1/1 2/1 4/1\n")),
         (
             "tabs",
-            format!("v\t0 0\t0\nv 1\t0 0\nv 0 1 0\n\tf\t1\t2 3\n"),
+            "v\t0 0\t0\nv 1\t0 0\nv 0 1 0\n\tf\t1\t2 3\n".to_owned(),
         ),
         ("CRLF", format!("{TETRA}f 1 2 3\n").replace('\n', "\r\n")),
         ("CR alone", format!("{TETRA}f 1 2 3\n").replace('\n', "\r")),
