@@ -210,7 +210,7 @@ impl<'a> Reader<'a> {
                 // tobj ended a group with faces at any `o` or `g` line.
                 Some("o" | "g") => self.end_group(line_number),
                 Some("usemtl") => {
-                    // tobj took the name after the first space, and refused none.
+                    // tobj took the name after the first space and refused an empty one.
                     let name = line.split_once(' ').unwrap_or_default().1.trim();
                     if name.is_empty() {
                         self.refuse_by_group_rules(
