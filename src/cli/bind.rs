@@ -24,13 +24,14 @@ use anyhow::Result;
 use std::path::{Path, PathBuf};
 
 /// Rows a streamed bind computes and writes at a time when `--block-rows` is not
-/// given: 256 MiB of weights, so that memory stays flat however large the mesh.
-const BLOCK_BYTES: usize = 256 << 20;
+/// given: 128 MiB of weights. Two blocks are held at once (one written while the
+/// next is bound), so memory stays at 256 MiB of weights however large the mesh.
+const BLOCK_BYTES: usize = 128 << 20;
 
-/// Rows held at once by `pmvc bind`: everything for a family that solves for the
-/// whole cage or is written as a `.npz` (array after array), a block for one whose
-/// rows are independent.
-fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
+/// Rows bound at a time by `pmvc bind`: all of them for a family that solves
+/// for the whole cage or is written as a `.npz` (array after array), a block for
+/// one whose rows are independent.
+fn block_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
     if args.method.method.spec().rows_independent && !writes_npz(args.method.method) {
         let block = args
             .block_rows
@@ -41,6 +42,21 @@ fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
     } else {
         rows
     }
+}
+
+/// Rows held at once when `rows` are bound `block` at a time: all of them, or
+/// two blocks, the one being written and the next, bound meanwhile.
+fn resident_rows(block: usize, rows: usize) -> usize {
+    if block >= rows {
+        rows
+    } else {
+        block.saturating_mul(2).min(rows)
+    }
+}
+
+/// Rows held at once by `pmvc bind` ([`resident_rows`] of [`block_rows`]).
+fn bind_resident_rows(args: &BindArgs, rows: usize, columns: usize) -> usize {
+    resident_rows(block_rows(args, rows, columns), rows)
 }
 
 /// The class mask and metadata that go beside the weights `out`, each refused
@@ -166,7 +182,7 @@ fn bind_to(
     rows: usize,
     columns: usize,
 ) -> Result<BindDone> {
-    let block = bind_resident_rows(args, rows, columns);
+    let block = block_rows(args, rows, columns);
     let bar = progress_bar(rows as u64, args.method.method);
     let codes = class_codes(&input.classes.classes);
     let preamble = npy_preamble(&args.out, rows, columns)?;
@@ -193,30 +209,56 @@ fn bind_to(
         })?;
         return Ok(done);
     }
-    // In blocks of rows, each written as soon as it is bound: memory stays at one
-    // block, and the disk is the only limit. The metadata, written last, has the
-    // whole bind's time.
+    // In blocks of rows: a second thread binds block k + 1 while this one writes
+    // block k, handing each over when the writer is ready for it (a rendezvous
+    // channel), so at most two blocks are held ([`resident_rows`]) and the disk
+    // is the only limit. The metadata, written last, has the whole bind's time.
     let mut bind_error = None;
     let mut done = BindDone::default();
     let written = outputs.finish(|index, out| match index {
         0 => {
             out.write_all(&preamble)?;
-            for start in (0..rows).step_by(block) {
-                let range = start..(start + block).min(rows);
-                match bind_rows(input, range, &args.method, &backend, &bar) {
-                    Ok(bound) => {
-                        done.device = bound.device;
-                        done.on_gpu = bound.on_gpu;
-                        done.seconds += bound.seconds;
-                        write_f32_values(out, &bound.weights.values)?
+            std::thread::scope(|scope| {
+                let (sender, receiver) = std::sync::mpsc::sync_channel(0);
+                let (method, backend, bar) = (&args.method, &backend, &bar);
+                let binder = scope.spawn(move || {
+                    for start in (0..rows).step_by(block) {
+                        let range = start..(start + block).min(rows);
+                        let bound = bind_rows(input, range, method, backend, bar);
+                        let failed = bound.is_err();
+                        // A writer that stopped has dropped the receiver.
+                        if sender.send(bound).is_err() || failed {
+                            return;
+                        }
                     }
-                    Err(error) => {
-                        bind_error = Some(error);
-                        return Err(std::io::Error::other("the bind failed"));
+                });
+                let mut result = Ok(());
+                for bound in &receiver {
+                    match bound {
+                        Ok(bound) => {
+                            done.device = bound.device;
+                            done.on_gpu = bound.on_gpu;
+                            done.seconds += bound.seconds;
+                            result = write_f32_values(out, &bound.weights.values);
+                        }
+                        Err(error) => {
+                            bind_error = Some(error);
+                            result = Err(std::io::Error::other("the bind failed"));
+                        }
+                    }
+                    if result.is_err() {
+                        break;
                     }
                 }
-            }
-            Ok(())
+                // The binder stops at its next hand-over once this is gone.
+                drop(receiver);
+                if binder.join().is_err() {
+                    return Err(std::io::Error::other(
+                        "internal error: the bind thread panicked",
+                    ));
+                }
+                result
+            })
         }
         1 => write_classes_npy_to(out, &codes),
         _ => out.write_all(metadata_json(args, input, &done).as_bytes()),
@@ -225,5 +267,20 @@ fn bind_to(
     match (bind_error, written) {
         (Some(error), _) => Err(error),
         (None, result) => Ok(result.map(|()| done)?),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::resident_rows;
+
+    /// The memory check counts the block being written and the one bound
+    /// meanwhile.
+    #[test]
+    fn a_streamed_bind_holds_two_blocks() {
+        assert_eq!(resident_rows(100, 1000), 200);
+        assert_eq!(resident_rows(600, 1000), 1000);
+        assert_eq!(resident_rows(1000, 1000), 1000);
+        assert_eq!(resident_rows(usize::MAX / 2 + 1, usize::MAX), usize::MAX);
     }
 }

@@ -186,6 +186,10 @@ pub fn npy_preamble(path: &Path, rows: usize, cols: usize) -> Result<Vec<u8>, Np
 
 /// `values` as little-endian float32.
 pub fn write_f32_values(out: &mut dyn std::io::Write, values: &[f32]) -> std::io::Result<()> {
+    if cfg!(target_endian = "little") {
+        // The values' own bytes: one write, past the writer's buffer, with no copy.
+        return out.write_all(bytemuck::cast_slice(values));
+    }
     // In blocks rather than element by element, which took tens of milliseconds.
     let mut block = Vec::with_capacity(1 << 16);
     for values in values.chunks(1 << 14) {

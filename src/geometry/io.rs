@@ -9,6 +9,7 @@ use super::output::{human_bytes, write_atomically};
 use super::points_npy::read_points_npy;
 use super::{obj, off, Cage, CageReport, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
@@ -38,6 +39,46 @@ fn format_of(path: &Path) -> Result<MeshFormat, LoadError> {
 /// `f 1 2 3` lines, 7.2 for `v 0 0 0` lines, 6.3 for a million vertices with two
 /// million triangles, 5.6 for the shared scanned meshes; 3.9 for OFF.
 fn parse_memory(format: MeshFormat, text: &[u8]) -> u64 {
+    // Counted on every core, in pieces cut after a line end.
+    let pieces_bytes = (1 << 20).max(text.len() / (4 * rayon::current_num_threads()));
+    let mut pieces = Vec::new();
+    let mut rest = text;
+    while rest.len() > pieces_bytes {
+        let Some(end) = rest[pieces_bytes..].iter().position(|&b| b == b'\n') else {
+            break;
+        };
+        let (piece, after) = rest.split_at(pieces_bytes + end + 1);
+        pieces.push(piece);
+        rest = after;
+    }
+    pieces.push(rest);
+    let (lines, tokens, vertices, corners) =
+        pieces.par_iter().map(|piece| count_lines(piece)).reduce(
+            || (0, 0, 0, 0),
+            |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3),
+        );
+    let text = text.len() as u64;
+    let total = match format {
+        // Set for the reader through tobj (the text and its copy; per vertex
+        // f64 and f32 positions and a line in the copy; per corner 24 bytes of
+        // indices, the triangles and their faces) and kept: the direct reader
+        // holds less (each piece's positions and triangles, then all of them:
+        // 48 bytes per vertex, 32 per triangle, the text once).
+        MeshFormat::Obj => [
+            bytes_for(text, 2),
+            bytes_for(vertices, 64),
+            bytes_for(corners, 60),
+        ],
+        // Per line at most one position; per number at most a triangle's share.
+        MeshFormat::Off => [text, bytes_for(lines, 24), bytes_for(tokens, 8)],
+        // Binary: never parsed as text.
+        MeshFormat::Npy => [text, 0, 0],
+    };
+    total.into_iter().fold(0, u64::saturating_add)
+}
+
+/// Lines, words, `v` lines and `f` corners in `text`.
+fn count_lines(text: &[u8]) -> (u64, u64, u64, u64) {
     let (mut lines, mut tokens, mut vertices, mut corners) = (0u64, 0u64, 0u64, 0u64);
     for line in text.split(|&b| b == b'\n' || b == b'\r') {
         let mut words = line
@@ -53,22 +94,7 @@ fn parse_memory(format: MeshFormat, text: &[u8]) -> u64 {
             _ => {}
         }
     }
-    let text = text.len() as u64;
-    let total = match format {
-        // The text and the copy the OBJ library reads; per vertex its f64 and
-        // f32 positions and its line in that copy; per face corner the
-        // library's indices (24 bytes), the triangles and their faces.
-        MeshFormat::Obj => [
-            bytes_for(text, 2),
-            bytes_for(vertices, 64),
-            bytes_for(corners, 60),
-        ],
-        // Per line at most one position; per number at most a triangle's share.
-        MeshFormat::Off => [text, bytes_for(lines, 24), bytes_for(tokens, 8)],
-        // Binary: never parsed as text.
-        MeshFormat::Npy => [text, 0, 0],
-    };
-    total.into_iter().fold(0, u64::saturating_add)
+    (lines, tokens, vertices, corners)
 }
 
 /// Read an OBJ or OFF file, or a `.npy` point set (chosen by extension,
@@ -116,7 +142,12 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
             path: path.to_owned(),
         });
     }
-    let binary_at = bytes.iter().position(|&b| b == 0);
+    // `contains` finds a byte with memchr; most files have none to place.
+    let binary_at = if bytes.contains(&0) {
+        bytes.iter().position(|&b| b == 0)
+    } else {
+        None
+    };
     if binary_at.is_none() {
         let size = bytes.len() as u64;
         let needed = parse_memory(format, &bytes).saturating_sub(size);

@@ -1,4 +1,6 @@
-//! Wavefront OBJ through tobj, keeping the file's vertex order.
+//! The OBJ reader pmvc had before its own (`geometry/obj.rs`): the checks it made
+//! itself, then tobj for the faces. Kept here as the reference the direct reader
+//! is compared with (tests/obj_reader.rs).
 //!
 //! tobj splits a file into one model per `o`/`g` group and re-indexes each model's
 //! vertices in first-use order, which loses the file's `v` order. To undo that, tobj
@@ -6,14 +8,14 @@
 //! instead of its coordinates; each model's positions then name the original rows.
 //! The coordinates themselves are read here, in f64.
 
-use super::{triangulate_polygon, LoadError, MeshFile, MeshFormat, TriMesh};
 use glam::DVec3;
+use pmvc::geometry::{triangulate_polygon, LoadError, MeshFile, MeshFormat, TriMesh};
 use std::path::Path;
 
 /// Largest vertex ordinal that survives the round trip through tobj's f32 positions.
-pub(super) const MAX_VERTICES: usize = 1 << 24;
+pub const MAX_VERTICES: usize = 1 << 24;
 
-pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError> {
+pub fn parse_obj_with_tobj(path: &Path, text: String) -> Result<MeshFile, LoadError> {
     let parse_error = |line: usize, message: String| LoadError::Parse {
         path: path.to_owned(),
         line,
