@@ -94,10 +94,11 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     };
     check_output(&args.out, &inputs, extensions, what)?;
     let companions = companion_paths(&args.out, &inputs)?;
-    // Probing adapters for `auto` or `gpu` takes tens of milliseconds, mostly waiting
-    // on the driver: do it while the inputs load and are classified.
+    // Opening a device takes a tenth of a second or more, mostly waiting on the
+    // driver: for `gpu`, and `auto` on a large mesh, it opens while the inputs load.
     let choice = args.method.backend;
-    let probe = std::thread::spawn(move || choose_backend(choice));
+    let mesh_bytes = std::fs::metadata(&args.input.mesh).map_or(0, |meta| meta.len());
+    let probe = std::thread::spawn(move || choose_backend(choice, mesh_bytes));
     let method = args.method.method;
     let input = load_input(
         &args.input,

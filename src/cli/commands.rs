@@ -102,7 +102,7 @@ fn outside_summary(classes: &PointClasses, total: usize) -> String {
 
 /// Compute the weights with the chosen backend, showing progress on a terminal.
 pub(super) fn compute_weights(input: &BoundInput, choice: &MethodChoice) -> Result<Weights> {
-    compute_weights_on(input, choice, choose_backend(choice.backend)?)
+    compute_weights_on(input, choice, choose_backend(choice.backend, 0)?)
 }
 
 /// [`compute_weights`] on a backend chosen beforehand.
@@ -216,15 +216,22 @@ impl From<BackendArg> for BackendRequest {
     }
 }
 
-/// The device `--backend gpu` binds on, opened while the inputs load. `cpu` and
-/// `auto` open nothing here: `auto` loads a driver only once the work is known
-/// and a GPU could win it ([`decide_on`]).
-pub(super) fn choose_backend(choice: BackendArg) -> Result<Backend> {
-    if choice != BackendArg::Gpu {
-        return Ok(Backend::Cpu);
-    }
-    let device =
-        device_for(BackendRequest::Gpu).map_err(|error| anyhow!(error).context("--backend gpu"))?;
+/// From this size of mesh file `auto` opens a hardware device while the inputs
+/// load: about 250,000 vertices of OBJ text, where a GPU may win and its start
+/// (0.14–0.18 s on the H200 machine) would otherwise add to the bind.
+const AUTO_EARLY_OPEN_BYTES: u64 = 8 << 20;
+
+/// The device to bind on, opened while the inputs load (`mesh_bytes` is the mesh
+/// file's size, 0 when unknown): for `gpu` always; for `auto` only for a large
+/// mesh. Otherwise nothing is opened here, and `auto` loads a driver only once
+/// the work is known and a GPU could win it ([`decide_on`]).
+pub(super) fn choose_backend(choice: BackendArg, mesh_bytes: u64) -> Result<Backend> {
+    let request = match choice {
+        BackendArg::Gpu => BackendRequest::Gpu,
+        BackendArg::Auto if mesh_bytes >= AUTO_EARLY_OPEN_BYTES => BackendRequest::Auto,
+        _ => return Ok(Backend::Cpu),
+    };
+    let device = device_for(request).map_err(|error| anyhow!(error).context("--backend gpu"))?;
     Ok(device.map_or(Backend::Cpu, Backend::Gpu))
 }
 

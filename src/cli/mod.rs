@@ -151,8 +151,9 @@ pub struct BindArgs {
     /// Output .npy: little-endian float32, shape (mesh vertices, cage vertices), rows and columns in file `v` order. Green coordinates (--method green) go to a .npz with two arrays: phi (mesh vertices × cage vertices) and psi (mesh vertices × cage triangles, in the order the cage's faces are triangulated). Beside W.npy or W.npz go W.json (the method and its parameters, backend, device, the bind's seconds, program version, what each column is and Green's psi triangles, the outside policy, the inputs' names and digests) and W.classes.npy (int8 per row: 0 inside, 1 on the cage, 2 outside), replaced together with the weights or not at all; beside a device or pipe, none.
     #[arg(long, value_name = "W.npy|W.npz")]
     pub out: PathBuf,
-    /// Bind and write this many rows at a time, so that memory holds one block
-    /// (MVC and PMVC; default: 256 MiB of weights). Harmonic coordinates solve for
+    /// Bind and write this many rows at a time, so that memory holds two blocks
+    /// (one written while the next binds; MVC and PMVC; default: 128 MiB of weights
+    /// each). Harmonic coordinates solve for
     /// the whole cage at once and hold every row.
     #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
     pub block_rows: Option<u64>,
