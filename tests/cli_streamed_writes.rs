@@ -8,22 +8,6 @@ use common::*;
 use std::path::Path;
 use std::process::Output;
 
-fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "bind",
-        "--mesh",
-        path_str(mesh),
-        "--cage",
-        path_str(cage),
-        "--out",
-        path_str(out),
-        "--backend",
-        "cpu",
-    ];
-    args.extend(extra);
-    pmvc(&args)
-}
-
 /// Files pmvc leaves in `dir` besides the inputs.
 fn written(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
@@ -41,12 +25,12 @@ fn blocks_of_any_size_write_the_whole_binds_bytes() {
     let (mesh, cage, _, _) = comb_scene(dir.path(), 300);
     for method in ["mvc", "pmvc"] {
         let whole = dir.path().join(format!("{method}.npy"));
-        let output = bind_with(&mesh, &cage, &whole, &["--method", method]);
+        let output = bind_on_cpu(&mesh, &cage, &whole, &["--method", method]);
         assert!(output.status.success(), "{}", stderr(&output));
         let expected = std::fs::read(&whole).unwrap();
         for rows in ["1", "2", "7", "150", "299"] {
             let out = dir.path().join(format!("{method}-{rows}.npy"));
-            let output = bind_with(
+            let output = bind_on_cpu(
                 &mesh,
                 &cage,
                 &out,
@@ -104,9 +88,9 @@ fn a_full_device_fails_between_blocks_as_in_a_whole_bind() {
     let dir = tempfile::tempdir().unwrap();
     let (mesh, cage, _, _) = comb_scene(dir.path(), 300);
     let full = Path::new("/dev/full");
-    let whole = bind_with(&mesh, &cage, full, &["--method", "mvc"]);
+    let whole = bind_on_cpu(&mesh, &cage, full, &["--method", "mvc"]);
     assert_clean_failure(&whole, "/dev/full", "cannot write");
-    let streamed = bind_with(
+    let streamed = bind_on_cpu(
         &mesh,
         &cage,
         full,

@@ -9,23 +9,7 @@ use std::path::Path;
 use std::process::Output;
 
 fn bind(mesh: &Path, cage: &Path, out: &Path) -> Output {
-    bind_with(mesh, cage, out, &[])
-}
-
-fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "bind",
-        "--mesh",
-        path_str(mesh),
-        "--cage",
-        path_str(cage),
-        "--out",
-        path_str(out),
-        "--backend",
-        "cpu",
-    ];
-    args.extend(extra);
-    pmvc(&args)
+    bind_on_cpu(mesh, cage, out, &[])
 }
 
 fn temporary_files(dir: &Path) -> Vec<String> {
@@ -129,7 +113,7 @@ fn a_bind_that_cannot_fit_in_memory_is_refused_before_the_work() {
     let cage = write(dir.path(), "cage.obj", &cage_obj(&sphere));
     let out = dir.path().join("w.npy");
     // Harmonic coordinates hold every row (one solve for the whole cage).
-    let output = bind_with(&mesh, &cage, &out, &["--method", "harmonic"]);
+    let output = bind_on_cpu(&mesh, &cage, &out, &["--method", "harmonic"]);
     assert_clean_failure(&output, "mesh.obj", "memory");
     let text = stderr(&output);
     assert!(
@@ -182,7 +166,7 @@ fn a_bind_in_blocks_of_rows_writes_what_the_whole_bind_writes() {
     for method in ["pmvc", "mvc", "harmonic"] {
         let whole = dir.path().join(format!("{method}-whole.npy"));
         let blocks = dir.path().join(format!("{method}-blocks.npy"));
-        let output = bind_with(&mesh, &cage, &whole, &["--method", method]);
+        let output = bind_on_cpu(&mesh, &cage, &whole, &["--method", method]);
         assert!(output.status.success(), "{}", stderr(&output));
         let args = [
             "--method",
@@ -192,7 +176,7 @@ fn a_bind_in_blocks_of_rows_writes_what_the_whole_bind_writes() {
             "--block-rows",
             "7",
         ];
-        let output = bind_with(&mesh, &cage, &blocks, &args);
+        let output = bind_on_cpu(&mesh, &cage, &blocks, &args);
         assert!(output.status.success(), "{}", stderr(&output));
         let (whole, blocks) = (
             std::fs::read(&whole).unwrap(),

@@ -67,7 +67,26 @@ pub fn pmvc(args: &[&str]) -> Output {
         .expect("run pmvc")
 }
 
+/// `pmvc bind --mesh mesh --cage cage --out out --backend cpu`, then `extra`.
+#[cfg(feature = "editor")]
+pub fn bind_on_cpu(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "bind",
+        "--mesh",
+        path_str(mesh),
+        "--cage",
+        path_str(cage),
+        "--out",
+        path_str(out),
+        "--backend",
+        "cpu",
+    ];
+    args.extend(extra);
+    pmvc(&args)
+}
+
 /// `pmvc deform` of `mesh` in `cage` to `pose` with stored `weights`, into `out`.
+#[cfg(feature = "editor")]
 pub fn deform_with_weights(
     mesh: &Path,
     cage: &Path,
