@@ -348,6 +348,8 @@ pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
 pub struct Decision {
     pub backend: Backend,
     pub prediction: Option<Prediction>,
+    /// Why `auto` binds on the CPU when no prediction says so.
+    pub reason: Option<&'static str>,
 }
 
 impl Decision {
@@ -368,9 +370,10 @@ impl Decision {
             ),
             Backend::Cpu => "CPU".to_owned(),
         };
-        match &self.prediction {
-            Some(prediction) => format!("binding on the {place}: {}", prediction.explain()),
-            None => format!("binding on the {place}"),
+        match (&self.prediction, self.reason) {
+            (Some(prediction), _) => format!("binding on the {place}: {}", prediction.explain()),
+            (None, Some(reason)) => format!("binding on the {place}: {reason}"),
+            (None, None) => format!("binding on the {place}"),
         }
     }
 }
@@ -404,6 +407,7 @@ pub fn decide_and_open(request: BackendRequest, work: &Work) -> Result<Decision,
             return Ok(Decision {
                 backend: Backend::Cpu,
                 prediction: Some(best),
+                reason: None,
             });
         }
     }
@@ -418,12 +422,14 @@ pub fn decide(request: BackendRequest, device: Option<&Arc<GpuContext>>, work: &
         return Decision {
             backend: Backend::Cpu,
             prediction: None,
+            reason: (request == BackendRequest::Auto).then_some("no hardware GPU adapter"),
         };
     };
     if request == BackendRequest::Gpu {
         return Decision {
             backend: Backend::Gpu(Arc::clone(context)),
             prediction: None,
+            reason: None,
         };
     }
     let prediction = predict(work, &GpuState::of(context));
@@ -434,6 +440,7 @@ pub fn decide(request: BackendRequest, device: Option<&Arc<GpuContext>>, work: &
             Backend::Cpu
         },
         prediction: Some(prediction),
+        reason: None,
     }
 }
 

@@ -133,3 +133,16 @@ fn auto_decides_a_bind_the_best_gpu_would_lose_before_opening_any_device() {
     assert_eq!(prediction.gpu.start_s, HARDWARE_START_S);
     assert!(!prediction.gpu_wins(), "{}", prediction.explain());
 }
+
+#[test]
+fn auto_without_a_hardware_adapter_says_so() {
+    let large = work(Method::Pmvc, 1_000_000, 110, 2);
+    let decision = decide(BackendRequest::Auto, None, &large);
+    assert!(matches!(decision.backend, Backend::Cpu));
+    assert_eq!(
+        decision.explain(),
+        "binding on the CPU: no hardware GPU adapter"
+    );
+    let asked_for_cpu = decide(BackendRequest::Cpu, None, &large);
+    assert_eq!(asked_for_cpu.explain(), "binding on the CPU");
+}
