@@ -149,3 +149,51 @@ fn the_save_point_moves_only_when_the_editor_runs_the_queued_actions() {
     assert!(harness.state().pose_is_unsaved());
     assert!(!harness.state().quit_confirmed());
 }
+
+/// The notices panel with its own list, over the comb.
+struct NoticesScene {
+    notices: pmvc::app::ui::notices::Notices,
+    model: Model,
+    actions: Vec<Action>,
+}
+
+#[test]
+fn dismissing_a_notice_is_queued_and_removes_that_notice_when_run() {
+    let mut notices = pmvc::app::ui::notices::Notices::default();
+    notices.info("first");
+    notices.error("second");
+    let scene = NoticesScene {
+        notices,
+        model: Model::new(Document::new(
+            "comb",
+            scenes::comb_mesh(),
+            scenes::comb_cage(),
+        )),
+        actions: Vec::new(),
+    };
+    let mut harness = Harness::new_ui_state(
+        |ui, scene: &mut NoticesScene| {
+            let mut context = PanelContext::new(&scene.model, &mut scene.actions);
+            scene.notices.ui(ui, &mut context);
+        },
+        scene,
+    );
+    harness.run();
+    // Newest first: the first "x" dismisses "second", at index 1 of the list.
+    harness.get_all_by_label("x").next().unwrap().click();
+    harness.run();
+    let scene = harness.state_mut();
+    assert_eq!(scene.notices.all().len(), 2, "the panel only asks");
+    let index = match scene.actions.as_slice() {
+        [Action::DismissNotice(index)] => *index,
+        other => panic!("expected one DismissNotice, got {other:?}"),
+    };
+    scene.notices.dismiss(index);
+    let left: Vec<&str> = scene
+        .notices
+        .all()
+        .iter()
+        .map(|n| n.text.as_str())
+        .collect();
+    assert_eq!(left, ["first"]);
+}

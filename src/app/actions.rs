@@ -6,6 +6,7 @@
 use super::editor::{EditorApp, FileRole};
 use super::model::Command;
 use super::ui::file_dialog::FileAction;
+use super::ui::notices::Notices;
 use glam::DVec3;
 use std::path::PathBuf;
 
@@ -91,6 +92,19 @@ impl EditorApp {
     /// The current pose is on disk (saved, loaded or bundled): quitting keeps it.
     pub(super) fn mark_pose_saved(&mut self) {
         self.apply(Command::MarkSaved);
+    }
+
+    pub fn notices(&self) -> &Notices {
+        &self.notices
+    }
+
+    pub fn notices_mut(&mut self) -> &mut Notices {
+        &mut self.notices
+    }
+
+    /// The latest error, if any (for tests and the status bar).
+    pub fn last_error(&self) -> Option<&str> {
+        self.notices.last_error()
     }
 
     /// The quit question is shown.

@@ -102,7 +102,6 @@ pub struct EditorApp {
     pub(super) viewport: ViewportState,
     pub(super) readouts: ReadoutCache,
     pub(super) notices: Notices,
-    /// View > Statistics.
     pub(super) statistics: StatisticsPanel,
     pub(super) highlight_outside: bool,
     pub(super) recent: RecentFiles,
@@ -333,19 +332,6 @@ impl EditorApp {
     /// Use the in-window file dialog (true) or the system's (false).
     pub fn set_in_window_file_dialog(&mut self, in_window: bool) {
         self.file_dialogs.in_window = in_window;
-    }
-
-    pub fn notices(&self) -> &Notices {
-        &self.notices
-    }
-
-    pub fn notices_mut(&mut self) -> &mut Notices {
-        &mut self.notices
-    }
-
-    /// The latest error, if any (for tests and the status bar).
-    pub fn last_error(&self) -> Option<&str> {
-        self.notices.last_error()
     }
 
     pub(super) fn error(&mut self, text: impl Into<String>) {
