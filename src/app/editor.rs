@@ -4,6 +4,7 @@
 //! actions in `files.rs`, the CPU read-outs behind the views in `readouts.rs`, the
 //! viewport in `viewport/`, and one file per panel in `ui/`.
 
+use super::actions::Action;
 use super::bind_queue::BindQueue;
 use super::cage_generation::CageGeneration;
 use super::compare::{HoverReadout, Pane, ViewSettings};
@@ -15,12 +16,12 @@ use super::readouts::ReadoutCache;
 use super::recent::RecentFiles;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
-use super::ui::drop_dialog::DroppedFile;
+use super::ui::drop_dialog::DropDialog;
 use super::ui::file_dialog::FileDialogs;
 use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
-use super::ui::quit_dialog::QuitState;
-use super::ui::statistics::FrameStats;
+use super::ui::quit_dialog::QuitDialog;
+use super::ui::statistics::StatisticsPanel;
 use super::viewport::ViewportState;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
@@ -101,8 +102,7 @@ pub struct EditorApp {
     pub(super) viewport: ViewportState,
     pub(super) readouts: ReadoutCache,
     pub(super) notices: Notices,
-    pub(super) stats: FrameStats,
-    pub(super) show_statistics: bool,
+    pub(super) statistics: StatisticsPanel,
     pub(super) highlight_outside: bool,
     pub(super) recent: RecentFiles,
     /// The session file last opened or saved: File > Save session writes there.
@@ -116,7 +116,7 @@ pub struct EditorApp {
     /// The system's or the in-window file dialog.
     pub(super) file_dialogs: FileDialogs,
     /// Quitting asks first when the pose is unsaved.
-    pub(super) quit: QuitState,
+    pub(super) quit: QuitDialog,
     pub(super) screenshot: Option<ScreenshotState>,
     /// Frames drawn, up to a limit, for asking for keyboard focus at start.
     pub(super) focus_frames: u32,
@@ -127,7 +127,9 @@ pub struct EditorApp {
     /// The first run's line saying what to look at, until it is dismissed.
     pub(super) first_run_hint: bool,
     /// A file dropped on the window, waiting for the user to say what it is.
-    pub(super) dropped: Option<DroppedFile>,
+    pub(super) drop_dialog: DropDialog,
+    /// What the panels asked for this frame, run after them (`actions.rs`).
+    pub(super) actions: Vec<Action>,
     /// File > Generate cage…: its window, job and proposal.
     pub(super) cage_generation: CageGeneration,
 }
@@ -186,8 +188,7 @@ impl EditorApp {
             viewport: ViewportState::default(),
             readouts: ReadoutCache::default(),
             notices: Notices::default(),
-            stats: FrameStats::default(),
-            show_statistics: false,
+            statistics: StatisticsPanel::default(),
             highlight_outside: false,
             recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
             session_path: None,
@@ -195,7 +196,7 @@ impl EditorApp {
             image_request: ImageRequest::default(),
             pose_tools: PoseToolSettings::default(),
             file_dialogs: FileDialogs::default(),
-            quit: QuitState::default(),
+            quit: QuitDialog::default(),
             screenshot: options
                 .screenshot
                 .clone()
@@ -204,7 +205,8 @@ impl EditorApp {
             binding_paused: false,
             hide_timings: options.hide_timings,
             first_run_hint: false,
-            dropped: None,
+            drop_dialog: DropDialog::default(),
+            actions: Vec::new(),
             cage_generation: CageGeneration::new(cc.egui_ctx.clone()),
         };
         for refused in refused_parameters {
@@ -324,25 +326,12 @@ impl EditorApp {
 
     /// A dialog (file, quit or dropped file) waits for the user.
     pub fn modal_dialog_open(&self) -> bool {
-        self.file_dialogs.is_open() || self.is_asking_to_quit() || self.dropped.is_some()
+        self.file_dialogs.is_open() || self.quit.is_asking() || self.drop_dialog.is_open()
     }
 
     /// Use the in-window file dialog (true) or the system's (false).
     pub fn set_in_window_file_dialog(&mut self, in_window: bool) {
         self.file_dialogs.in_window = in_window;
-    }
-
-    pub fn notices(&self) -> &Notices {
-        &self.notices
-    }
-
-    pub fn notices_mut(&mut self) -> &mut Notices {
-        &mut self.notices
-    }
-
-    /// The latest error, if any (for tests and the status bar).
-    pub fn last_error(&self) -> Option<&str> {
-        self.notices.last_error()
     }
 
     pub(super) fn error(&mut self, text: impl Into<String>) {

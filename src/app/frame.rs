@@ -1,17 +1,22 @@
 //! The frame loop: what the editor does each frame, in order, and what it keeps
 //! across runs (the recent files).
 
+use super::ctx::PanelContext;
 use super::editor::EditorApp;
 
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
-        self.stats.record_frame(ctx.input(|i| i.time));
-        self.intercept_close(&ctx);
+        self.statistics
+            .frames_mut()
+            .record_frame(ctx.input(|i| i.time));
+        let (scripted, unsaved) = (self.screenshot.is_some(), self.model.pose_unsaved());
+        self.quit.intercept_close(&ctx, scripted, unsaved);
         self.ask_for_keyboard_focus(&ctx, frame);
         self.poll_bind();
         self.poll_cage_generation();
-        self.handle_dropped_files(&ctx);
+        let mut context = PanelContext::new(&self.model, &mut self.actions);
+        self.drop_dialog.take_dropped_files(&ctx, &mut context);
         self.run_shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
@@ -24,13 +29,16 @@ impl eframe::App for EditorApp {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui))
             });
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
-        self.drop_dialog(&ctx);
-        // The question first: its Save pose… opens the file dialog in this frame.
-        self.quit_dialog(&ctx);
+        let mut context = PanelContext::new(&self.model, &mut self.actions);
+        self.drop_dialog.ui(&ctx, &mut context);
+        self.quit.ui(&ctx, &mut context);
+        // After the panels that send actions, in one place; before the file
+        // dialog, so the question's Save pose… opens it in this frame.
+        self.run_actions(&ctx);
         self.file_dialog_window(&ctx);
         self.generate_cage_window(&ctx);
         self.request_wanted_binds();
-        if self.show_statistics {
+        if self.statistics.is_shown() {
             // Keep frames coming so the readout measures rendering, not idling.
             ctx.request_repaint();
         }

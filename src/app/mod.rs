@@ -9,15 +9,19 @@
 //!   `files` and `readouts` add its actions, `gpu_readback` what the GPU drew.
 //! - `viewport`: panes, input and picking; `ui`: menu, toolbar, side panel,
 //!   quality table, notices and statistics.
+//! - [`ctx`]: what a panel sees; [`actions`]: what it asks for, run in one
+//!   place after the panels each frame.
 //! - [`cage_generation`]: File > Generate cage…, a cage generated in the
 //!   background and proposed over the mesh before it replaces the cage.
 //! - [`compare`]: what the views compare and how the mesh is coloured.
 //! - [`scenes`]: the bundled scenes; [`widgets`]: the colour bar and hover box.
 
+pub mod actions;
 pub mod bind_queue;
 mod binding;
 pub mod cage_generation;
 pub mod compare;
+pub mod ctx;
 pub mod editor;
 mod exports;
 mod files;

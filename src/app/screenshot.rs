@@ -87,7 +87,7 @@ impl EditorApp {
             return;
         };
         if state.saved.swap(false, Ordering::Relaxed) {
-            if let Some(average) = self.stats.average() {
+            if let Some(average) = self.statistics.frames().average() {
                 eprintln!("pmvc editor: average frame time {:.1} ms", average * 1000.0);
             }
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -96,7 +96,7 @@ impl EditorApp {
         state.frames_after_bind += 1;
         if state.frames_after_bind == 1 {
             // Measure frame times of the idle scene only, not of the bind.
-            self.stats.restart();
+            self.statistics.frames_mut().restart();
         }
         // Frames before the capture let the GPU upload settle and give a frame-time
         // sample of the continuously redrawn viewport.

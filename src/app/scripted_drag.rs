@@ -146,7 +146,7 @@ impl EditorApp {
             100.0 * moved / diagonal,
             (now - since) * 1000.0 / intervals as f64,
         );
-        self.stats.restart();
+        self.statistics.frames_mut().restart();
     }
 }
 

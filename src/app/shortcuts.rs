@@ -159,7 +159,7 @@ impl EditorApp {
 
     fn run_action(&mut self, ctx: &egui::Context, action: Action) {
         match action {
-            Action::Quit => self.request_quit(ctx),
+            Action::Quit => self.actions.push(super::actions::Action::Quit),
             Action::BeginTransform(kind) => {
                 self.begin_transform_at_pointer(ctx, kind);
             }

@@ -3,7 +3,9 @@
 //! what it will do. A file's name does not decide: the dataset's
 //! `*_Cage_Deformed.obj` is a pose, not a new rest cage.
 
-use crate::app::editor::{EditorApp, FileRole};
+use crate::app::actions::Action;
+use crate::app::ctx::PanelContext;
+use crate::app::editor::FileRole;
 use crate::geometry::{load_mesh, MeshFile};
 use std::path::PathBuf;
 
@@ -28,10 +30,25 @@ pub enum DropChoice {
     Cancel,
 }
 
-impl EditorApp {
+/// The dialog for a dropped file, and the file waiting for the user's choice.
+#[derive(Default)]
+pub struct DropDialog {
+    pending: Option<DroppedFile>,
+}
+
+impl DropDialog {
+    /// The dropped file waiting for a choice, if any.
+    pub fn pending(&self) -> Option<&DroppedFile> {
+        self.pending.as_ref()
+    }
+
+    pub fn is_open(&self) -> bool {
+        self.pending.is_some()
+    }
+
     /// Read the files dropped this frame. Two files, one named like a cage, open
     /// together as mesh and cage; a single file waits for the dialog.
-    pub(in crate::app) fn handle_dropped_files(&mut self, ctx: &egui::Context) {
+    pub fn take_dropped_files(&mut self, ctx: &egui::Context, context: &mut PanelContext) {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw
                 .dropped_files
@@ -44,12 +61,12 @@ impl EditorApp {
             [] => {}
             [path] => match load_mesh(path) {
                 Ok(file) => {
-                    self.dropped = Some(DroppedFile {
+                    self.pending = Some(DroppedFile {
                         path: path.clone(),
                         file,
                     })
                 }
-                Err(error) => self.error(error.to_string()),
+                Err(error) => context.send(Action::Error(error.to_string())),
             },
             [first, second] => {
                 let named_cage = |p: &PathBuf| p.to_string_lossy().to_lowercase().contains("cage");
@@ -58,24 +75,28 @@ impl EditorApp {
                 } else {
                     (first, second)
                 };
-                self.open_pair(mesh, cage);
+                context.send(Action::OpenPair {
+                    mesh: mesh.clone(),
+                    cage: cage.clone(),
+                });
             }
-            _ => self.error(format!(
+            _ => context.send(Action::Error(format!(
                 "{} files dropped: drop one file, or a mesh and its cage",
                 dropped.len()
-            )),
+            ))),
         }
     }
 
-    /// The dialog for a dropped file, while one waits.
-    pub(in crate::app) fn drop_dialog(&mut self, ctx: &egui::Context) {
-        let Some(dropped) = &self.dropped else { return };
+    /// The dialog for a dropped file, while one waits. It reads the cage's vertex
+    /// count, and sends `TakePose` or `Open` for the choice made.
+    pub fn ui(&mut self, ctx: &egui::Context, context: &mut PanelContext) {
+        let Some(dropped) = &self.pending else { return };
         let name = dropped.path.file_name().map_or_else(
             || dropped.path.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
         let vertices = dropped.vertex_count();
-        let cage_vertices = self.model.document().pose().len();
+        let cage_vertices = context.document().pose().len();
         let mut choice = None;
         egui::Window::new("Open dropped file")
             .collapsible(false)
@@ -118,31 +139,24 @@ impl EditorApp {
                 }
             });
         if let Some(choice) = choice {
-            self.resolve_drop(choice);
+            self.resolve(choice, context);
         }
     }
 
-    /// Act on the dialog's choice for the waiting dropped file.
-    pub fn resolve_drop(&mut self, choice: DropChoice) {
-        let Some(dropped) = self.dropped.take() else {
+    /// Close the dialog, asking for what `choice` does with the waiting file.
+    pub fn resolve(&mut self, choice: DropChoice, context: &mut PanelContext) {
+        let Some(dropped) = self.pending.take() else {
             return;
         };
-        match choice {
-            DropChoice::Pose => {
-                self.take_pose_file(&dropped.path, dropped.file.mesh.positions);
-            }
-            DropChoice::Cage => {
-                self.open_file(FileRole::Cage, &dropped.path);
-            }
-            DropChoice::Mesh => {
-                self.open_file(FileRole::Mesh, &dropped.path);
-            }
-            DropChoice::Cancel => {}
-        }
-    }
-
-    /// The dropped file waiting for a choice, if any.
-    pub fn pending_drop(&self) -> Option<&DroppedFile> {
-        self.dropped.as_ref()
+        let action = match choice {
+            DropChoice::Pose => Action::TakePose {
+                path: dropped.path,
+                pose: dropped.file.mesh.positions,
+            },
+            DropChoice::Cage => Action::Open(FileRole::Cage, dropped.path),
+            DropChoice::Mesh => Action::Open(FileRole::Mesh, dropped.path),
+            DropChoice::Cancel => return,
+        };
+        context.send(action);
     }
 }

@@ -287,14 +287,14 @@ impl EditorApp {
             FileAction::ExportColouredMesh => self.export_coloured_mesh(path),
         };
         if action == FileAction::SavePose {
-            self.pose_save_finished(done);
+            self.quit.pose_save_finished(done);
         }
         done
     }
 
     fn file_action_cancelled(&mut self, action: FileAction) {
         if action == FileAction::SavePose {
-            self.pose_save_finished(false);
+            self.quit.pose_save_finished(false);
         }
     }
 

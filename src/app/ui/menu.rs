@@ -1,5 +1,6 @@
 //! The menu bar: File, Edit, View and Scenes.
 
+use crate::app::actions::Action;
 use crate::app::compare::HANDLE_SIZES;
 use crate::app::editor::EditorApp;
 use crate::app::scenes::BundledScene;
@@ -8,9 +9,8 @@ use crate::render::viewport::MSAA_SAMPLES;
 
 impl EditorApp {
     pub(in crate::app) fn menu_bar(&mut self, ui: &mut egui::Ui) {
-        let ctx = ui.ctx().clone();
         egui::MenuBar::new().ui(ui, |ui| {
-            ui.menu_button("File", |ui| self.file_menu(ui, &ctx));
+            ui.menu_button("File", |ui| self.file_menu(ui));
             ui.menu_button("Edit", |ui| self.edit_menu(ui));
             ui.menu_button("View", |ui| self.view_menu(ui));
             ui.menu_button("Scenes", |ui| {
@@ -23,7 +23,7 @@ impl EditorApp {
         });
     }
 
-    fn file_menu(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+    fn file_menu(&mut self, ui: &mut egui::Ui) {
         if ui.button("Open mesh…").clicked() {
             self.ask_for_file(FileAction::OpenMesh);
         }
@@ -96,7 +96,7 @@ impl EditorApp {
             );
         ui.separator();
         if ui.button("Quit (Ctrl+Q)").clicked() {
-            self.request_quit(ctx);
+            self.actions.push(Action::Quit);
         }
     }
 
@@ -131,11 +131,9 @@ impl EditorApp {
     }
 
     fn view_menu(&mut self, ui: &mut egui::Ui) {
-        if ui
-            .checkbox(&mut self.show_statistics, "Statistics")
-            .changed()
-        {
-            self.stats.restart();
+        let mut statistics = self.statistics.is_shown();
+        if ui.checkbox(&mut statistics, "Statistics").changed() {
+            self.statistics.set_shown(statistics);
         }
         ui.checkbox(
             &mut self.view.hover_in_shaded,

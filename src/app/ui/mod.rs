@@ -1,5 +1,7 @@
-//! The editor's panels, one file each, as in egui's demo app: each adds an
-//! `impl EditorApp` method that draws its panel and calls the editor's actions.
+//! The editor's panels, one file each, as in egui's demo app. The quit dialog,
+//! the drop dialog, notices and statistics are structs that own their state and
+//! draw through a [`crate::app::ctx::PanelContext`], sending actions; the others
+//! still add an `impl EditorApp` method that calls the editor directly.
 
 pub mod drop_dialog;
 pub mod file_dialog;

@@ -1,6 +1,7 @@
 //! Messages for the user: what happened (info) and what went wrong (errors).
 
-use crate::app::editor::EditorApp;
+use crate::app::actions::Action;
+use crate::app::ctx::PanelContext;
 use egui::Color32;
 
 /// How many notices the side panel lists.
@@ -51,11 +52,18 @@ impl Notices {
     }
 }
 
-impl EditorApp {
-    /// The latest notices, newest first, each with a button to dismiss it.
-    pub(in crate::app) fn notices_panel(&mut self, ui: &mut egui::Ui) {
-        let mut dismiss = None;
-        for (index, notice) in self.notices.list.iter().enumerate().rev().take(SHOWN) {
+impl Notices {
+    /// Remove the notice at `index` (as [`Self::all`] lists them), if it is there.
+    pub fn dismiss(&mut self, index: usize) {
+        if index < self.list.len() {
+            self.list.remove(index);
+        }
+    }
+
+    /// The latest notices, newest first, each with a button that sends
+    /// `DismissNotice`; the panel sees only its own list.
+    pub fn ui(&self, ui: &mut egui::Ui, context: &mut PanelContext) {
+        for (index, notice) in self.list.iter().enumerate().rev().take(SHOWN) {
             // Not horizontal_wrapped: there a text just wider than the space left
             // beside the button widens the whole panel. Here it wraps in that space.
             ui.horizontal_top(|ui| {
@@ -65,16 +73,13 @@ impl EditorApp {
                     ui.visuals().text_color()
                 };
                 if ui.small_button("x").clicked() {
-                    dismiss = Some(index);
+                    context.send(Action::DismissNotice(index));
                 }
                 ui.add(
                     egui::Label::new(egui::RichText::new(&notice.text).color(colour))
                         .wrap_mode(egui::TextWrapMode::Wrap),
                 );
             });
-        }
-        if let Some(index) = dismiss {
-            self.notices.list.remove(index);
         }
     }
 }

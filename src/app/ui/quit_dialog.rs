@@ -2,13 +2,13 @@
 //! quit without it, or go back. A pose counts as saved when it is the rest pose or
 //! the last one saved or loaded.
 
-use crate::app::editor::EditorApp;
-use crate::app::model::Command;
+use crate::app::actions::Action;
+use crate::app::ctx::PanelContext;
 use crate::app::ui::file_dialog::FileAction;
 
-/// Where quitting stands.
+/// The quit question and where quitting stands.
 #[derive(Clone, Debug, Default)]
-pub struct QuitState {
+pub struct QuitDialog {
     /// The question is shown.
     asking: bool,
     /// The user chose to quit; the window may close.
@@ -19,67 +19,57 @@ pub struct QuitState {
     close_next_frame: bool,
 }
 
-impl EditorApp {
-    /// The pose differs from the rest pose and from the last one saved or loaded.
-    pub fn pose_is_unsaved(&self) -> bool {
-        self.model.pose_unsaved()
-    }
-
-    /// The current pose is on disk (saved, loaded or bundled): quitting keeps it.
-    pub(in crate::app) fn mark_pose_saved(&mut self) {
-        self.apply(Command::MarkSaved);
-    }
-
-    /// The quit question is shown.
-    pub fn is_asking_to_quit(&self) -> bool {
-        self.quit.asking
+impl QuitDialog {
+    /// The question is shown.
+    pub fn is_asking(&self) -> bool {
+        self.asking
     }
 
     /// The window was told to close.
-    pub fn quit_confirmed(&self) -> bool {
-        self.quit.confirmed
+    pub fn confirmed(&self) -> bool {
+        self.confirmed
     }
 
-    /// File > Quit, Ctrl+Q, or the window's close button: close now when nothing
-    /// would be lost, else ask.
-    pub fn request_quit(&mut self, ctx: &egui::Context) {
-        if self.quit.confirmed || !self.pose_is_unsaved() {
-            self.quit.confirmed = true;
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    /// File > Quit, Ctrl+Q, or the window's close button: true when the window
+    /// may close now (nothing would be lost), else the question is shown.
+    pub fn request(&mut self, pose_unsaved: bool) -> bool {
+        if self.confirmed || !pose_unsaved {
+            self.confirmed = true;
         } else {
-            self.quit.asking = true;
+            self.asking = true;
         }
+        self.confirmed
     }
 
-    /// A close asked for by the window system waits for the question's answer.
-    pub(in crate::app) fn intercept_close(&mut self, ctx: &egui::Context) {
-        // A scripted run (`--screenshot`) ends on its own; its pose (`--drag`) is
-        // not work to keep.
+    /// A close asked for by the window system waits for the question's answer. A
+    /// scripted run (`--screenshot`) ends on its own; its pose (`--drag`) is not
+    /// work to keep.
+    pub fn intercept_close(&mut self, ctx: &egui::Context, scripted: bool, pose_unsaved: bool) {
         if ctx.input(|i| i.viewport().close_requested())
-            && self.screenshot.is_none()
-            && !self.quit.confirmed
-            && self.pose_is_unsaved()
+            && !scripted
+            && !self.confirmed
+            && pose_unsaved
         {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.quit.asking = true;
+            self.asking = true;
         }
     }
 
-    /// A pose save asked for from the question ended: quit if it was written
-    /// (`save_pose` has moved the save point).
-    pub(in crate::app) fn pose_save_finished(&mut self, saved: bool) {
-        if std::mem::take(&mut self.quit.after_save) && saved {
-            self.quit.confirmed = true;
-            self.quit.close_next_frame = true;
+    /// A pose save ended: quit if it was asked for by the question and written.
+    pub fn pose_save_finished(&mut self, saved: bool) {
+        if std::mem::take(&mut self.after_save) && saved {
+            self.confirmed = true;
+            self.close_next_frame = true;
         }
     }
 
-    /// The question, while it is shown.
-    pub(in crate::app) fn quit_dialog(&mut self, ctx: &egui::Context) {
-        if std::mem::take(&mut self.quit.close_next_frame) {
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    /// The question, while it is shown. It sends `AskForFile(SavePose)` for
+    /// Save pose… and `CloseWindow` for quitting; it sees nothing else.
+    pub fn ui(&mut self, ctx: &egui::Context, context: &mut PanelContext) {
+        if std::mem::take(&mut self.close_next_frame) {
+            context.send(Action::CloseWindow);
         }
-        if !self.quit.asking {
+        if !self.asking {
             return;
         }
         let mut answer = None;
@@ -106,16 +96,16 @@ impl EditorApp {
         }
         match answer {
             Some(QuitAnswer::Save) => {
-                self.quit.asking = false;
-                self.quit.after_save = true;
-                self.ask_for_file(FileAction::SavePose);
+                self.asking = false;
+                self.after_save = true;
+                context.send(Action::AskForFile(FileAction::SavePose));
             }
             Some(QuitAnswer::Discard) => {
-                self.quit.asking = false;
-                self.quit.confirmed = true;
-                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                self.asking = false;
+                self.confirmed = true;
+                context.send(Action::CloseWindow);
             }
-            Some(QuitAnswer::Cancel) => self.quit.asking = false,
+            Some(QuitAnswer::Cancel) => self.asking = false,
             None => {}
         }
     }

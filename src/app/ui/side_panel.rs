@@ -1,6 +1,7 @@
 //! The side panel: the scene, binding (each family's parameter, progress and
 //! cancel), quality, the selected handle's position, and the notices.
 
+use crate::app::ctx::PanelContext;
 use crate::app::editor::EditorApp;
 use crate::app::model::{Command, GestureKind, POSE_EDIT};
 use crate::coords::Method;
@@ -27,12 +28,13 @@ impl EditorApp {
         self.named_poses_section(ui);
         ui.separator();
         ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · G/R/S: move/rotate/scale · O: soft selection · Shift+right click: 3D cursor · F: frame selection · Home: frame all · H: cage · M: next method · Esc: deselect");
-        if self.show_statistics {
+        let mut context = PanelContext::new(&self.model, &mut self.actions);
+        if self.statistics.is_shown() {
             ui.separator();
-            self.statistics(ui);
+            self.statistics.ui(ui, &context);
         }
         ui.separator();
-        self.notices_panel(ui);
+        self.notices.ui(ui, &mut context);
     }
 
     fn binding_section(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {

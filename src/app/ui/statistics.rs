@@ -1,7 +1,7 @@
 //! View → Statistics: frame times over the last seconds, measured only while the
 //! readout is shown (so idle time before it was switched on never counts).
 
-use crate::app::editor::EditorApp;
+use crate::app::ctx::PanelContext;
 use egui::util::History;
 
 /// Frames kept, and how far back they may reach in seconds.
@@ -55,25 +55,49 @@ impl FrameStats {
     }
 }
 
-impl EditorApp {
-    /// Average frame interval over the recent frames, in seconds.
-    pub fn average_frame_time(&self) -> Option<f32> {
-        self.stats.average()
+/// The readout: whether it is shown, and the frames it measures.
+#[derive(Default)]
+pub struct StatisticsPanel {
+    shown: bool,
+    frames: FrameStats,
+}
+
+impl StatisticsPanel {
+    pub fn is_shown(&self) -> bool {
+        self.shown
     }
 
-    pub(in crate::app) fn statistics(&self, ui: &mut egui::Ui) {
+    /// Show or hide the readout; switching it on or off starts measuring afresh.
+    pub fn set_shown(&mut self, shown: bool) {
+        if shown != self.shown {
+            self.shown = shown;
+            self.frames.restart();
+        }
+    }
+
+    pub fn frames(&self) -> &FrameStats {
+        &self.frames
+    }
+
+    pub fn frames_mut(&mut self) -> &mut FrameStats {
+        &mut self.frames
+    }
+
+    /// Frame times, and the size of the document's mesh and weights.
+    pub fn ui(&self, ui: &mut egui::Ui, context: &PanelContext) {
         let milliseconds = |seconds: Option<f32>| seconds.map_or(0.0, |s| s * 1000.0);
         ui.label(format!(
             "Frame time: {:.1} ms average, {:.1} ms worst (last {} frames)",
-            milliseconds(self.stats.average()),
-            milliseconds(self.stats.worst()),
-            self.stats.len()
+            milliseconds(self.frames.average()),
+            milliseconds(self.frames.worst()),
+            self.frames.len()
         ));
-        let mesh = self.model.document().mesh();
+        let document = context.document();
+        let mesh = document.mesh();
         ui.label(format!(
             "{} triangles, {} weights",
             mesh.triangles.len(),
-            mesh.positions.len() * self.model.document().pose().len()
+            mesh.positions.len() * document.pose().len()
         ));
     }
 }

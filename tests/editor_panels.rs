@@ -1,0 +1,199 @@
+//! Panels see a narrow, read-only context and queue actions; the editor changes
+//! only when it runs that queue, after the panels have drawn.
+
+mod common;
+
+use common::editor::*;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use glam::DVec3;
+use pmvc::app::actions::Action;
+use pmvc::app::ctx::PanelContext;
+use pmvc::app::document::Document;
+use pmvc::app::model::{Command, Model};
+use pmvc::app::scenes;
+use pmvc::app::ui::file_dialog::FileAction;
+use pmvc::app::ui::quit_dialog::QuitDialog;
+
+/// The quit dialog alone, over a model whose pose is not saved.
+struct QuitScene {
+    dialog: QuitDialog,
+    model: Model,
+    actions: Vec<Action>,
+}
+
+fn quit_scene() -> QuitScene {
+    let mut model = Model::new(Document::new(
+        "comb",
+        scenes::comb_mesh(),
+        scenes::comb_cage(),
+    ));
+    let pose = scenes::comb_demo_pose(model.document().cage());
+    model.apply(Command::edit_pose(pose));
+    assert!(model.pose_unsaved());
+    let mut dialog = QuitDialog::default();
+    assert!(
+        !dialog.request(model.pose_unsaved()),
+        "an unsaved pose asks"
+    );
+    QuitScene {
+        dialog,
+        model,
+        actions: Vec::new(),
+    }
+}
+
+fn quit_harness(scene: QuitScene) -> Harness<'static, QuitScene> {
+    Harness::new_ui_state(
+        |ui, scene: &mut QuitScene| {
+            let ctx = ui.ctx().clone();
+            let mut context = PanelContext::new(&scene.model, &mut scene.actions);
+            scene.dialog.ui(&ctx, &mut context);
+        },
+        scene,
+    )
+}
+
+#[test]
+fn the_quit_dialogs_save_and_quit_is_queued_actions_not_changes() {
+    let mut harness = quit_harness(quit_scene());
+    harness.run();
+    harness.get_by_label("Save pose…").click();
+    harness.run();
+    let scene = harness.state();
+    assert!(
+        matches!(
+            scene.actions.as_slice(),
+            [Action::AskForFile(FileAction::SavePose)]
+        ),
+        "Save pose… queues the file dialog, and only that: {:?}",
+        scene.actions
+    );
+    assert!(
+        scene.model.pose_unsaved(),
+        "the save point stays until a save is run"
+    );
+    assert!(!scene.dialog.is_asking());
+    assert!(!scene.dialog.confirmed(), "nothing is saved yet");
+
+    // The save written: the dialog asks for the window to close, once.
+    harness.state_mut().actions.clear();
+    harness.state_mut().dialog.pose_save_finished(true);
+    harness.run();
+    let scene = harness.state();
+    assert!(scene.dialog.confirmed());
+    assert!(
+        matches!(scene.actions.as_slice(), [Action::CloseWindow]),
+        "{:?}",
+        scene.actions
+    );
+}
+
+#[test]
+fn quitting_without_saving_is_a_queued_close() {
+    let mut harness = quit_harness(quit_scene());
+    harness.run();
+    harness.get_by_label("Quit without saving").click();
+    harness.run();
+    let scene = harness.state();
+    assert!(scene.dialog.confirmed());
+    assert!(
+        matches!(scene.actions.as_slice(), [Action::CloseWindow]),
+        "{:?}",
+        scene.actions
+    );
+    assert!(
+        scene.model.pose_unsaved(),
+        "the pose is not saved by quitting"
+    );
+}
+
+#[test]
+fn the_save_point_moves_only_when_the_editor_runs_the_queued_actions() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    let rest = harness.state().document().pose()[3];
+    harness
+        .state_mut()
+        .set_handle_position(3, rest + DVec3::new(0.0, 0.5, 0.0));
+    assert!(harness.state().pose_is_unsaved());
+
+    harness
+        .state_mut()
+        .queue_action(Action::Apply(Command::MarkSaved));
+    assert!(
+        harness.state().pose_is_unsaved(),
+        "a queued action changes nothing by itself"
+    );
+    harness.step();
+    assert!(
+        !harness.state().pose_is_unsaved(),
+        "the frame's runner applied it"
+    );
+
+    // The question's Save pose… reaches the file dialog through the runner, in
+    // the frame it was clicked, and leaves the save point alone.
+    harness
+        .state_mut()
+        .set_handle_position(3, rest + DVec3::new(0.0, 0.7, 0.0));
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    assert!(harness.state().is_asking_to_quit());
+    harness.get_by_label("Save pose…").click();
+    harness.step();
+    assert_eq!(
+        harness.state().open_file_dialog(),
+        Some(FileAction::SavePose)
+    );
+    assert!(harness.state().pose_is_unsaved());
+    assert!(!harness.state().quit_confirmed());
+}
+
+/// The notices panel with its own list, over the comb.
+struct NoticesScene {
+    notices: pmvc::app::ui::notices::Notices,
+    model: Model,
+    actions: Vec<Action>,
+}
+
+#[test]
+fn dismissing_a_notice_is_queued_and_removes_that_notice_when_run() {
+    let mut notices = pmvc::app::ui::notices::Notices::default();
+    notices.info("first");
+    notices.error("second");
+    let scene = NoticesScene {
+        notices,
+        model: Model::new(Document::new(
+            "comb",
+            scenes::comb_mesh(),
+            scenes::comb_cage(),
+        )),
+        actions: Vec::new(),
+    };
+    let mut harness = Harness::new_ui_state(
+        |ui, scene: &mut NoticesScene| {
+            let mut context = PanelContext::new(&scene.model, &mut scene.actions);
+            scene.notices.ui(ui, &mut context);
+        },
+        scene,
+    );
+    harness.run();
+    // Newest first: the first "x" dismisses "second", at index 1 of the list.
+    harness.get_all_by_label("x").next().unwrap().click();
+    harness.run();
+    let scene = harness.state_mut();
+    assert_eq!(scene.notices.all().len(), 2, "the panel only asks");
+    let index = match scene.actions.as_slice() {
+        [Action::DismissNotice(index)] => *index,
+        other => panic!("expected one DismissNotice, got {other:?}"),
+    };
+    scene.notices.dismiss(index);
+    let left: Vec<&str> = scene
+        .notices
+        .all()
+        .iter()
+        .map(|n| n.text.as_str())
+        .collect();
+    assert_eq!(left, ["first"]);
+}
