@@ -100,21 +100,9 @@ pub fn bind(
     out: &Path,
     extra: &[&str],
 ) -> std::process::Output {
-    let mut args = vec![
-        "bind",
-        "--mesh",
-        path_str(mesh),
-        "--cage",
-        path_str(cage),
-        "--method",
-        method,
-        "--backend",
-        "cpu",
-        "--out",
-        path_str(out),
-    ];
+    let mut args = vec!["--method", method];
     args.extend_from_slice(extra);
-    pmvc(&args)
+    bind_on_cpu(mesh, cage, out, &args)
 }
 
 pub fn deform(
