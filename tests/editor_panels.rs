@@ -8,7 +8,7 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use glam::DVec3;
 use pmvc::app::actions::Action;
-use pmvc::app::ctx::PanelContext;
+use pmvc::app::ctx::{PanelContext, Shown};
 use pmvc::app::document::Document;
 use pmvc::app::model::{Command, Model};
 use pmvc::app::scenes;
@@ -47,7 +47,8 @@ fn quit_harness(scene: QuitScene) -> Harness<'static, QuitScene> {
     Harness::new_ui_state(
         |ui, scene: &mut QuitScene| {
             let ctx = ui.ctx().clone();
-            let mut context = PanelContext::new(&scene.model, &mut scene.actions);
+            let shown = Shown::default();
+            let mut context = PanelContext::new(&scene.model, &shown, &mut scene.actions);
             scene.dialog.ui(&ctx, &mut context);
         },
         scene,
@@ -173,7 +174,8 @@ fn dismissing_a_notice_is_queued_and_removes_that_notice_when_run() {
     };
     let mut harness = Harness::new_ui_state(
         |ui, scene: &mut NoticesScene| {
-            let mut context = PanelContext::new(&scene.model, &mut scene.actions);
+            let shown = Shown::default();
+            let mut context = PanelContext::new(&scene.model, &shown, &mut scene.actions);
             scene.notices.ui(ui, &mut context);
         },
         scene,

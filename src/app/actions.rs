@@ -1,12 +1,15 @@
-//! What panels ask the editor to do, as values, and the one runner that does it
-//! after the panels have drawn each frame (egui's demo app returns its commands
-//! the same way). Actions do the I/O; what changes the document goes on to the
-//! model as a [`Command`].
+//! What panels and shortcuts ask the editor to do, as values (egui's demo app
+//! returns its commands the same way). The editor's one runner
+//! (`editor/runner.rs`) carries them out: actions do the I/O, and what changes
+//! the document goes on to the model as a [`Command`].
 
-use super::editor::{EditorApp, FileRole};
+use super::compare::ViewSettings;
+use super::editor::FileRole;
 use super::model::Command;
+use super::recent::RecentEntry;
+use super::scenes::BundledScene;
 use super::ui::file_dialog::FileAction;
-use super::ui::notices::Notices;
+use crate::coords::{Method, Parameter};
 use glam::DVec3;
 use std::path::PathBuf;
 
@@ -19,111 +22,112 @@ pub enum Action {
     CloseWindow,
     /// Open the file dialog for `FileAction`.
     AskForFile(FileAction),
+    /// The in-window dialog's answer: carry out `FileAction` on the path.
+    FileChosen(FileAction, PathBuf),
+    /// A file dialog was closed without a file.
+    FileCancelled(FileAction),
     /// Open a file as the mesh or the cage.
     Open(FileRole, PathBuf),
     /// Open a mesh and its cage together.
-    OpenPair { mesh: PathBuf, cage: PathBuf },
+    OpenPair {
+        mesh: PathBuf,
+        cage: PathBuf,
+    },
+    /// Open a File > Recent entry; one that no longer opens leaves the list.
+    OpenRecent(RecentEntry),
+    /// Open a bundled scene.
+    OpenBundled(BundledScene),
     /// Use the vertices read from `path` as the cage's pose.
-    TakePose { path: PathBuf, pose: Vec<DVec3> },
+    TakePose {
+        path: PathBuf,
+        pose: Vec<DVec3>,
+    },
+    /// File > Save session: where it was last saved or opened, else ask.
+    SaveSessionAgain,
     /// Report an error to the user.
     Error(String),
+    /// Tell the user something.
+    Info(String),
     /// Remove the notice at this index of the list.
     DismissNotice(usize),
     /// Change the model.
     Apply(Command),
+    Undo,
+    Redo,
+    /// Pose the cage at rest, as one undo step.
+    ResetPose,
+    /// Edit > Use pose as rest shape.
+    PoseAsRest,
+    /// Subdivide the cage 1-to-4, keeping the pose, and bind again.
+    SubdivideCage,
+    /// Move one handle to a typed position, as one undo step.
+    SetHandlePosition(usize, DVec3),
+    /// The rest-to-pose blend slider.
+    Blend(BlendStep),
+    /// Keep the current pose under a name.
+    StoreNamedPose(String),
+    /// Pose the cage as the named pose at this index.
+    ApplyNamedPose(usize),
+    RenameNamedPose {
+        index: usize,
+        name: String,
+    },
+    /// Show these view settings.
+    SetView(ViewSettings),
+    /// The family a single view shows.
+    SetMethod(Method),
+    /// The next family (the M key).
+    NextMethod,
+    /// A family parameter, checked by its spec.
+    SetParameter(Parameter, u32),
+    /// Bind the methods the views show, replacing a running bind.
+    StartBind,
+    /// Cancel the running bind; views stop asking until the user binds again.
+    CancelBind,
+    SetHighlightOutside(bool),
+    /// Anti-aliasing: the viewport's samples per pixel.
+    SetSampleCount(u32),
+    /// One camera for every view, or one each.
+    SetCamerasLocked(bool),
+    /// Keep the difference's colour scale at the distance shown now, or go back
+    /// to following the largest distance.
+    FixDifferenceScale(bool),
+    FrameSelection,
+    FrameAll,
+    /// Show or hide the cage and its handles (H).
+    ToggleCage,
+    /// Soft selection on or off (O).
+    ToggleSoftSelection,
+    ShowStatistics(bool),
+    /// pmvc's own file dialog instead of the system's.
+    SetInWindowDialog(bool),
+    /// The Generate cage window.
+    CageWindow(CageRequest),
+    /// Hide the first run's line.
+    HideFirstRunLine,
 }
 
-impl EditorApp {
-    /// Run the actions the panels and shortcuts queued this frame, in order.
-    pub(super) fn run_actions(&mut self, ctx: &egui::Context) {
-        let mut ran = false;
-        // An action may queue more (none does yet): run until none is left.
-        while !self.actions.is_empty() {
-            for action in std::mem::take(&mut self.actions) {
-                self.run_queued(ctx, action);
-                ran = true;
-            }
-        }
-        if ran {
-            // What the actions changed shows in the next frame, without waiting
-            // for input.
-            ctx.request_repaint();
-        }
-    }
+/// A step of the blend slider's gesture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BlendStep {
+    /// The slider's drag began.
+    Begin,
+    /// Show the blend at this amount (0 to 1) while the drag lasts.
+    Preview(f64),
+    /// The drag ended: one undo step.
+    End,
+    /// A click or a typed amount: the blend at once, as one undo step.
+    Set(f64),
+}
 
-    fn run_queued(&mut self, ctx: &egui::Context, action: Action) {
-        match action {
-            Action::Quit => {
-                if self.quit.request(self.model.pose_unsaved()) {
-                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                }
-            }
-            Action::CloseWindow => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
-            Action::AskForFile(file_action) => self.ask_for_file(file_action),
-            Action::Open(role, path) => {
-                self.open_file(role, &path);
-            }
-            Action::OpenPair { mesh, cage } => {
-                self.open_pair(&mesh, &cage);
-            }
-            Action::TakePose { path, pose } => {
-                self.take_pose_file(&path, pose);
-            }
-            Action::Error(text) => self.error(text),
-            Action::DismissNotice(index) => self.notices.dismiss(index),
-            Action::Apply(command) => {
-                self.apply(command);
-            }
-        }
-    }
-
-    /// Queue `action` for the end of the next frame, as a panel would.
-    pub fn queue_action(&mut self, action: Action) {
-        self.actions.push(action);
-    }
-
-    // ---- thin wrappers over the panels' state, for the tests ---------------------
-
-    /// The pose differs from the rest pose and from the last one saved or loaded.
-    pub fn pose_is_unsaved(&self) -> bool {
-        self.model.pose_unsaved()
-    }
-
-    /// The current pose is on disk (saved, loaded or bundled): quitting keeps it.
-    pub(super) fn mark_pose_saved(&mut self) {
-        self.apply(Command::MarkSaved);
-    }
-
-    pub fn notices(&self) -> &Notices {
-        &self.notices
-    }
-
-    pub fn notices_mut(&mut self) -> &mut Notices {
-        &mut self.notices
-    }
-
-    /// The latest error, if any (for tests and the status bar).
-    pub fn last_error(&self) -> Option<&str> {
-        self.notices.last_error()
-    }
-
-    /// The quit question is shown.
-    pub fn is_asking_to_quit(&self) -> bool {
-        self.quit.is_asking()
-    }
-
-    /// The window was told to close.
-    pub fn quit_confirmed(&self) -> bool {
-        self.quit.confirmed()
-    }
-
-    /// The dropped file waiting for a choice, if any.
-    pub fn pending_drop(&self) -> Option<&super::ui::drop_dialog::DroppedFile> {
-        self.drop_dialog.pending()
-    }
-
-    /// Average frame interval over the recent frames, in seconds.
-    pub fn average_frame_time(&self) -> Option<f32> {
-        self.statistics.frames().average()
-    }
+/// What the Generate cage window asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CageRequest {
+    Open,
+    Close,
+    Generate,
+    /// Cancel the job, or discard the proposal.
+    Cancel,
+    /// Use the proposal as the cage.
+    Use,
 }

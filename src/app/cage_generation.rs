@@ -5,20 +5,19 @@
 //! A proposal belongs to the mesh it was generated around: if the document's
 //! mesh changes meanwhile (undo, another file), the proposal is dropped.
 
-use super::document::Document;
-use super::editor::{EditorApp, Replacement};
 use crate::geometry::autocage::{
     generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
     DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
-use crate::geometry::shown_path;
-use crate::geometry::{Cage, MeshFile, TriMesh};
+use crate::geometry::{Cage, TriMesh};
 use crate::render::scene_gpu::unique_edges;
 use glam::DVec3;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
+
+/// The proposed cage's colour in the viewport and its stats' heading.
+pub const PROPOSAL_GREEN: egui::Color32 = egui::Color32::from_rgb(80, 220, 110);
 
 /// The target a first generation offers when the cage says nothing better.
 pub const DEFAULT_TARGET_VERTICES: usize = 64;
@@ -104,6 +103,26 @@ impl CageGeneration {
         self.open
     }
 
+    /// Open the window, offering `current_vertices` (the cage's vertex count,
+    /// or [`DEFAULT_TARGET_VERTICES`] for a box) unless the user chose a
+    /// target before.
+    pub fn open_window(&mut self, current_vertices: usize) {
+        if !self.target_chosen {
+            self.target_vertices = if current_vertices > MIN_TARGET_VERTICES {
+                current_vertices.min(MAX_TARGET_VERTICES)
+            } else {
+                DEFAULT_TARGET_VERTICES
+            };
+        }
+        self.open = true;
+    }
+
+    /// Close the window; a running job is cancelled and a proposal dropped.
+    pub fn close_window(&mut self) {
+        self.cancel();
+        self.open = false;
+    }
+
     pub fn is_running(&self) -> bool {
         matches!(self.state, State::Running(_))
     }
@@ -142,7 +161,7 @@ impl CageGeneration {
 
     /// Start generating around `mesh`, waking the editor as progress is made
     /// and when the job ends. Any job or proposal before it is dropped.
-    fn start(&mut self, mesh: Arc<TriMesh>) {
+    pub fn start(&mut self, mesh: Arc<TriMesh>) {
         self.cancel();
         let repaint = self.repaint.clone();
         let wake = move || {
@@ -187,7 +206,7 @@ impl CageGeneration {
     }
 
     /// Take a finished job's result; drop a proposal made for another mesh.
-    fn poll(&mut self, current_mesh: &Arc<TriMesh>) {
+    pub fn poll(&mut self, current_mesh: &Arc<TriMesh>) {
         match &self.state {
             State::Running(job) => {
                 let finished = match job.result.try_recv() {
@@ -224,7 +243,7 @@ impl CageGeneration {
         }
     }
 
-    fn take_proposal(&mut self) -> Option<Proposal> {
+    pub fn take_proposal(&mut self) -> Option<Proposal> {
         match std::mem::replace(&mut self.state, State::Idle { message: None }) {
             State::Proposed(proposal) => Some(*proposal),
             other => {
@@ -364,106 +383,6 @@ pub fn loose_box_cage(mesh: &TriMesh) -> Option<Cage> {
         triangle_faces: unit.triangle_faces().to_vec(),
     };
     Cage::new(cage).ok().map(|(cage, _)| cage)
-}
-
-impl EditorApp {
-    /// The Generate cage window's state, for the window and for tests.
-    pub fn cage_generation(&self) -> &CageGeneration {
-        &self.cage_generation
-    }
-
-    pub fn cage_generation_mut(&mut self) -> &mut CageGeneration {
-        &mut self.cage_generation
-    }
-
-    /// File > Generate cage…: open the window, offering the current cage's
-    /// vertex count (or [`DEFAULT_TARGET_VERTICES`] for a box) unless the user
-    /// chose a target before.
-    pub fn open_cage_generation(&mut self) {
-        let generation = &mut self.cage_generation;
-        if !generation.target_chosen {
-            let current = self.model.document().cage().vertex_count();
-            generation.target_vertices = if current > MIN_TARGET_VERTICES {
-                current.min(MAX_TARGET_VERTICES)
-            } else {
-                DEFAULT_TARGET_VERTICES
-            };
-        }
-        generation.open = true;
-    }
-
-    /// Close the window; a running job is cancelled and a proposal dropped.
-    pub fn close_cage_generation(&mut self) {
-        self.cage_generation.cancel();
-        self.cage_generation.open = false;
-    }
-
-    /// Generate a cage around the document's mesh in the background.
-    pub fn start_cage_generation(&mut self) {
-        let mesh = Arc::clone(self.model.document().mesh());
-        self.cage_generation.start(mesh);
-    }
-
-    /// Called every frame: take a finished job's result.
-    pub(super) fn poll_cage_generation(&mut self) {
-        let mesh = Arc::clone(self.model.document().mesh());
-        self.cage_generation.poll(&mesh);
-    }
-
-    /// Replace the document's cage by the proposal, as one undo step, and bind.
-    /// Returns false when there is no proposal.
-    pub fn use_generated_cage(&mut self) -> bool {
-        let Some(proposal) = self.cage_generation.take_proposal() else {
-            return false;
-        };
-        let cage = proposal.generated.cage;
-        let vertices = cage.vertex_count();
-        let rest = cage.positions().to_vec();
-        let document = self.model.document().with_cage(cage, None, rest);
-        self.replace_document_then_bind(Replacement::framed(
-            document,
-            format!("use the generated {vertices}-vertex cage"),
-        ));
-        self.info(format!(
-            "using the generated cage of {vertices} vertices; binding"
-        ));
-        self.cage_generation.open = false;
-        true
-    }
-
-    /// Open a mesh with no cage: it sits in a loose box, and the Generate cage
-    /// window opens to offer a real one. False, with an error, when it fails.
-    pub(super) fn open_mesh_alone(&mut self, path: &Path) -> bool {
-        match crate::geometry::load_mesh(path) {
-            Ok(file) => self.open_mesh_in_box(path, file),
-            Err(error) => {
-                self.error(error.to_string());
-                false
-            }
-        }
-    }
-
-    /// Make `file`, read from `path`, the document's mesh in a loose box cage
-    /// (one undo step) and bind it, and open the Generate cage window.
-    pub(super) fn open_mesh_in_box(&mut self, path: &Path, file: MeshFile) -> bool {
-        let Some(cage) = loose_box_cage(&file.mesh) else {
-            self.error(format!(
-                "{}: the mesh has no extent to put a cage around",
-                shown_path(path)
-            ));
-            return false;
-        };
-        let title = super::files::file_title(path);
-        let document =
-            Document::new(title.clone(), file.mesh.clone(), cage).with_files(Some(file), None);
-        self.replace_document_then_bind(Replacement::framed(document, format!("open {title}")));
-        self.info(format!(
-            "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
-            shown_path(path)
-        ));
-        self.open_cage_generation();
-        true
-    }
 }
 
 /// Whether any vertex of `mesh` lies in the bounding box of `cage`: a cage that

@@ -4,7 +4,9 @@
 //! gives it, with the scale and range in the header).
 
 use super::compare::{self, Layout, Pane};
-use super::editor::EditorApp;
+use super::document::Document;
+use super::views::Views;
+use crate::coords::Method;
 use crate::geometry::shown_path;
 use crate::geometry::{write_atomically, write_coloured_ply, WriteError};
 use crate::render::colormap::{heat_colour, Scale, OUTSIDE};
@@ -51,43 +53,31 @@ pub fn save_png(
     })
 }
 
-impl EditorApp {
+impl ImageRequest {
     /// File > Save image…: the panes as drawn in the next frame.
-    pub fn save_image(&mut self, path: &Path) -> bool {
-        if !self.refuse_overwriting_open_files(path) {
-            return false;
-        }
-        self.image_request.pending = Some(path.to_owned());
-        true
+    pub fn ask(&mut self, path: &Path) {
+        self.pending = Some(path.to_owned());
     }
 
-    /// Ask for the pixels of a pending Save image…, and report the result.
-    pub(super) fn drive_image_request(&mut self, ctx: &egui::Context) {
-        let finished = self
-            .image_request
-            .finished
-            .lock()
-            .ok()
-            .and_then(|mut slot| slot.take());
-        match finished {
-            Some(Ok(path)) => self.info(format!("saved image {}", shown_path(&path))),
-            Some(Err(error)) => self.error(error),
-            None => {}
-        }
-        let Some(path) = self.image_request.pending.take() else {
-            return;
+    /// Ask for the pixels of a pending Save image… cropped to `panes`, and
+    /// return what became of an earlier one: the notice, or the error.
+    pub fn drive(
+        &mut self,
+        ctx: &egui::Context,
+        panes: impl Iterator<Item = egui::Rect>,
+    ) -> Option<Result<String, String>> {
+        let finished = self.finished.lock().ok().and_then(|mut slot| slot.take());
+        let report =
+            finished.map(|result| result.map(|path| format!("saved image {}", shown_path(&path))));
+        let Some(path) = self.pending.take() else {
+            return report;
         };
         let scale = ctx.pixels_per_point();
-        let crop = self
-            .pane_rects()
-            .into_iter()
-            .map(|(_, rect)| rect)
-            .reduce(|a, b| a.union(b))
-            .map(|rect| {
-                [rect.left(), rect.top(), rect.right(), rect.bottom()]
-                    .map(|v| (v * scale).round().max(0.0) as usize)
-            });
-        let finished = Arc::clone(&self.image_request.finished);
+        let crop = panes.reduce(|a, b| a.union(b)).map(|rect| {
+            [rect.left(), rect.top(), rect.right(), rect.bottom()]
+                .map(|v| (v * scale).round().max(0.0) as usize)
+        });
+        let finished = Arc::clone(&self.finished);
         let repaint = ctx.clone();
         ctx.request_screenshot(move |image| {
             let result = save_png(&path, &image, crop)
@@ -99,35 +89,39 @@ impl EditorApp {
             repaint.request_repaint();
         });
         ctx.request_repaint();
+        report
     }
+}
 
+impl Views {
     /// The view a coloured export takes its colours from: the difference view in
     /// that layout, else the shown method's.
-    fn exported_pane(&self) -> Pane {
-        match self.view.layout {
-            Layout::Difference => self.view.difference_pane_kind(),
-            _ => Pane::Method(self.active_method()),
+    fn exported_pane(&self, active: Method) -> Pane {
+        match self.settings.layout {
+            Layout::Difference => self.settings.difference_pane_kind(),
+            _ => Pane::Method(active),
         }
     }
 
     /// File > Export coloured mesh…: the mesh deformed by the shown method, each
     /// vertex in the colour the view gives it (unlit), as PLY.
-    pub fn export_coloured_mesh(&mut self, path: &Path) -> bool {
-        if !self.refuse_overwriting_open_files(path) {
-            return false;
-        }
-        let pane = self.exported_pane();
-        let colouring = self.view.colouring(pane);
-        let Some(values) = self.vertex_values(colouring, pane) else {
-            self.error(match colouring {
+    pub fn export_coloured_mesh(
+        &mut self,
+        path: &Path,
+        document: &Document,
+        wanted: &[Method],
+    ) -> Result<String, String> {
+        super::files::refuse_overwriting_open_files(path, document)?;
+        let pane = self.exported_pane(wanted[0]);
+        let colouring = self.settings.colouring(pane);
+        let Some(values) = self.vertex_values(document, colouring, pane) else {
+            return Err(match colouring {
                 Colouring::Shaded => {
                     "the mesh is plainly shaded: colour it by a heatmap, the negativity or \
                      the difference first"
                         .to_owned()
                 }
-                Colouring::TriangleWeight(_)
-                    if self.model.document().weights(pane.method()).is_some() =>
-                {
+                Colouring::TriangleWeight(_) if document.weights(pane.method()).is_some() => {
                     format!(
                         "{} has no per-triangle functions ψ; only Green coordinates do",
                         pane.method()
@@ -135,12 +129,10 @@ impl EditorApp {
                 }
                 _ => format!("{} is not bound yet", pane.method()),
             });
-            return false;
         };
-        let limit = self.colour_limit(colouring, pane);
-        let scale = self.view.scale_of(colouring);
-        let outside: std::collections::HashSet<u32> =
-            self.model.document().outside().iter().copied().collect();
+        let limit = self.colour_limit(document, wanted, colouring, pane);
+        let scale = self.settings.scale_of(colouring);
+        let outside: std::collections::HashSet<u32> = document.outside().iter().copied().collect();
         let colours: Vec<[f32; 3]> = values
             .iter()
             .enumerate()
@@ -153,41 +145,42 @@ impl EditorApp {
                 }
             })
             .collect();
-        let comments = self.colour_comments(colouring, pane, limit, scale);
-        let positions = self.model.document().deformed_positions(pane.method());
-        let result = write_coloured_ply(
+        let comments = Self::colour_comments(colouring, pane, limit, scale);
+        let positions = document.deformed_positions(pane.method());
+        write_coloured_ply(
             path,
             &positions,
-            &self.model.document().mesh().triangles,
+            &document.mesh().triangles,
             &colours,
             &comments,
-        );
-        self.report_export(result, path)
+        )
+        .map_err(|error| error.to_string())?;
+        Ok(format!("exported {}", shown_path(path)))
     }
 
     /// The value each mesh vertex is coloured by, as the vertex shader computes it.
-    fn vertex_values(&mut self, colouring: Colouring, pane: Pane) -> Option<Vec<f32>> {
+    fn vertex_values(
+        &mut self,
+        document: &Document,
+        colouring: Colouring,
+        pane: Pane,
+    ) -> Option<Vec<f32>> {
         match colouring {
             Colouring::Shaded => None,
             Colouring::CageVertexWeight(column) => {
-                let weights = self.model.document().weights(pane.method())?;
+                let weights = document.weights(pane.method())?;
                 let column = (column as usize).min(weights.cols.saturating_sub(1));
                 Some((0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
             Colouring::TriangleWeight(triangle) => {
-                let weights = self.model.document().weights(pane.method())?;
-                let column = self.model.document().cage().vertex_count() + triangle as usize;
+                let weights = document.weights(pane.method())?;
+                let column = document.cage().vertex_count() + triangle as usize;
                 (column < weights.cols)
                     .then(|| (0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
             Colouring::MostNegativeWeight => {
-                let weights = self.model.document().weights(pane.method())?;
-                let columns = self
-                    .model
-                    .document()
-                    .cage()
-                    .vertex_count()
-                    .min(weights.cols);
+                let weights = document.weights(pane.method())?;
+                let columns = document.cage().vertex_count().min(weights.cols);
                 Some(
                     (0..weights.rows)
                         .map(|r| {
@@ -203,9 +196,9 @@ impl EditorApp {
                 let Pane::Difference { against, shown } = pane else {
                     return None;
                 };
-                let a = self.deformed_on_cpu(against)?;
-                let b = self.deformed_on_cpu(shown)?;
-                let size = compare::cage_size(self.model.document().cage().positions()) as f32;
+                let a = self.deformed_on_cpu(document, against)?;
+                let b = self.deformed_on_cpu(document, shown)?;
+                let size = compare::cage_size(document.cage().positions()) as f32;
                 Some(
                     b.iter()
                         .zip(a.iter())
@@ -216,13 +209,7 @@ impl EditorApp {
         }
     }
 
-    fn colour_comments(
-        &self,
-        colouring: Colouring,
-        pane: Pane,
-        limit: f32,
-        scale: Scale,
-    ) -> Vec<String> {
+    fn colour_comments(colouring: Colouring, pane: Pane, limit: f32, scale: Scale) -> Vec<String> {
         let what = match (colouring, pane) {
             (Colouring::CageVertexWeight(vertex), _) => {
                 format!("{} coordinate of cage vertex {vertex}", pane.method())

@@ -3,23 +3,27 @@
 //! either, so the shortcuts (M, F, X/Y/Z) would do nothing. egui's request goes
 //! through the window manager; without one, the window asks the X server itself.
 
-use super::editor::EditorApp;
-
 /// Frames at the start during which the window keeps asking until it has focus
 /// (the first ones come before the window is mapped, when X refuses).
 const STARTUP_FRAMES: u32 = 30;
 
-impl EditorApp {
+/// Frames drawn, up to a limit, for asking for keyboard focus at start.
+#[derive(Default)]
+pub struct KeyboardFocus {
+    frames: u32,
+}
+
+impl KeyboardFocus {
     /// Ask for keyboard focus at start, and on any press while the window lacks it.
-    pub(super) fn ask_for_keyboard_focus(&mut self, ctx: &egui::Context, frame: &eframe::Frame) {
+    pub fn ask(&mut self, ctx: &egui::Context, frame: &eframe::Frame) {
         let (focused, pressed) = ctx.input(|i| (i.viewport().focused, i.pointer.any_pressed()));
-        let starting = self.focus_frames < STARTUP_FRAMES;
-        self.focus_frames = self.focus_frames.saturating_add(1);
+        let starting = self.frames < STARTUP_FRAMES;
+        self.frames = self.frames.saturating_add(1);
         let wanted = (starting && focused != Some(true)) || (pressed && focused == Some(false));
         if !wanted {
             return;
         }
-        if self.focus_frames == 1 || pressed {
+        if self.frames == 1 || pressed {
             ctx.send_viewport_cmd(egui::ViewportCommand::Focus);
         }
         focus_without_window_manager(frame);

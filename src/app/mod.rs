@@ -5,10 +5,13 @@
 //! - [`model`]: everything undoable (the [`document`], the one undo log, the
 //!   gesture under way, the save point), changed only through `Model::apply`.
 //! - [`bind_queue`]: binding in the background, one job at a time.
-//! - [`editor`]: the [`EditorApp`] that ties them to the viewport; `binding`,
-//!   `files` and `readouts` add its actions, `gpu_readback` what the GPU drew.
-//! - `viewport`: panes, input and picking; `ui`: menu, toolbar, side panel,
-//!   quality table, notices and statistics.
+//! - [`editor`]: the [`EditorApp`] shell that holds the parts and runs the
+//!   frame: its action runner, its GPU copy and the tests' thin wrappers.
+//! - `binding`: the bind options and which families to bind; `files`: what
+//!   opening and saving read and write, as values.
+//! - `views` and `viewport`: the panes' state, input, picking and drawing,
+//!   `readouts` the CPU values behind them; `ui`: menu, toolbar, side panel,
+//!   quality table, dialogs, notices and statistics, each a panel.
 //! - [`ctx`]: what a panel sees; [`actions`]: what it asks for, run in one
 //!   place after the panels each frame.
 //! - [`cage_generation`]: File > Generate cage…, a cage generated in the
@@ -26,9 +29,6 @@ pub mod editor;
 mod exports;
 mod files;
 mod focus;
-mod frame;
-mod gpu_readback;
-mod gpu_sync;
 pub mod model;
 mod offscreen;
 pub mod pose_tools;
@@ -42,6 +42,7 @@ pub mod session_checks;
 mod shortcuts;
 pub mod ui;
 mod viewport;
+pub mod views;
 pub mod widgets;
 
 pub use editor::{EditorApp, FileRole};
@@ -162,9 +163,7 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
         native_options,
         Box::new(move |cc| {
             let mut app = EditorApp::new(cc, options);
-            if let Some(screenshot) = app.screenshot.as_mut() {
-                screenshot.share_failures(failures_of_run);
-            }
+            app.share_scripted_failures(failures_of_run);
             Ok(Box::new(app))
         }),
     )

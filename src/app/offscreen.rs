@@ -30,7 +30,7 @@ pub fn run_offscreen(options: EditorOptions) -> Result<(), EditorError> {
     creation.wgpu_render_state = Some(state.clone());
     let mut frame = eframe::Frame::_new_kittest();
     let mut app = EditorApp::new(&creation, options);
-    let failures = app.screenshot.as_ref().map(|s| s.failures());
+    let failures = app.scripted_failures();
     let target = Target::new(&state);
     let started = Instant::now();
     let mut events = Vec::new();

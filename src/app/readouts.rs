@@ -4,8 +4,8 @@
 //! nothing here unless a colour bar needs it.
 
 use super::compare::{self, Pane, ValueRange};
-use super::document::Changes;
-use super::editor::EditorApp;
+use super::document::{Changes, Document};
+use super::views::Views;
 use crate::coords::Method;
 use crate::render::{Colouring, Shading};
 use glam::Vec3;
@@ -16,7 +16,7 @@ use std::sync::Arc;
 type RangeKey = (Colouring, Method, Option<Method>);
 
 #[derive(Default)]
-pub(super) struct ReadoutCache {
+pub struct ReadoutCache {
     /// The mesh deformed per method, with the pose revision it was made for.
     deformed: BTreeMap<Method, (u64, Arc<Vec<Vec3>>)>,
     /// Colour-bar ranges (a row-minimum scan of a large matrix is too slow to
@@ -50,21 +50,24 @@ impl ReadoutCache {
     }
 }
 
-impl EditorApp {
+impl Views {
     /// The mesh deformed with `method` on the CPU for the current pose (cached).
-    pub(super) fn deformed_on_cpu(&mut self, method: Method) -> Option<Arc<Vec<Vec3>>> {
-        let revision = self.model.document().pose_revision();
+    pub(super) fn deformed_on_cpu(
+        &mut self,
+        document: &Document,
+        method: Method,
+    ) -> Option<Arc<Vec<Vec3>>> {
+        let revision = document.pose_revision();
         if let Some((made_for, positions)) = self.readouts.deformed.get(&method) {
             if *made_for == revision {
                 return Some(Arc::clone(positions));
             }
         }
-        let weights = self.model.document().weights(method)?;
-        let moves =
-            method.column_displacements(self.model.document().cage(), self.model.document().pose());
+        let weights = document.weights(method)?;
+        let moves = method.column_displacements(document.cage(), document.pose());
         let positions = Arc::new(compare::deform(
             weights,
-            &self.model.document().mesh().positions,
+            &document.mesh().positions,
             &moves,
             self.viewport.origin(),
         ));
@@ -77,17 +80,23 @@ impl EditorApp {
     /// Screen position of mesh vertex `vertex` as drawn in view `pane`.
     pub fn mesh_vertex_screen_position(
         &mut self,
+        document: &Document,
         pane: usize,
         vertex: usize,
     ) -> Option<egui::Pos2> {
         let (kind, projection) = self.viewport.pane(pane)?;
-        let positions = self.deformed_on_cpu(kind.method())?;
+        let positions = self.deformed_on_cpu(document, kind.method())?;
         let screen = projection.project(*positions.get(vertex)?)?;
         Some(egui::Pos2::new(screen.x, screen.y))
     }
 
     /// The range of the values `colouring` shows in `pane`.
-    pub fn value_range(&mut self, colouring: Colouring, pane: Pane) -> Option<ValueRange> {
+    pub fn value_range(
+        &mut self,
+        document: &Document,
+        colouring: Colouring,
+        pane: Pane,
+    ) -> Option<ValueRange> {
         let against = match pane {
             Pane::Difference { against, .. } => Some(against),
             Pane::Method(_) => None,
@@ -96,34 +105,39 @@ impl EditorApp {
         if let Some((_, range)) = self.readouts.ranges.iter().find(|(k, _)| *k == key) {
             return *range;
         }
-        let range = self.compute_value_range(colouring, pane);
+        let range = self.compute_value_range(document, colouring, pane);
         self.readouts.ranges.push((key, range));
         range
     }
 
-    fn compute_value_range(&mut self, colouring: Colouring, pane: Pane) -> Option<ValueRange> {
+    fn compute_value_range(
+        &mut self,
+        document: &Document,
+        colouring: Colouring,
+        pane: Pane,
+    ) -> Option<ValueRange> {
         let method = pane.method();
         match colouring {
             Colouring::Shaded => None,
             Colouring::CageVertexWeight(vertex) => {
-                compare::column_range(self.model.document().weights(method)?, vertex as usize)
+                compare::column_range(document.weights(method)?, vertex as usize)
             }
             Colouring::TriangleWeight(triangle) => {
-                let column = self.model.document().cage().vertex_count() + triangle as usize;
-                compare::column_range(self.model.document().weights(method)?, column)
+                let column = document.cage().vertex_count() + triangle as usize;
+                compare::column_range(document.weights(method)?, column)
             }
             Colouring::MostNegativeWeight => {
-                let weights = self.model.document().weights(method)?;
-                let cage_vertices = self.model.document().cage().vertex_count();
-                compare::row_minimum_range(weights, cage_vertices, self.model.document().outside())
+                let weights = document.weights(method)?;
+                let cage_vertices = document.cage().vertex_count();
+                compare::row_minimum_range(weights, cage_vertices, document.outside())
             }
             Colouring::MethodDistance => {
                 let Pane::Difference { against, shown } = pane else {
                     return None;
                 };
-                let a = self.deformed_on_cpu(against)?;
-                let b = self.deformed_on_cpu(shown)?;
-                let size = compare::cage_size(self.model.document().cage().positions()) as f32;
+                let a = self.deformed_on_cpu(document, against)?;
+                let b = self.deformed_on_cpu(document, shown)?;
+                let size = compare::cage_size(document.cage().positions()) as f32;
                 compare::distance_range(&b, &a, size)
             }
         }
@@ -132,9 +146,15 @@ impl EditorApp {
     /// The magnitude at which `colouring`'s colours saturate: the same for every
     /// method in view, so methods are compared on one scale, side by side or when
     /// switching.
-    pub(super) fn colour_limit(&mut self, colouring: Colouring, pane: Pane) -> f32 {
+    pub(super) fn colour_limit(
+        &mut self,
+        document: &Document,
+        wanted: &[Method],
+        colouring: Colouring,
+        pane: Pane,
+    ) -> f32 {
         if colouring == Colouring::MethodDistance {
-            if let Some(fixed) = self.view.difference_limit {
+            if let Some(fixed) = self.settings.difference_limit {
                 return fixed.max(f32::MIN_POSITIVE);
             }
         }
@@ -145,15 +165,11 @@ impl EditorApp {
         };
         let panes: Vec<Pane> = match colouring {
             Colouring::MethodDistance => vec![pane],
-            _ => self
-                .wanted_methods()
-                .into_iter()
-                .map(Pane::Method)
-                .collect(),
+            _ => wanted.iter().copied().map(Pane::Method).collect(),
         };
         let limit = panes
             .into_iter()
-            .filter_map(|pane| self.value_range(colouring, pane))
+            .filter_map(|pane| self.value_range(document, colouring, pane))
             .map(|range| range.magnitude())
             .fold(floor, f32::max);
         if limit > 0.0 {
@@ -164,8 +180,8 @@ impl EditorApp {
     }
 
     /// How view `pane` is shaded this frame (method, colouring and colour scale).
-    pub fn shading_of(&mut self, pane: Pane) -> Shading {
-        let colouring = self.view.colouring(pane);
+    pub fn shading_of(&mut self, document: &Document, wanted: &[Method], pane: Pane) -> Shading {
+        let colouring = self.settings.colouring(pane);
         Shading {
             method: pane.method(),
             against: match pane {
@@ -173,9 +189,9 @@ impl EditorApp {
                 Pane::Method(_) => None,
             },
             colouring,
-            scale: self.view.scale_of(colouring),
-            colour_limit: self.colour_limit(colouring, pane),
-            cage_size: compare::cage_size(self.model.document().cage().positions()) as f32,
+            scale: self.settings.scale_of(colouring),
+            colour_limit: self.colour_limit(document, wanted, colouring, pane),
+            cage_size: compare::cage_size(document.cage().positions()) as f32,
         }
     }
 }

@@ -2,9 +2,9 @@
 //! window as PNG, quit. Every error the run reports is also kept here, so that a
 //! script learns of it: the command then exits with status 1.
 
-use super::editor::EditorApp;
 use super::exports::save_png;
 use super::scripted_drag::{ScriptedDrag, DRAG_FRAMES, DRAG_START_FRAME};
+use super::ui::statistics::FrameStats;
 use crate::geometry::shown_path;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -74,38 +74,34 @@ impl ScreenshotState {
     }
 }
 
-impl EditorApp {
-    pub(super) fn drive_screenshot(&mut self, ctx: &egui::Context) {
-        if self.screenshot.is_none() {
-            return;
-        }
-        if self.is_binding() {
+impl ScreenshotState {
+    /// Each frame of a scripted run: wait for the binds (`binding`), let a few
+    /// frames settle, capture the window, then close it.
+    pub fn drive(&mut self, ctx: &egui::Context, binding: bool, frames: &mut FrameStats) {
+        if binding {
             ctx.request_repaint_after(Duration::from_millis(50));
             return;
         }
-        let Some(state) = &mut self.screenshot else {
-            return;
-        };
-        if state.saved.swap(false, Ordering::Relaxed) {
-            if let Some(average) = self.statistics.frames().average() {
+        if self.saved.swap(false, Ordering::Relaxed) {
+            if let Some(average) = frames.average() {
                 eprintln!("pmvc editor: average frame time {:.1} ms", average * 1000.0);
             }
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        state.frames_after_bind += 1;
-        if state.frames_after_bind == 1 {
+        self.frames_after_bind += 1;
+        if self.frames_after_bind == 1 {
             // Measure frame times of the idle scene only, not of the bind.
-            self.statistics.frames_mut().restart();
+            frames.restart();
         }
         // Frames before the capture let the GPU upload settle and give a frame-time
         // sample of the continuously redrawn viewport.
-        let drag_done = state.drag.as_ref().is_none_or(ScriptedDrag::is_done);
-        if state.frames_after_bind >= state.capture_frame() && drag_done && !state.requested {
-            state.requested = true;
-            let path = state.path.clone();
-            let saved = Arc::clone(&state.saved);
-            let failures = state.failures();
+        let drag_done = self.drag.as_ref().is_none_or(ScriptedDrag::is_done);
+        if self.frames_after_bind >= self.capture_frame() && drag_done && !self.requested {
+            self.requested = true;
+            let path = self.path.clone();
+            let saved = Arc::clone(&self.saved);
+            let failures = self.failures();
             let repaint = ctx.clone();
             ctx.request_screenshot(move |image| {
                 if let Err(error) = save_png(&path, &image, None) {

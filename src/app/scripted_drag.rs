@@ -5,8 +5,10 @@
 //! the figure the editor's drag benchmark quotes. A handle that is off screen or
 //! that did not move is a failure of the run (exit status 1).
 
-use super::editor::EditorApp;
+use super::document::Document;
+use super::ui::statistics::FrameStats;
 use super::viewport::Drag;
+use super::views::Views;
 use egui::{Event, Modifiers, PointerButton, Pos2, RawInput, Vec2};
 
 /// Frames after the bind before the pointer presses (the views settle).
@@ -56,42 +58,52 @@ impl ScriptedDrag {
     }
 }
 
-impl EditorApp {
-    /// Add this frame's pointer events of the scripted drag to `input`.
-    pub(super) fn script_drag_input(&mut self, input: &mut RawInput) {
-        let Some(frame) = self.screenshot.as_ref().map(|s| s.frames_after_bind()) else {
-            return;
-        };
-        let Some(mut drag) = self.screenshot.as_mut().and_then(|s| s.drag.take()) else {
-            return;
-        };
+/// What the scripted drag reads and steers besides its own state.
+pub struct DragScene<'a> {
+    pub document: &'a Document,
+    pub views: &'a mut Views,
+    /// A bind is running or queued: the drag waits for it.
+    pub binding: bool,
+    /// The frame times, restarted when the drag ends.
+    pub frames: &'a mut FrameStats,
+}
+
+impl ScriptedDrag {
+    /// Add this frame's pointer events (`frame` frames after the bind) to
+    /// `input`; an error when the drag cannot start or did not move the handle.
+    pub fn script_input(
+        &mut self,
+        frame: u32,
+        input: &mut RawInput,
+        scene: DragScene,
+    ) -> Option<String> {
         let time = input.time.unwrap_or(0.0);
-        let moving = matches!(self.viewport.drag, Some(Drag::Move { .. }));
-        if moving && drag.moving_since.is_none() {
-            drag.moving_since = Some(time);
+        let moving = matches!(scene.views.viewport.drag, Some(Drag::Move { .. }));
+        if moving && self.moving_since.is_none() {
+            self.moving_since = Some(time);
         }
         if moving {
-            drag.frames_moving += 1;
+            self.frames_moving += 1;
         }
-        match drag.phase.clone() {
-            Phase::Waiting if frame >= DRAG_START_FRAME && !self.is_binding() => {
-                match self.start_drag(drag.handle) {
+        match self.phase.clone() {
+            Phase::Waiting if frame >= DRAG_START_FRAME && !scene.binding => {
+                match start_drag(self.handle, scene.document, scene.views) {
                     Ok(from) => {
                         input.events.push(Event::PointerMoved(from));
                         input.events.push(button(from, true));
-                        drag.start = self.model.document().pose().get(drag.handle).copied();
-                        drag.phase = Phase::Held { from, frames: 0 };
+                        self.start = scene.document.pose().get(self.handle).copied();
+                        self.phase = Phase::Held { from, frames: 0 };
                     }
                     Err(text) => {
-                        self.error(text);
-                        drag.phase = Phase::Done;
+                        self.phase = Phase::Done;
+                        return Some(text);
                     }
                 }
             }
             Phase::Held { from, frames } if frames < DRAG_FRAMES => {
                 let at = from + STEP * (frames + 1) as f32;
                 input.events.push(Event::PointerMoved(at));
-                drag.phase = Phase::Held {
+                self.phase = Phase::Held {
                     from,
                     frames: frames + 1,
                 };
@@ -100,54 +112,60 @@ impl EditorApp {
                 input
                     .events
                     .push(button(from + STEP * frames as f32, false));
-                self.report_drag(&drag, time);
-                drag.phase = Phase::Done;
+                self.phase = Phase::Done;
+                return self.report_drag(scene.document, time, scene.frames);
             }
             _ => {}
         }
-        if let Some(screenshot) = self.screenshot.as_mut() {
-            screenshot.drag = Some(drag);
-        }
+        None
     }
 
-    /// Where the handle to drag is on screen, or why it cannot be dragged.
-    fn start_drag(&mut self, handle: usize) -> Result<Pos2, String> {
-        let count = self.model.document().pose().len();
-        if handle >= count {
-            return Err(format!(
-                "--drag {handle}: the cage has {count} vertices (0 to {})",
-                count.saturating_sub(1)
-            ));
-        }
-        // Handles are picked only while the cage is shown.
-        self.view.show_cage = true;
-        let on_screen = self.handle_screen_position(handle).filter(|at| {
-            self.viewport
-                .pane_rects()
-                .first()
-                .is_some_and(|(_, rect)| rect.shrink(8.0).contains(*at))
-        });
-        on_screen.ok_or_else(|| format!("--drag {handle}: that handle is not in the first view"))
-    }
-
-    fn report_drag(&mut self, drag: &ScriptedDrag, now: f64) {
-        let handle = drag.handle;
-        let now_at = self.model.document().pose().get(handle).copied();
-        let moved = now_at.zip(drag.start).map_or(0.0, |(a, b)| a.distance(b));
-        let diagonal = self.model.document().cage().diagonal();
-        let Some(since) = drag.moving_since.filter(|_| moved > 0.0) else {
-            self.error(format!("--drag {handle}: the handle did not move"));
-            return;
+    fn report_drag(
+        &self,
+        document: &Document,
+        now: f64,
+        frames: &mut FrameStats,
+    ) -> Option<String> {
+        let handle = self.handle;
+        let now_at = document.pose().get(handle).copied();
+        let moved = now_at.zip(self.start).map_or(0.0, |(a, b)| a.distance(b));
+        let diagonal = document.cage().diagonal();
+        let Some(since) = self.moving_since.filter(|_| moved > 0.0) else {
+            return Some(format!("--drag {handle}: the handle did not move"));
         };
         // Frame intervals from the first frame that moved it to the release.
-        let intervals = drag.frames_moving.saturating_sub(1).max(1);
+        let intervals = self.frames_moving.saturating_sub(1).max(1);
         eprintln!(
             "pmvc editor: dragged cage vertex {handle} by {:.3} % of the cage diagonal; average frame time while dragging {:.1} ms over {intervals} frames",
             100.0 * moved / diagonal,
             (now - since) * 1000.0 / intervals as f64,
         );
-        self.statistics.frames_mut().restart();
+        frames.restart();
+        None
     }
+}
+
+/// Where the handle to drag is on screen, or why it cannot be dragged.
+fn start_drag(handle: usize, document: &Document, views: &mut Views) -> Result<Pos2, String> {
+    let count = document.pose().len();
+    if handle >= count {
+        return Err(format!(
+            "--drag {handle}: the cage has {count} vertices (0 to {})",
+            count.saturating_sub(1)
+        ));
+    }
+    // Handles are picked only while the cage is shown.
+    views.settings.show_cage = true;
+    let on_screen = views
+        .screen_position_in(0, document.pose()[handle])
+        .filter(|at| {
+            views
+                .viewport
+                .pane_rects()
+                .first()
+                .is_some_and(|(_, rect)| rect.shrink(8.0).contains(*at))
+        });
+    on_screen.ok_or_else(|| format!("--drag {handle}: that handle is not in the first view"))
 }
 
 fn button(pos: Pos2, pressed: bool) -> Event {

@@ -1,15 +1,17 @@
 //! The keyboard shortcuts, as Blender binds them: one table from keys to
-//! actions, and the one place that runs them. A transform under way (G, R, S)
+//! what they do, each an [`Action`] the editor's one runner carries out
+//! (`editor/frame.rs` reads them each frame). A transform under way (G, R, S)
 //! steers with its own keys (`viewport/modal.rs`) until it ends.
 
-use super::editor::EditorApp;
+use super::actions::Action;
+use super::model::{Command, Selection};
 use super::ui::file_dialog::FileAction;
 use super::viewport::TransformKind;
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 /// What a shortcut does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Action {
+pub enum Shortcut {
     Quit,
     BeginTransform(TransformKind),
     Redo,
@@ -38,7 +40,7 @@ enum Keys {
 
 /// When a shortcut's keys are live.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Scope {
+pub enum Scope {
     /// Always, even over a dialog.
     Always,
     /// Not while a dialog or a text field has the keyboard, nor during a transform
@@ -56,60 +58,64 @@ const COMMAND_SHIFT: Modifiers = Modifiers {
 };
 
 /// Every shortcut, in the order they are checked.
-const SHORTCUTS: &[(Keys, Scope, Action)] = &[
-    (Keys::With(COMMAND, Key::Q), Scope::Always, Action::Quit),
+const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
+    (Keys::With(COMMAND, Key::Q), Scope::Always, Shortcut::Quit),
     (
         Keys::Plain(Key::G),
         Scope::Viewport,
-        Action::BeginTransform(TransformKind::Grab),
+        Shortcut::BeginTransform(TransformKind::Grab),
     ),
     (
         Keys::Plain(Key::R),
         Scope::Viewport,
-        Action::BeginTransform(TransformKind::Rotate),
+        Shortcut::BeginTransform(TransformKind::Rotate),
     ),
     (
         Keys::Plain(Key::S),
         Scope::Viewport,
-        Action::BeginTransform(TransformKind::Scale),
+        Shortcut::BeginTransform(TransformKind::Scale),
     ),
     (
         Keys::With(COMMAND_SHIFT, Key::Z),
         Scope::Viewport,
-        Action::Redo,
+        Shortcut::Redo,
     ),
-    (Keys::With(COMMAND, Key::Y), Scope::Viewport, Action::Redo),
-    (Keys::With(COMMAND, Key::Z), Scope::Viewport, Action::Undo),
-    (Keys::Any(Key::Escape), Scope::Viewport, Action::Deselect),
-    (Keys::Plain(Key::F), Scope::Viewport, Action::FrameSelection),
-    (Keys::Plain(Key::M), Scope::Viewport, Action::NextMethod),
-    (Keys::Any(Key::Home), Scope::Viewport, Action::FrameAll),
-    (Keys::Plain(Key::H), Scope::Viewport, Action::ToggleCage),
+    (Keys::With(COMMAND, Key::Y), Scope::Viewport, Shortcut::Redo),
+    (Keys::With(COMMAND, Key::Z), Scope::Viewport, Shortcut::Undo),
+    (Keys::Any(Key::Escape), Scope::Viewport, Shortcut::Deselect),
+    (
+        Keys::Plain(Key::F),
+        Scope::Viewport,
+        Shortcut::FrameSelection,
+    ),
+    (Keys::Plain(Key::M), Scope::Viewport, Shortcut::NextMethod),
+    (Keys::Any(Key::Home), Scope::Viewport, Shortcut::FrameAll),
+    (Keys::Plain(Key::H), Scope::Viewport, Shortcut::ToggleCage),
     (
         Keys::Plain(Key::O),
         Scope::Viewport,
-        Action::ToggleSoftSelection,
+        Shortcut::ToggleSoftSelection,
     ),
     (
         Keys::With(COMMAND_SHIFT, Key::S),
         Scope::Files,
-        Action::SaveSessionAs,
+        Shortcut::SaveSessionAs,
     ),
     (
         Keys::With(COMMAND, Key::S),
         Scope::Files,
-        Action::SaveSession,
+        Shortcut::SaveSession,
     ),
     (
         Keys::With(COMMAND, Key::O),
         Scope::Files,
-        Action::OpenSession,
+        Shortcut::OpenSession,
     ),
 ];
 
 /// The actions of `scope` whose keys were pressed this frame, in table order.
-fn pressed(ctx: &egui::Context, scope: Scope) -> Vec<Action> {
-    let mut actions: Vec<Action> = Vec::new();
+pub fn pressed(ctx: &egui::Context, scope: Scope) -> Vec<Shortcut> {
+    let mut actions: Vec<Shortcut> = Vec::new();
     for &(keys, _, action) in SHORTCUTS.iter().filter(|(_, s, _)| *s == scope) {
         let hit = ctx.input_mut(|i| match keys {
             Keys::With(modifiers, key) => {
@@ -125,57 +131,24 @@ fn pressed(ctx: &egui::Context, scope: Scope) -> Vec<Action> {
     actions
 }
 
-impl EditorApp {
-    /// Run this frame's shortcuts.
-    pub(super) fn run_shortcuts(&mut self, ctx: &egui::Context) {
-        for action in pressed(ctx, Scope::Always) {
-            self.run_action(ctx, action);
-        }
-        // A dialog's fields and keys are its own; M or F typed into a path must
-        // not switch the method or move the camera.
-        let keyboard_taken =
-            |app: &Self| ctx.egui_wants_keyboard_input() || app.modal_dialog_open();
-        if keyboard_taken(self) {
-            return;
-        }
-        if !self.steer_transform(ctx) {
-            for action in pressed(ctx, Scope::Viewport) {
-                if let Action::BeginTransform(kind) = action {
-                    if self.begin_transform_at_pointer(ctx, kind) {
-                        break;
-                    }
-                    continue;
-                }
-                self.run_action(ctx, action);
-            }
-        }
-        if keyboard_taken(self) {
-            return;
-        }
-        if let Some(&action) = pressed(ctx, Scope::Files).first() {
-            self.run_action(ctx, action);
-        }
-    }
-
-    fn run_action(&mut self, ctx: &egui::Context, action: Action) {
-        match action {
-            Action::Quit => self.actions.push(super::actions::Action::Quit),
-            Action::BeginTransform(kind) => {
-                self.begin_transform_at_pointer(ctx, kind);
-            }
-            Action::Redo => self.redo(),
-            Action::Undo => self.undo(),
-            Action::Deselect => self.select_only([]),
-            Action::FrameSelection => self.frame_selection(),
-            Action::FrameAll => self.frame_scene(),
-            Action::NextMethod => self.toggle_method(),
-            Action::ToggleCage => self.view.show_cage = !self.view.show_cage,
-            Action::ToggleSoftSelection => {
-                self.pose_tools.soft_selection = !self.pose_tools.soft_selection;
-            }
-            Action::SaveSessionAs => self.ask_for_file(FileAction::SaveSession),
-            Action::SaveSession => self.save_session_again(),
-            Action::OpenSession => self.ask_for_file(FileAction::OpenSession),
-        }
+impl Shortcut {
+    /// The action the runner carries out; a transform begins in the viewport
+    /// instead (it needs the pointer's view).
+    pub fn action(self) -> Option<Action> {
+        Some(match self {
+            Shortcut::Quit => Action::Quit,
+            Shortcut::BeginTransform(_) => return None,
+            Shortcut::Redo => Action::Redo,
+            Shortcut::Undo => Action::Undo,
+            Shortcut::Deselect => Action::Apply(Command::Select(Selection::only([]))),
+            Shortcut::FrameSelection => Action::FrameSelection,
+            Shortcut::FrameAll => Action::FrameAll,
+            Shortcut::NextMethod => Action::NextMethod,
+            Shortcut::ToggleCage => Action::ToggleCage,
+            Shortcut::ToggleSoftSelection => Action::ToggleSoftSelection,
+            Shortcut::SaveSessionAs => Action::AskForFile(FileAction::SaveSession),
+            Shortcut::SaveSession => Action::SaveSessionAgain,
+            Shortcut::OpenSession => Action::AskForFile(FileAction::OpenSession),
+        })
     }
 }

@@ -4,7 +4,8 @@
 //! it in the File menu, a dialog inside the window takes its place: it browses
 //! folders, lists meshes, and takes a typed path for every file action.
 
-use crate::app::editor::{EditorApp, FileRole};
+use crate::app::actions::Action;
+use crate::app::ctx::PanelContext;
 use crate::geometry::shown_path;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -237,70 +238,70 @@ impl FileDialogs {
     }
 }
 
-impl EditorApp {
-    /// Ask for a file for `action` and carry it out: the system's dialog when it
-    /// works, else the in-window one (which finishes in a later frame).
-    pub fn ask_for_file(&mut self, action: FileAction) {
-        if !self.file_dialogs.in_window {
+/// What asking for a file gave at once.
+pub enum DialogAnswer {
+    /// The system's dialog gave this file.
+    Chosen(PathBuf),
+    /// The system's dialog was cancelled.
+    Cancelled,
+    /// The in-window dialog opened, and answers in a later frame; `fell_back`
+    /// when the system's dialog did not appear.
+    InWindow { fell_back: bool },
+}
+
+impl FileDialogs {
+    /// Ask for a file for `action`: the system's dialog when it works, else the
+    /// in-window one.
+    pub fn ask(&mut self, action: FileAction) -> DialogAnswer {
+        let mut fell_back = false;
+        if !self.in_window {
             let asked = Instant::now();
-            match system_dialog(action, &self.file_dialogs.start_folder()) {
-                Some(path) => {
-                    self.finish_file_action(action, &path);
-                    return;
-                }
+            match system_dialog(action, &self.start_folder()) {
+                Some(path) => return DialogAnswer::Chosen(path),
                 None if asked.elapsed() >= SYSTEM_DIALOG_MIN_TIME => {
-                    self.file_action_cancelled(action);
-                    return;
+                    return DialogAnswer::Cancelled;
                 }
                 None => {
-                    self.file_dialogs.in_window = true;
-                    self.info(
-                        "the system's file dialog did not open (no desktop portal?): using the \
-                         in-window dialog (File > In-window file dialog)",
-                    );
+                    self.in_window = true;
+                    fell_back = true;
                 }
             }
         }
-        let folder = self.file_dialogs.start_folder();
-        self.file_dialogs.browser = Some(FileBrowser::new(action, folder));
+        let folder = self.start_folder();
+        self.browser = Some(FileBrowser::new(action, folder));
+        DialogAnswer::InWindow { fell_back }
     }
 
     /// The action the in-window dialog is open for, if it is.
-    pub fn open_file_dialog(&self) -> Option<FileAction> {
-        self.file_dialogs.browser.as_ref().map(|b| b.action)
+    pub fn open_for(&self) -> Option<FileAction> {
+        self.browser.as_ref().map(|b| b.action)
     }
 
-    /// Carry out `action` on `path`; true when it succeeded.
-    fn finish_file_action(&mut self, action: FileAction, path: &Path) -> bool {
+    /// The next in-window dialog starts in the folder of `path`.
+    pub fn remember_folder(&mut self, path: &Path) {
         if let Some(folder) = path.parent().filter(|f| f.is_dir()) {
-            self.file_dialogs.folder = Some(folder.to_owned());
-        }
-        let done = match action {
-            FileAction::OpenMesh => self.open_file(FileRole::Mesh, path),
-            FileAction::OpenCage => self.open_file(FileRole::Cage, path),
-            FileAction::LoadPose => self.load_pose(path),
-            FileAction::SavePose => self.save_pose(path),
-            FileAction::ExportMesh => self.export_deformed(path),
-            FileAction::OpenSession => self.open_session(path),
-            FileAction::SaveSession => self.save_session(path),
-            FileAction::SaveImage => self.save_image(path),
-            FileAction::ExportColouredMesh => self.export_coloured_mesh(path),
-        };
-        if action == FileAction::SavePose {
-            self.quit.pose_save_finished(done);
-        }
-        done
-    }
-
-    fn file_action_cancelled(&mut self, action: FileAction) {
-        if action == FileAction::SavePose {
-            self.quit.pose_save_finished(false);
+            self.folder = Some(folder.to_owned());
         }
     }
 
-    /// The in-window dialog, while it is open.
-    pub(in crate::app) fn file_dialog_window(&mut self, ctx: &egui::Context) {
-        let Some(browser) = self.file_dialogs.browser.as_mut() else {
+    /// The in-window dialog's file was carried out (`failed` is `None`) and the
+    /// dialog closes, or it failed and the dialog stays, saying why, so that
+    /// another file can be chosen.
+    pub fn answered(&mut self, failed: Option<String>) {
+        match (failed, self.browser.as_mut()) {
+            (None, _) => self.browser = None,
+            (Some(problem), Some(browser)) => {
+                browser.problem = Some(problem);
+                browser.confirm_replace = None;
+            }
+            (Some(_), None) => {}
+        }
+    }
+
+    /// The in-window dialog, while it is open: it sends the chosen file, or the
+    /// cancel.
+    pub fn window(&mut self, ctx: &egui::Context, cx: &mut PanelContext) {
+        let Some(browser) = self.browser.as_mut() else {
             return;
         };
         let action = browser.action;
@@ -389,17 +390,17 @@ impl EditorApp {
                 });
             });
         if cancel {
-            self.file_dialogs.browser = None;
-            self.file_action_cancelled(action);
+            self.browser = None;
+            cx.send(Action::FileCancelled(action));
         } else if confirm {
-            self.confirm_in_window_dialog();
+            self.confirm_in_window_dialog(cx);
         }
     }
 
     /// The in-window dialog's confirm: a folder opens, a missing file or an
     /// unconfirmed replacement is said in the dialog, anything else is carried out.
-    fn confirm_in_window_dialog(&mut self) {
-        let Some(browser) = self.file_dialogs.browser.as_mut() else {
+    fn confirm_in_window_dialog(&mut self, cx: &mut PanelContext) {
+        let Some(browser) = self.browser.as_mut() else {
             return;
         };
         let action = browser.action;
@@ -426,20 +427,8 @@ impl EditorApp {
             browser.confirm_replace = Some(path);
             return;
         }
-        let notices_before = self.notices.all().len();
-        if self.finish_file_action(action, &path) {
-            self.file_dialogs.browser = None;
-        } else if let Some(browser) = self.file_dialogs.browser.as_mut() {
-            // The dialog stays, so another file can be chosen; it says what failed.
-            let failed = self.notices.all().get(notices_before..).and_then(|new| {
-                new.iter()
-                    .rev()
-                    .find(|n| n.is_error)
-                    .map(|n| n.text.clone())
-            });
-            browser.problem = Some(failed.unwrap_or_else(|| "failed".into()));
-            browser.confirm_replace = None;
-        }
+        // The dialog stays open until the editor says how the file fared.
+        cx.send(Action::FileChosen(action, path));
     }
 }
 

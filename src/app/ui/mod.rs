@@ -1,7 +1,8 @@
-//! The editor's panels, one file each, as in egui's demo app. The quit dialog,
-//! the drop dialog, notices and statistics are structs that own their state and
-//! draw through a [`crate::app::ctx::PanelContext`], sending actions; the others
-//! still add an `impl EditorApp` method that calls the editor directly.
+//! The editor's panels, one file each, as in egui's demo app. Each owns its
+//! state (a struct, or none for the menu, the toolbar, the side panel's own
+//! sections and the quality table) and draws through a
+//! [`crate::app::ctx::PanelContext`]: read-only views of what it shows, and a
+//! queue of actions. No panel touches the editor itself.
 
 pub mod drop_dialog;
 pub mod file_dialog;

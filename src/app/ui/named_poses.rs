@@ -3,8 +3,10 @@
 //! pose into the current one to preview the motion. Export and Save pose write
 //! what the slider shows.
 
-use crate::app::editor::EditorApp;
-use crate::app::model::{Command, GestureKind, Outcome};
+use crate::app::actions::{Action, BlendStep};
+use crate::app::ctx::PanelContext;
+use crate::app::document::Document;
+use crate::app::model::{Command, GestureKind};
 use glam::DVec3;
 
 /// The rest-to-pose slider. While it is below 100% the document shows a blend of
@@ -33,68 +35,46 @@ pub fn blend_poses(rest: &[DVec3], target: &[DVec3], amount: f64) -> Vec<DVec3> 
         .collect()
 }
 
-impl EditorApp {
+impl PoseBlend {
     /// The blend shown, 0 to 1 (1 when no blend is under way).
-    pub fn pose_blend_amount(&self) -> f64 {
-        match &self.pose_blend.target {
-            Some((_, revision)) if *revision == self.model.document().pose_revision() => {
-                self.pose_blend.amount
-            }
+    pub fn shown_amount(&self, document: &Document) -> f64 {
+        match &self.target {
+            Some((_, revision)) if *revision == document.pose_revision() => self.amount,
             _ => 1.0,
         }
     }
 
-    /// Show the rest pose blended `amount` (0 to 1) of the way to the current
-    /// pose (or to the pose a blend under way is heading for), as one undo step.
-    pub fn set_pose_blend(&mut self, amount: f64) {
-        self.apply(Command::BeginGesture(GestureKind::Blend));
-        self.preview_pose_blend(amount);
-        self.end_pose_blend();
-    }
-
-    /// The blend gesture ends as one undo step named by the blend reached.
-    fn end_pose_blend(&mut self) {
-        let percent = (self.pose_blend.amount * 100.0).round();
-        self.apply(Command::EndGesture {
-            action: format!("blend the pose to {percent}%"),
-        });
-    }
-
-    fn preview_pose_blend(&mut self, amount: f64) {
-        let amount = amount.clamp(0.0, 1.0);
-        let target = match self.pose_blend.target.take() {
-            Some((target, revision)) if revision == self.model.document().pose_revision() => target,
-            _ => self.model.document().pose().to_vec(),
+    /// The amount asked for, clamped, and the pose a blend heads for: the one
+    /// a blend under way heads for, else the current pose.
+    pub fn blend_target(&mut self, document: &Document, amount: f64) -> (f64, Vec<DVec3>) {
+        let target = match self.target.take() {
+            Some((target, revision)) if revision == document.pose_revision() => target,
+            _ => document.pose().to_vec(),
         };
-        let pose = blend_poses(self.model.document().cage().positions(), &target, amount);
-        self.apply(Command::PreviewGesture(pose));
-        self.pose_blend.amount = amount;
-        self.pose_blend.target = Some((target, self.model.document().pose_revision()));
+        (amount.clamp(0.0, 1.0), target)
     }
 
-    /// Keep the current pose under `name`.
-    pub fn store_named_pose(&mut self, name: &str) {
-        let name = name.trim();
-        if name.is_empty() {
-            self.error("a stored pose needs a name");
-            return;
-        }
-        self.apply(Command::StoreNamedPose(name.to_owned()));
-        self.info(format!("stored the pose as \"{name}\""));
+    /// The blend now shown: `amount` of the way to `target`, at pose `revision`.
+    pub fn blended(&mut self, amount: f64, target: Vec<DVec3>, revision: u64) {
+        self.amount = amount;
+        self.target = Some((target, revision));
     }
 
-    /// Pose the cage as the named pose at `index`, as one undo step.
-    pub fn apply_named_pose(&mut self, index: usize) {
-        if let Some(named) = self.model.document().named_poses().get(index) {
-            let pose = named.positions.clone();
-            self.apply(Command::edit_pose(pose));
-        }
+    /// The blend reached, 0 to 1.
+    pub fn amount(&self) -> f64 {
+        self.amount
     }
 
-    pub(in crate::app) fn named_poses_section(&mut self, ui: &mut egui::Ui) {
+    /// A rename went through: the field closes.
+    pub fn renamed(&mut self) {
+        self.renaming = None;
+    }
+
+    pub fn ui(&mut self, ui: &mut egui::Ui, cx: &mut PanelContext) {
         ui.label("Poses");
-        let amount_now = self.pose_blend_amount();
-        let at_rest = self.model.document().pose() == self.model.document().cage().positions();
+        let document = cx.document();
+        let amount_now = self.shown_amount(document);
+        let at_rest = document.pose() == document.cage().positions();
         let mut percent = amount_now * 100.0;
         ui.horizontal(|ui| {
             ui.label("Rest");
@@ -112,28 +92,30 @@ impl EditorApp {
                 )
                 .on_disabled_hover_text("The cage is at rest: there is no motion to blend.");
             if slider.drag_started() {
-                self.apply(Command::BeginGesture(GestureKind::Blend));
+                cx.send(Action::Blend(BlendStep::Begin));
             }
             if slider.changed() {
-                if self.model.gesture_under_way() == Some(GestureKind::Blend) {
-                    self.preview_pose_blend(percent / 100.0);
+                // A step of a drag under way (or begun now), else one step at once.
+                let dragging = slider.drag_started()
+                    || cx.model().gesture_under_way() == Some(GestureKind::Blend);
+                cx.send(Action::Blend(if dragging {
+                    BlendStep::Preview(percent / 100.0)
                 } else {
-                    self.set_pose_blend(percent / 100.0);
-                }
+                    BlendStep::Set(percent / 100.0)
+                }));
             }
-            if slider.drag_stopped() && self.model.gesture_under_way() == Some(GestureKind::Blend) {
-                self.end_pose_blend();
+            if slider.drag_stopped() {
+                cx.send(Action::Blend(BlendStep::End));
             }
         });
 
         ui.horizontal(|ui| {
-            if self.pose_blend.new_name.is_empty() {
-                self.pose_blend.new_name =
-                    format!("pose {}", self.model.document().named_poses().len() + 1);
+            if self.new_name.is_empty() {
+                self.new_name = format!("pose {}", cx.document().named_poses().len() + 1);
             }
             let label = ui.label("Name:");
             let field = ui
-                .add(egui::TextEdit::singleline(&mut self.pose_blend.new_name).desired_width(110.0))
+                .add(egui::TextEdit::singleline(&mut self.new_name).desired_width(110.0))
                 .labelled_by(label.id);
             let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             if ui
@@ -142,16 +124,13 @@ impl EditorApp {
                 .clicked()
                 || entered
             {
-                let name = std::mem::take(&mut self.pose_blend.new_name);
-                self.store_named_pose(&name);
+                cx.send(Action::StoreNamedPose(std::mem::take(&mut self.new_name)));
             }
         });
 
-        let mut apply = None;
-        let mut delete = None;
-        let mut rename = None;
-        for (index, named) in self.model.document().named_poses().iter().enumerate() {
-            ui.horizontal(|ui| match &mut self.pose_blend.renaming {
+        let mut sent = Vec::new();
+        for (index, named) in cx.document().named_poses().iter().enumerate() {
+            ui.horizontal(|ui| match &mut self.renaming {
                 Some((renaming, text)) if *renaming == index => {
                     let label = ui.label("New name:");
                     let field = ui
@@ -160,48 +139,32 @@ impl EditorApp {
                     if ui.button("OK").clicked()
                         || (field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)))
                     {
-                        rename = Some((index, text.clone()));
+                        sent.push(Action::RenameNamedPose {
+                            index,
+                            name: text.clone(),
+                        });
                     }
                 }
                 _ => {
                     ui.label(&named.name);
                     if ui.small_button("Apply").clicked() {
-                        apply = Some(index);
+                        sent.push(Action::ApplyNamedPose(index));
                     }
                     if ui.small_button("Rename").clicked() {
-                        self.pose_blend.renaming = Some((index, named.name.clone()));
+                        self.renaming = Some((index, named.name.clone()));
                     }
                     if ui
                         .small_button("Delete")
                         .on_hover_text("Forget this pose (Ctrl+Z brings it back)")
                         .clicked()
                     {
-                        delete = Some(index);
+                        sent.push(Action::Apply(Command::DeleteNamedPose(index)));
                     }
                 }
             });
         }
-        if let Some(index) = apply {
-            self.apply_named_pose(index);
-        }
-        if let Some(index) = delete {
-            self.apply(Command::DeleteNamedPose(index));
-        }
-        if let Some((index, name)) = rename {
-            let name = name.trim().to_owned();
-            if name.is_empty() {
-                self.error("a stored pose needs a name");
-            } else if let Outcome::Refused(_) = self
-                .apply(Command::RenameNamedPose {
-                    index,
-                    name: name.clone(),
-                })
-                .outcome
-            {
-                self.error(format!("there is already a pose called \"{name}\""));
-            } else {
-                self.pose_blend.renaming = None;
-            }
+        for action in sent {
+            cx.send(action);
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The quality table: one column per bound method, one row per measure.
 
+use crate::app::ctx::PanelContext;
 use crate::app::document::WeightSet;
-use crate::app::editor::EditorApp;
 use crate::coords::quality::NEGATIVE_TOLERANCE;
 
 /// A row of the table: its name and how a method's weights show in it.
@@ -33,64 +33,53 @@ const ROWS: [QualityRow; 5] = [
     }),
 ];
 
-impl EditorApp {
-    /// Per bound method: negativity, partition of unity, linear precision.
-    pub(in crate::app) fn quality_table(&self, ui: &mut egui::Ui) {
-        ui.label("Quality");
-        let methods: Vec<_> = self.model.document().bound_methods().collect();
-        if methods.is_empty() {
-            ui.label("(nothing bound yet)");
-            return;
-        }
-        let outside = self.model.document().outside().len();
-        egui::Grid::new("quality")
-            .num_columns(methods.len() + 1)
-            .striped(true)
-            .show(ui, |ui| {
-                ui.label("");
-                for method in &methods {
-                    ui.strong(method.name());
+/// Per bound method: negativity, partition of unity, linear precision.
+pub fn quality_table(ui: &mut egui::Ui, cx: &PanelContext) {
+    ui.label("Quality");
+    let document = cx.document();
+    let methods: Vec<_> = document.bound_methods().collect();
+    if methods.is_empty() {
+        ui.label("(nothing bound yet)");
+        return;
+    }
+    let outside = document.outside().len();
+    egui::Grid::new("quality")
+        .num_columns(methods.len() + 1)
+        .striped(true)
+        .show(ui, |ui| {
+            ui.label("");
+            for method in &methods {
+                ui.strong(method.name());
+            }
+            ui.end_row();
+            for (name, value) in ROWS {
+                if cx.shown().hide_timings && name == "bind time" {
+                    continue;
+                }
+                ui.label(name);
+                for &method in &methods {
+                    ui.label(document.bound(method).map_or("—".into(), value));
                 }
                 ui.end_row();
-                for (name, value) in ROWS {
-                    if self.hide_timings && name == "bind time" {
-                        continue;
-                    }
-                    ui.label(name);
-                    for &method in &methods {
-                        ui.label(
-                            self.model
-                                .document()
-                                .bound(method)
-                                .map_or("—".into(), value),
-                        );
-                    }
-                    ui.end_row();
-                }
-                ui.label("outside vertices").on_hover_text(
-                    "Vertices outside the cage follow each family's outside policy \
+            }
+            ui.label("outside vertices").on_hover_text(
+                "Vertices outside the cage follow each family's outside policy \
                      (MVC weights under MVC, PMVC and HC; Green coordinates' own \
                      exterior extension under Green), so their negative weights are \
                      counted here, not above.",
-                );
-                for _ in &methods {
-                    ui.label(outside.to_string());
+            );
+            for _ in &methods {
+                ui.label(outside.to_string());
+            }
+            ui.end_row();
+            if outside > 0 {
+                ui.label("outside: with λ < 0");
+                for &method in &methods {
+                    ui.label(document.bound(method).map_or("—".into(), |set| {
+                        set.quality.outside_negative_vertices.to_string()
+                    }));
                 }
                 ui.end_row();
-                if outside > 0 {
-                    ui.label("outside: with λ < 0");
-                    for &method in &methods {
-                        ui.label(
-                            self.model
-                                .document()
-                                .bound(method)
-                                .map_or("—".into(), |set| {
-                                    set.quality.outside_negative_vertices.to_string()
-                                }),
-                        );
-                    }
-                    ui.end_row();
-                }
-            });
-    }
+            }
+        });
 }

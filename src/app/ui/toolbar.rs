@@ -1,168 +1,174 @@
 //! The comparison controls above the viewport: the method shown, the layout,
-//! which methods are compared, and the colouring.
+//! which methods are compared, and the colouring. They edit a copy of the view
+//! settings and send it back when it changed.
 
-use crate::app::compare::{Layout, Overlay, Pane, DIFFERENCE_LIMITS};
-use crate::app::editor::EditorApp;
+use crate::app::actions::Action;
+use crate::app::compare::{Layout, Overlay, ViewSettings, DIFFERENCE_LIMITS};
+use crate::app::ctx::PanelContext;
 use crate::coords::Method;
 use crate::render::colormap::Scale;
-use crate::render::Colouring;
 
 /// What the first run shows, in one line.
 pub const FIRST_RUN_LINE: &str = "The middle finger's handles are pulled up. \
     Left, MVC: negative weights make the fingers beside it sink. Middle, PMVC: they stay. \
     Right: the distance between the two. Drag any handle to try.";
 
-impl EditorApp {
-    /// The first run's line, with a button that dismisses it.
-    pub(in crate::app) fn first_run_line(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            if ui.small_button("Hide").clicked() {
-                self.first_run_hint = false;
-            }
-            ui.label(egui::RichText::new(FIRST_RUN_LINE).strong());
-        });
-    }
-
-    pub(in crate::app) fn toolbar(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal_wrapped(|ui| {
-            ui.label("Method (M):");
-            let mut method = self.active_method();
-            for family in Method::ALL {
-                ui.selectable_value(&mut method, family, family.name())
-                    .on_hover_text(family.spec().summary);
-            }
-            self.set_active_method(method);
-            ui.separator();
-            ui.label("View:");
-            let layout = &mut self.view.layout;
-            ui.selectable_value(layout, Layout::Single, "Single");
-            ui.selectable_value(layout, Layout::SideBySide, "Side by side");
-            ui.selectable_value(layout, Layout::Difference, "Difference");
-            match self.view.layout {
-                Layout::SideBySide => self.comparison_controls(ui),
-                Layout::Difference => self.difference_controls(ui),
-                Layout::Single => {}
-            }
-            ui.separator();
-            ui.label("Colour:");
-            let overlay = &mut self.view.overlay;
-            ui.selectable_value(overlay, Overlay::Shaded, "Shaded");
-            ui.selectable_value(overlay, Overlay::Heatmap, "Heatmap λi");
-            ui.selectable_value(overlay, Overlay::Negativity, "Negativity");
-            if self.view.overlay == Overlay::Heatmap {
-                self.heatmap_controls(ui);
-            }
-            if self.view.overlay != Overlay::Shaded || self.view.layout != Layout::Single {
-                let scale = self.view.overlay_scale_mut();
-                ui.selectable_value(scale, Scale::Linear, "Linear");
-                ui.selectable_value(scale, Scale::LogMagnitude, "Log");
-            }
-        });
-    }
-
-    /// Which coordinate function the heatmap shows: a cage vertex's, or (Green
-    /// coordinates) a cage triangle's ψ.
-    fn heatmap_controls(&mut self, ui: &mut egui::Ui) {
-        let triangles = self.model.document().cage().triangle_count();
-        let mut of_triangle = self.view.heat_triangle.is_some();
-        let label = ui.label("of");
-        egui::ComboBox::from_id_salt("heatmap of")
-            .selected_text(if of_triangle {
-                "ψj of triangle"
-            } else {
-                "λi of vertex"
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut of_triangle, false, "λi of vertex")
-                    .on_hover_text("Every family: the coordinate of cage vertex i (φi for Green)");
-                ui.selectable_value(&mut of_triangle, true, "ψj of triangle")
-                    .on_hover_text("Green coordinates only: the function of cage triangle j");
-            })
-            .response
-            .labelled_by(label.id);
-        if of_triangle {
-            let mut triangle = self.view.heat_triangle.unwrap_or(0);
-            let label = ui.label("j =");
-            ui.add(egui::DragValue::new(&mut triangle).range(0..=triangles.saturating_sub(1)))
-                .labelled_by(label.id)
-                .on_hover_text("Cage triangle, in the order the cage's faces are triangulated");
-            self.view.heat_triangle = Some(triangle);
-        } else {
-            self.view.heat_triangle = None;
-            let last = self.model.document().pose().len().saturating_sub(1);
-            let label = ui.label("i =");
-            ui.add(egui::DragValue::new(&mut self.view.heat_vertex).range(0..=last))
-                .labelled_by(label.id)
-                .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+/// The first run's line, with a button that dismisses it.
+pub fn first_run_line(ui: &mut egui::Ui, cx: &mut PanelContext) {
+    ui.horizontal(|ui| {
+        if ui.small_button("Hide").clicked() {
+            cx.send(Action::HideFirstRunLine);
         }
-    }
+        ui.label(egui::RichText::new(FIRST_RUN_LINE).strong());
+    });
+}
 
-    /// Which methods the side-by-side layout shows.
-    fn comparison_controls(&mut self, ui: &mut egui::Ui) {
-        if Method::ALL.len() > 2 {
-            ui.menu_button("Compare…", |ui| {
+pub fn toolbar(ui: &mut egui::Ui, cx: &mut PanelContext) {
+    let mut view = cx.shown().view;
+    // Sent after the view settings, which they change further.
+    let mut later = Vec::new();
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Method (M):");
+        let active = cx.shown().bind_options.method;
+        let mut method = active;
+        for family in Method::ALL {
+            ui.selectable_value(&mut method, family, family.name())
+                .on_hover_text(family.spec().summary);
+        }
+        if method != active {
+            cx.send(Action::SetMethod(method));
+        }
+        ui.separator();
+        ui.label("View:");
+        let layout = &mut view.layout;
+        ui.selectable_value(layout, Layout::Single, "Single");
+        ui.selectable_value(layout, Layout::SideBySide, "Side by side");
+        ui.selectable_value(layout, Layout::Difference, "Difference");
+        match view.layout {
+            Layout::SideBySide => comparison_controls(ui, &mut view, &mut later),
+            Layout::Difference => difference_controls(ui, &mut view, &mut later),
+            Layout::Single => {}
+        }
+        ui.separator();
+        ui.label("Colour:");
+        let overlay = &mut view.overlay;
+        ui.selectable_value(overlay, Overlay::Shaded, "Shaded");
+        ui.selectable_value(overlay, Overlay::Heatmap, "Heatmap λi");
+        ui.selectable_value(overlay, Overlay::Negativity, "Negativity");
+        if view.overlay == Overlay::Heatmap {
+            heatmap_controls(ui, cx, &mut view);
+        }
+        if view.overlay != Overlay::Shaded || view.layout != Layout::Single {
+            let scale = view.overlay_scale_mut();
+            ui.selectable_value(scale, Scale::Linear, "Linear");
+            ui.selectable_value(scale, Scale::LogMagnitude, "Log");
+        }
+    });
+    if view != cx.shown().view {
+        cx.send(Action::SetView(view));
+    }
+    for action in later {
+        cx.send(action);
+    }
+}
+
+/// Which coordinate function the heatmap shows: a cage vertex's, or (Green
+/// coordinates) a cage triangle's ψ.
+fn heatmap_controls(ui: &mut egui::Ui, cx: &PanelContext, view: &mut ViewSettings) {
+    let triangles = cx.document().cage().triangle_count();
+    let mut of_triangle = view.heat_triangle.is_some();
+    let label = ui.label("of");
+    egui::ComboBox::from_id_salt("heatmap of")
+        .selected_text(if of_triangle {
+            "ψj of triangle"
+        } else {
+            "λi of vertex"
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut of_triangle, false, "λi of vertex")
+                .on_hover_text("Every family: the coordinate of cage vertex i (φi for Green)");
+            ui.selectable_value(&mut of_triangle, true, "ψj of triangle")
+                .on_hover_text("Green coordinates only: the function of cage triangle j");
+        })
+        .response
+        .labelled_by(label.id);
+    if of_triangle {
+        let mut triangle = view.heat_triangle.unwrap_or(0);
+        let label = ui.label("j =");
+        ui.add(egui::DragValue::new(&mut triangle).range(0..=triangles.saturating_sub(1)))
+            .labelled_by(label.id)
+            .on_hover_text("Cage triangle, in the order the cage's faces are triangulated");
+        view.heat_triangle = Some(triangle);
+    } else {
+        view.heat_triangle = None;
+        let last = cx.document().pose().len().saturating_sub(1);
+        let label = ui.label("i =");
+        ui.add(egui::DragValue::new(&mut view.heat_vertex).range(0..=last))
+            .labelled_by(label.id)
+            .on_hover_text("Cage vertex whose coordinate is shown (or click its handle)");
+    }
+}
+
+/// Which methods the side-by-side layout shows.
+fn comparison_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut Vec<Action>) {
+    if Method::ALL.len() > 2 {
+        ui.menu_button("Compare…", |ui| {
+            for family in Method::ALL {
+                let mut shown = view.compared.contains(family);
+                if ui.checkbox(&mut shown, family.name()).changed() {
+                    view.compared.set(family, shown);
+                }
+            }
+        });
+    }
+    ui.checkbox(&mut view.difference_pane, "+ difference");
+    if view.difference_pane {
+        difference_scale_controls(ui, view, later);
+    }
+    let mut locked = view.cameras_locked;
+    if ui.checkbox(&mut locked, "Lock cameras").changed() {
+        later.push(Action::SetCamerasLocked(locked));
+    }
+}
+
+/// Which two methods the difference compares: "[MVC] vs [PMVC] shown".
+fn difference_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut Vec<Action>) {
+    for (index, label) in ["vs", "shown"].into_iter().enumerate() {
+        let mut chosen = view.difference[index];
+        egui::ComboBox::from_label(label)
+            .selected_text(chosen.name())
+            .show_ui(ui, |ui| {
                 for family in Method::ALL {
-                    let mut shown = self.view.compared.contains(family);
-                    if ui.checkbox(&mut shown, family.name()).changed() {
-                        self.view.compared.set(family, shown);
-                    }
+                    ui.selectable_value(&mut chosen, family, family.name());
                 }
             });
-        }
-        ui.checkbox(&mut self.view.difference_pane, "+ difference");
-        if self.view.difference_pane {
-            self.difference_scale_controls(ui);
-        }
-        let mut locked = self.view.cameras_locked;
-        if ui.checkbox(&mut locked, "Lock cameras").changed() {
-            self.set_cameras_locked(locked);
-        }
+        view.difference[index] = chosen;
     }
+    difference_scale_controls(ui, view, later);
+}
 
-    /// Which two methods the difference compares: "[MVC] vs [PMVC] shown".
-    fn difference_controls(&mut self, ui: &mut egui::Ui) {
-        for (index, label) in ["vs", "shown"].into_iter().enumerate() {
-            let mut chosen = self.view.difference[index];
-            egui::ComboBox::from_label(label)
-                .selected_text(chosen.name())
-                .show_ui(ui, |ui| {
-                    for family in Method::ALL {
-                        ui.selectable_value(&mut chosen, family, family.name());
-                    }
-                });
-            self.view.difference[index] = chosen;
-        }
-        self.difference_scale_controls(ui);
+/// Auto (the largest distance, at least `compare::DIFFERENCE_FLOOR`) or a fixed end
+/// of the difference's colour scale, shared by every difference view.
+fn difference_scale_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut Vec<Action>) {
+    let mut fixed = view.difference_limit.is_some();
+    let toggle = ui.checkbox(&mut fixed, "fixed scale").on_hover_text(
+        "Keep the difference's colour scale at one distance (in % of the cage diagonal) \
+         across poses and views; pmvc edit --difference-limit sets it for a run",
+    );
+    if toggle.changed() {
+        // The scale shown now, which the editor measures.
+        later.push(Action::FixDifferenceScale(fixed));
     }
-
-    /// Auto (the largest distance, at least `compare::DIFFERENCE_FLOOR`) or a fixed end
-    /// of the difference's colour scale, shared by every difference view.
-    fn difference_scale_controls(&mut self, ui: &mut egui::Ui) {
-        let mut fixed = self.view.difference_limit.is_some();
-        let toggle = ui.checkbox(&mut fixed, "fixed scale").on_hover_text(
-            "Keep the difference's colour scale at one distance (in % of the cage diagonal) \
-             across poses and views; pmvc edit --difference-limit sets it for a run",
+    if let Some(limit) = view.difference_limit {
+        let mut percent = limit * 100.0;
+        let field = ui.add(
+            egui::DragValue::new(&mut percent)
+                .speed(0.01)
+                .range(DIFFERENCE_LIMITS.start() * 100.0..=DIFFERENCE_LIMITS.end() * 100.0)
+                .suffix("%"),
         );
-        if toggle.changed() {
-            self.view.difference_limit = if fixed {
-                let [against, shown] = self.view.difference;
-                Some(self.colour_limit(
-                    Colouring::MethodDistance,
-                    Pane::Difference { against, shown },
-                ))
-            } else {
-                None
-            };
-        }
-        if let Some(limit) = self.view.difference_limit {
-            let mut percent = limit * 100.0;
-            ui.add(
-                egui::DragValue::new(&mut percent)
-                    .speed(0.01)
-                    .range(DIFFERENCE_LIMITS.start() * 100.0..=DIFFERENCE_LIMITS.end() * 100.0)
-                    .suffix("%"),
-            );
-            self.view.difference_limit = Some(percent / 100.0);
+        if field.changed() {
+            view.difference_limit = Some(percent / 100.0);
         }
     }
 }

@@ -2,8 +2,8 @@
 //! box select), the wheel and clicks. Keys are in `shortcuts.rs`.
 
 use crate::app::compare::Overlay;
-use crate::app::editor::EditorApp;
 use crate::app::model::{Command, GestureKind, Selection, POSE_EDIT};
+use crate::app::views::{ViewportContext, Views};
 use egui::{Key, PointerButton, Pos2, Rect};
 use glam::{DVec3, Vec2};
 
@@ -40,15 +40,16 @@ fn held_axis(ui: &egui::Ui) -> Option<DVec3> {
     })
 }
 
-impl EditorApp {
+impl Views {
     pub(super) fn viewport_input(
         &mut self,
         ui: &egui::Ui,
+        cx: &mut ViewportContext,
         pane: usize,
         response: &egui::Response,
         rect: Rect,
     ) {
-        let locked = self.view.cameras_locked;
+        let locked = self.settings.cameras_locked;
         let (modifiers, press_origin, scroll, hover) = ui.input(|i| {
             (
                 i.modifiers,
@@ -61,21 +62,23 @@ impl EditorApp {
         // A G, R or S transform takes the pointer until it is confirmed or cancelled.
         if self.viewport.modal.is_some() {
             if response.hovered() {
-                self.transform_pointer(response);
+                self.transform_pointer(cx, response);
             }
             return;
         }
         if response.clicked_by(PointerButton::Secondary) && modifiers.shift {
             if let Some(pointer) = response.interact_pointer_pos() {
-                self.place_cursor(pane, pointer);
+                self.place_cursor(cx, pane, pointer);
             }
         }
 
         // Hover highlight (not while dragging, so the highlight does not flicker, and
         // not in `--screenshot` runs, where the pointer rests wherever the display
         // server put it).
-        if self.viewport.drag.is_none() && self.screenshot.is_none() && response.hovered() {
-            let hovered = response.hover_pos().and_then(|p| self.pick(p));
+        if self.viewport.drag.is_none() && !cx.facts.scripted && response.hovered() {
+            let hovered = response
+                .hover_pos()
+                .and_then(|p| self.pick(cx.model.document(), p));
             self.viewport.set_hovered(hovered);
         }
 
@@ -92,17 +95,22 @@ impl EditorApp {
         }
 
         if response.clicked_by(PointerButton::Primary) {
-            let picked = response.interact_pointer_pos().and_then(|p| self.pick(p));
+            let picked = response
+                .interact_pointer_pos()
+                .and_then(|p| self.pick(cx.model.document(), p));
             // In heatmap mode a click on a handle shows that vertex's coordinate.
-            if let (Some(handle), Overlay::Heatmap) = (picked, self.view.overlay) {
-                self.view.heat_vertex = handle;
-                self.view.heat_triangle = None;
+            if let (Some(handle), Overlay::Heatmap) = (picked, self.settings.overlay) {
+                self.settings.heat_vertex = handle;
+                self.settings.heat_triangle = None;
             }
-            match (picked, modifiers.shift) {
-                (Some(handle), true) => self.select(Selection::Toggle(handle)),
-                (Some(handle), false) => self.select(Selection::only([handle])),
-                (None, false) => self.select(Selection::only([])),
-                (None, true) => {}
+            let selection = match (picked, modifiers.shift) {
+                (Some(handle), true) => Some(Selection::Toggle(handle)),
+                (Some(handle), false) => Some(Selection::only([handle])),
+                (None, false) => Some(Selection::only([])),
+                (None, true) => None,
+            };
+            if let Some(selection) = selection {
+                cx.apply(Command::Select(selection));
             }
         }
 
@@ -114,15 +122,15 @@ impl EditorApp {
                         origin,
                         additive: modifiers.shift,
                     }
-                } else if let Some(handle) = self.pick(origin) {
-                    if !self.model.document().selection().contains(&handle) {
+                } else if let Some(handle) = self.pick(cx.model.document(), origin) {
+                    if !cx.model.document().selection().contains(&handle) {
                         if modifiers.shift {
-                            self.select(Selection::Toggle(handle));
+                            cx.apply(Command::Select(Selection::Toggle(handle)));
                         } else {
-                            self.select(Selection::only([handle]));
+                            cx.apply(Command::Select(Selection::only([handle])));
                         }
                     }
-                    self.apply(Command::BeginGesture(GestureKind::Drag));
+                    cx.apply(Command::BeginGesture(GestureKind::Drag));
                     Drag::Move {
                         motion: egui::Vec2::ZERO,
                     }
@@ -157,10 +165,10 @@ impl EditorApp {
                 }
                 Some(Drag::Move { motion }) => {
                     // A drag whose document was replaced has ended.
-                    if let Some(start) = self.model.gesture_start(GestureKind::Drag) {
+                    if let Some(start) = cx.model.gesture_start(GestureKind::Drag) {
                         let motion = motion + delta;
-                        let pose = self.moved_pose(pane, start, motion, held_axis(ui), rect);
-                        self.apply(Command::PreviewGesture(pose));
+                        let pose = self.moved_pose(cx, pane, start, motion, held_axis(ui), rect);
+                        cx.apply(Command::PreviewGesture(pose));
                         self.viewport.drag = Some(Drag::Move { motion });
                     }
                 }
@@ -171,13 +179,13 @@ impl EditorApp {
         if response.drag_stopped() {
             match self.viewport.drag.take() {
                 Some(Drag::Move { .. }) => {
-                    self.apply(Command::EndGesture {
+                    cx.apply(Command::EndGesture {
                         action: POSE_EDIT.into(),
                     });
                 }
                 Some(Drag::Box { origin, additive }) => {
                     let end = response.interact_pointer_pos().unwrap_or(origin);
-                    self.box_select(pane, Rect::from_two_pos(origin, end), additive);
+                    self.box_select(cx, pane, Rect::from_two_pos(origin, end), additive);
                 }
                 _ => {}
             }

@@ -6,10 +6,12 @@ mod input;
 mod modal;
 mod picking;
 
-pub use modal::TransformKind;
+pub use modal::{handles_without_partner, pose_transformed, transform_selection, TransformKind};
 
+use super::cage_generation::{Proposal, PROPOSAL_GREEN};
 use super::compare::{HoverReadout, Pane};
-use super::editor::EditorApp;
+use super::document::Document;
+use super::views::{ViewportContext, Views};
 use super::widgets::{draw_colour_bar, BarNote};
 use crate::coords::Method;
 use crate::render::{
@@ -164,18 +166,24 @@ impl ViewportState {
     }
 }
 
-impl EditorApp {
-    /// Screen position (in points) of a cage handle in the first view.
-    pub fn handle_screen_position(&self, handle: usize) -> Option<Pos2> {
-        self.handle_screen_position_in(0, handle)
+/// This frame's panes, laid out by [`Views::input`] for [`Views::draw`].
+pub struct PaneLayout {
+    kinds: Vec<Pane>,
+    rects: Vec<Rect>,
+    full: Rect,
+    /// The pane under the pointer, and where the pointer is.
+    hovered: Option<(usize, Option<Pos2>)>,
+}
+
+impl Views {
+    /// The camera view `pane` is drawn with (in scene coordinates).
+    pub fn camera_of(&self, pane: usize) -> OrbitCamera {
+        self.viewport.camera_of(pane, self.settings.cameras_locked)
     }
 
-    /// Screen position (in points) of a cage handle in view `pane`.
-    pub fn handle_screen_position_in(&self, pane: usize, handle: usize) -> Option<Pos2> {
-        let screen = self
-            .viewport
-            .projection(pane)?
-            .project_world(*self.model.document().pose().get(handle)?)?;
+    /// Screen position (in points) of a cage handle at `at` (world) in view `pane`.
+    pub fn screen_position_in(&self, pane: usize, at: DVec3) -> Option<Pos2> {
+        let screen = self.viewport.projection(pane)?.project_world(at)?;
         Some(Pos2::new(screen.x, screen.y))
     }
 
@@ -189,9 +197,11 @@ impl EditorApp {
         }
     }
 
-    pub(super) fn viewport(&mut self, ui: &mut egui::Ui) {
+    /// Lay the panes out and take their input (which may change the model);
+    /// the GPU copy is brought up to date before [`Self::draw`].
+    pub fn input(&mut self, ui: &mut egui::Ui, cx: &mut ViewportContext) -> PaneLayout {
         let full = ui.available_rect_before_wrap();
-        let kinds = self.view.panes(self.active_method(), MAX_VIEWS);
+        let kinds = self.settings.panes(cx.facts.active_method, MAX_VIEWS);
         let width = (full.width() - PANE_GAP * (kinds.len() as f32 - 1.0)) / kinds.len() as f32;
         let rects: Vec<Rect> = (0..kinds.len())
             .map(|i| {
@@ -209,27 +219,42 @@ impl EditorApp {
             .enumerate()
             .map(|(i, (&kind, &rect))| (kind, rect, self.pane_projection(i, rect)))
             .collect();
-        let mut hovered_pane = None;
-        for (index, (&kind, &rect)) in kinds.iter().zip(&rects).enumerate() {
+        let mut hovered = None;
+        for (index, &rect) in rects.iter().enumerate() {
             let response = ui.interact(
                 rect,
                 ui.scope_id().with(("view", index)),
                 Sense::click_and_drag(),
             );
-            self.viewport_input(ui, index, &response, rect);
-            // The input may have moved the camera; draw with the final one.
-            let projection = self.pane_projection(index, rect);
-            self.viewport.panes[index].2 = projection;
+            self.viewport_input(ui, cx, index, &response, rect);
             if response.hovered() {
-                hovered_pane = Some((index, response.hover_pos()));
+                hovered = Some((index, response.hover_pos()));
             }
-            self.draw_pane(ui, index, kind, rect, projection);
         }
-        ui.advance_cursor_after_rect(full);
-        if hovered_pane.is_none() && self.viewport.drag.is_none() {
+        // The input may have moved the cameras; draw with the final ones.
+        for (index, &rect) in rects.iter().enumerate() {
+            self.viewport.panes[index].2 = self.pane_projection(index, rect);
+        }
+        if hovered.is_none() && self.viewport.drag.is_none() {
             self.viewport.set_hovered(None);
         }
-        self.update_hover(ui, hovered_pane);
+        PaneLayout {
+            kinds,
+            rects,
+            full,
+            hovered,
+        }
+    }
+
+    /// Draw the panes laid out by [`Self::input`], the hover box and the box
+    /// selection's band.
+    pub fn draw(&mut self, ui: &mut egui::Ui, cx: &mut ViewportContext, layout: PaneLayout) {
+        for (index, (&kind, &rect)) in layout.kinds.iter().zip(&layout.rects).enumerate() {
+            let projection = self.viewport.panes[index].2;
+            self.draw_pane(ui, cx, index, kind, rect, projection);
+        }
+        ui.advance_cursor_after_rect(layout.full);
+        self.update_hover(ui, cx, layout.hovered);
         if let Some(Drag::Box { origin, .. }) = &self.viewport.drag {
             if let Some(current) = ui.input(|i| i.pointer.interact_pos()) {
                 let band = Rect::from_two_pos(*origin, current);
@@ -249,16 +274,16 @@ impl EditorApp {
     fn draw_pane(
         &mut self,
         ui: &egui::Ui,
+        cx: &mut ViewportContext,
         index: usize,
         kind: Pane,
         rect: Rect,
         projection: ScreenProjection,
     ) {
-        self.sync_gpu();
-        let shading = self.shading_of(kind);
+        let shading = self.shading_of(cx.model.document(), &cx.facts.wanted, kind);
         let painter = ui.painter_at(rect);
         let pixels_per_point = ui.ctx().pixels_per_point();
-        if self.gpu.is_some() {
+        if cx.facts.has_gpu {
             let params = FrameParams {
                 view: index,
                 shading,
@@ -268,11 +293,11 @@ impl EditorApp {
                     (rect.width() * pixels_per_point).round().max(1.0) as u32,
                     (rect.height() * pixels_per_point).round().max(1.0) as u32,
                 ],
-                handle_radius_px: self.view.handle_size * pixels_per_point,
+                handle_radius_px: self.settings.handle_size * pixels_per_point,
                 highlight_outside: self.highlight_outside,
-                show_cage: self.view.show_cage,
-                wireframe: self.view.wireframe,
-                smooth_shading: self.view.smooth_shading,
+                show_cage: self.settings.show_cage,
+                wireframe: self.settings.wireframe,
+                smooth_shading: self.settings.smooth_shading,
             };
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
@@ -291,16 +316,13 @@ impl EditorApp {
         painter.text(
             rect.left_top() + egui::vec2(10.0, 8.0),
             egui::Align2::LEFT_TOP,
-            self.pane_title(kind),
+            self.pane_title(cx, kind),
             font.clone(),
             Color32::from_gray(230),
         );
-        if kind
-            .methods()
-            .iter()
-            .any(|&m| self.model.document().bound(m).is_none())
-        {
-            let message = if self.is_binding() {
+        let document = cx.model.document();
+        if kind.methods().iter().any(|&m| document.bound(m).is_none()) {
+            let message = if cx.facts.binding {
                 "Binding… the mesh is shown at rest until the weights are ready"
             } else {
                 "Not bound: the mesh is shown at rest (Bind in the side panel)"
@@ -313,28 +335,53 @@ impl EditorApp {
                 Color32::from_gray(200),
             );
         }
-        self.draw_transform(&painter, index, rect);
-        self.draw_proposed_cage(&painter, index);
+        self.draw_transform(cx, &painter, index, rect);
+        if let Some(proposal) = cx.facts.proposal {
+            self.draw_proposed_cage(proposal, &painter, index);
+        }
         if shading.colouring != Colouring::Shaded {
-            if let Some(range) = self.value_range(shading.colouring, kind) {
-                let note = self.colour_bar_note(shading.colouring, kind);
+            let document = cx.model.document();
+            if let Some(range) = self.value_range(document, shading.colouring, kind) {
+                let note = self.colour_bar_note(document, shading.colouring, kind);
                 let title = self.colour_bar_title(kind);
                 draw_colour_bar(&painter, rect, &shading, range, title, note);
             }
         }
     }
 
+    /// The proposed cage's edges over view `pane`, in green.
+    fn draw_proposed_cage(&self, proposal: &Proposal, painter: &egui::Painter, pane: usize) {
+        let Some((_, projection)) = self.viewport.pane(pane) else {
+            return;
+        };
+        let screen: Vec<Option<Pos2>> = proposal
+            .generated
+            .cage
+            .positions()
+            .iter()
+            .map(|p| projection.project_world(*p).map(|at| Pos2::new(at.x, at.y)))
+            .collect();
+        let stroke = Stroke::new(1.5, PROPOSAL_GREEN);
+        for [a, b] in &proposal.edges {
+            if let (Some(Some(from)), Some(Some(to))) =
+                (screen.get(*a as usize), screen.get(*b as usize))
+            {
+                painter.line_segment([*from, *to], stroke);
+            }
+        }
+    }
+
     /// "PMVC · 32² · bound in 0.41 s" and the like.
-    fn pane_title(&self, kind: Pane) -> String {
+    fn pane_title(&self, cx: &ViewportContext, kind: Pane) -> String {
         match kind {
-            Pane::Method(method) => match self.model.document().bound(method) {
+            Pane::Method(method) => match cx.model.document().bound(method) {
                 Some(set) => {
                     let parameter = set
                         .options
                         .parameter()
                         .map(|(spec, value)| format!(" · {}", (spec.format)(value)))
                         .unwrap_or_default();
-                    let seconds = if self.hide_timings {
+                    let seconds = if cx.facts.hide_timings {
                         String::new()
                     } else {
                         format!(" · bound in {:.2} s", set.bind_time.as_secs_f32())
@@ -352,8 +399,13 @@ impl EditorApp {
     /// What the colour bar must also say: in the negativity view, that a family
     /// does not promise positive weights and how many vertices are outside the cage (grey,
     /// and why); for ψ, that it is signed or missing.
-    fn colour_bar_note(&self, colouring: Colouring, kind: Pane) -> Option<BarNote> {
-        let outside = self.model.document().outside().len();
+    fn colour_bar_note(
+        &self,
+        document: &Document,
+        colouring: Colouring,
+        kind: Pane,
+    ) -> Option<BarNote> {
+        let outside = document.outside().len();
         let method = kind.method();
         let mut notes = Vec::new();
         // The grey swatch goes with the first line, so the outside count leads.
@@ -372,8 +424,8 @@ impl EditorApp {
             notes.push(format!("{method} does not promise positive weights"));
         }
         if let Colouring::TriangleWeight(_) = colouring {
-            let has_triangle_columns = method.columns(self.model.document().cage())
-                > method.vertex_columns(self.model.document().cage());
+            let has_triangle_columns =
+                method.columns(document.cage()) > method.vertex_columns(document.cage());
             notes.push(if has_triangle_columns {
                 "ψ is signed: blue below 0, red above".to_owned()
             } else {
@@ -388,13 +440,13 @@ impl EditorApp {
 
     fn colour_bar_title(&self, kind: Pane) -> String {
         let method = kind.method().name();
-        match (self.view.colouring(kind), kind) {
+        match (self.settings.colouring(kind), kind) {
             (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
             (Colouring::TriangleWeight(triangle), _) => format!("ψ{triangle} ({method})"),
             (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
             (Colouring::MethodDistance, Pane::Difference { .. }) => {
                 // The pane's title names the methods; the bar says how it scales.
-                match self.view.difference_limit {
+                match self.settings.difference_limit {
                     Some(_) => "distance / cage diagonal · fixed scale".to_owned(),
                     None => format!(
                         "distance / cage diagonal · auto, ≥ {}",
@@ -448,13 +500,14 @@ impl EditorApp {
     /// symmetry applied.
     fn moved_pose(
         &self,
+        cx: &ViewportContext,
         pane: usize,
         start_pose: &[DVec3],
         motion: egui::Vec2,
         axis: Option<DVec3>,
         rect: Rect,
     ) -> Vec<DVec3> {
-        let selection = self.model.document().selection();
+        let selection = cx.model.document().selection();
         if selection.is_empty() {
             return start_pose.to_vec();
         }
@@ -464,7 +517,9 @@ impl EditorApp {
             .sum::<DVec3>()
             / selection.len() as f64;
         let offset = self.drag_offset(pane, centre, motion, axis, rect);
-        self.pose_transformed(
+        modal::pose_transformed(
+            cx.model.document(),
+            cx.pose_tools,
             start_pose,
             &crate::app::pose_tools::Transform::Translate(offset),
         )

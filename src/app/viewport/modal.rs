@@ -5,11 +5,13 @@
 //! confirms, Esc or a right click restores the pose. Each transform is one undo
 //! step. Soft selection and symmetry apply to every edit (`pose_tools`).
 
-use crate::app::editor::EditorApp;
+use crate::app::document::Document;
 use crate::app::model::{Command, GestureKind};
 use crate::app::pose_tools::{
-    follow_weights, mid_plane, mirror_partners, posed, Pivot, Transform, AXIS_NAMES,
+    follow_weights, mid_plane, mirror_partners, posed, Pivot, PoseToolSettings, Transform,
+    AXIS_NAMES,
 };
+use crate::app::views::{ViewportContext, Views};
 use egui::{Color32, Key, Pos2, Rect, Stroke};
 use glam::{DVec3, Vec2};
 
@@ -45,39 +47,89 @@ pub struct Modal {
     typed: String,
 }
 
-impl EditorApp {
-    /// The pose `transform` gives `start` with the current selection, pivot,
-    /// soft selection and symmetry.
-    pub fn pose_transformed(&self, start: &[DVec3], transform: &Transform) -> Vec<DVec3> {
-        let rest = self.model.document().cage().positions();
-        let diagonal = self.model.document().cage().diagonal();
-        let tools = &self.pose_tools;
-        let soft = tools.soft_selection.then_some(tools.soft_radius * diagonal);
-        let weights = follow_weights(start, self.model.document().selection(), soft);
-        let partners = tools.symmetry.map(|axis| {
-            (
+/// The pose `transform` gives `start` with the document's selection and the
+/// tools' pivot, soft selection and symmetry.
+pub fn pose_transformed(
+    document: &Document,
+    tools: &PoseToolSettings,
+    start: &[DVec3],
+    transform: &Transform,
+) -> Vec<DVec3> {
+    let rest = document.cage().positions();
+    let diagonal = document.cage().diagonal();
+    let soft = tools.soft_selection.then_some(tools.soft_radius * diagonal);
+    let weights = follow_weights(start, document.selection(), soft);
+    let partners = tools.symmetry.map(|axis| {
+        (
+            axis,
+            mirror_partners(
+                rest,
                 axis,
-                mirror_partners(
-                    rest,
-                    axis,
-                    mid_plane(rest, axis),
-                    MIRROR_TOLERANCE * diagonal,
-                ),
-            )
-        });
-        let symmetry = partners.as_ref().map(|(axis, p)| (*axis, p.as_slice()));
-        posed(start, &weights, transform, self.pivot_of(start), symmetry)
-    }
+                mid_plane(rest, axis),
+                MIRROR_TOLERANCE * diagonal,
+            ),
+        )
+    });
+    let symmetry = partners.as_ref().map(|(axis, p)| (*axis, p.as_slice()));
+    posed(
+        start,
+        &weights,
+        transform,
+        pivot_of(document, tools, start),
+        symmetry,
+    )
+}
 
+/// What rotations and scalings turn about: the 3D cursor, or the selection's
+/// centre in `pose` (the scene's centre when nothing is selected).
+fn pivot_of(document: &Document, tools: &PoseToolSettings, pose: &[DVec3]) -> DVec3 {
+    let selection = document.selection();
+    match tools.pivot {
+        Pivot::Cursor => tools.cursor,
+        Pivot::SelectionCentre if !selection.is_empty() => {
+            selection.iter().filter_map(|&i| pose.get(i)).sum::<DVec3>() / selection.len() as f64
+        }
+        Pivot::SelectionCentre => document.bounding_sphere().0,
+    }
+}
+
+/// Handles with no mirror partner under the symmetry in use.
+pub fn handles_without_partner(document: &Document, tools: &PoseToolSettings) -> usize {
+    let Some(axis) = tools.symmetry else {
+        return 0;
+    };
+    let rest = document.cage().positions();
+    let tolerance = MIRROR_TOLERANCE * document.cage().diagonal();
+    mirror_partners(rest, axis, mid_plane(rest, axis), tolerance)
+        .iter()
+        .filter(|p| p.is_none())
+        .count()
+}
+
+/// Apply `transform` to the selection as one undo step.
+pub fn transform_selection(
+    model: &mut crate::app::model::Model,
+    tools: &PoseToolSettings,
+    transform: Transform,
+) {
+    let start = model.document().pose().to_vec();
+    let pose = pose_transformed(model.document(), tools, &start, &transform);
+    model.apply(Command::edit_pose(pose));
+}
+
+impl Views {
     /// Per handle, for the cage shader: 0 idle, 1 selected, 2 hovered, and with
     /// soft selection 3 + 255·w for a handle that follows with weight w.
-    pub(in crate::app) fn handle_states(&self) -> Vec<u32> {
-        let selection = self.model.document().selection();
-        let pose = self.model.document().pose();
-        let soft = self
-            .pose_tools
+    pub(in crate::app) fn handle_states(
+        &self,
+        document: &Document,
+        tools: &PoseToolSettings,
+    ) -> Vec<u32> {
+        let selection = document.selection();
+        let pose = document.pose();
+        let soft = tools
             .soft_selection
-            .then(|| self.pose_tools.soft_radius * self.model.document().cage().diagonal());
+            .then(|| tools.soft_radius * document.cage().diagonal());
         let weights = follow_weights(pose, selection, soft);
         (0..pose.len())
             .map(|i| {
@@ -94,60 +146,29 @@ impl EditorApp {
             .collect()
     }
 
-    /// Apply `transform` to the selection as one undo step.
-    pub fn transform_selection(&mut self, transform: Transform) {
-        let start = self.model.document().pose().to_vec();
-        let pose = self.pose_transformed(&start, &transform);
-        self.apply(Command::edit_pose(pose));
-    }
-
-    fn pivot_of(&self, pose: &[DVec3]) -> DVec3 {
-        let selection = self.model.document().selection();
-        match self.pose_tools.pivot {
-            Pivot::Cursor => self.pose_tools.cursor,
-            Pivot::SelectionCentre if !selection.is_empty() => {
-                selection.iter().filter_map(|&i| pose.get(i)).sum::<DVec3>()
-                    / selection.len() as f64
-            }
-            Pivot::SelectionCentre => self.model.document().bounding_sphere().0,
-        }
-    }
-
-    /// The 3D cursor, in world coordinates.
-    pub fn cursor(&self) -> DVec3 {
-        self.pose_tools.cursor
-    }
-
-    /// Handles with no mirror partner under the symmetry in use.
-    pub fn handles_without_partner(&self) -> usize {
-        let Some(axis) = self.pose_tools.symmetry else {
-            return 0;
-        };
-        let rest = self.model.document().cage().positions();
-        let tolerance = MIRROR_TOLERANCE * self.model.document().cage().diagonal();
-        mirror_partners(rest, axis, mid_plane(rest, axis), tolerance)
-            .iter()
-            .filter(|p| p.is_none())
-            .count()
-    }
-
     pub fn transform_under_way(&self) -> Option<TransformKind> {
         self.viewport.modal.as_ref().map(|m| m.kind)
     }
 
     /// G, R or S in view `pane` with the pointer at `pointer`.
-    fn begin_transform(&mut self, kind: TransformKind, pane: usize, pointer: Pos2) {
-        if self.model.document().selection().is_empty() {
-            self.info("select handles first: G moves, R rotates and S scales the selection");
+    fn begin_transform(
+        &mut self,
+        cx: &mut ViewportContext,
+        kind: TransformKind,
+        pane: usize,
+        pointer: Pos2,
+    ) {
+        if cx.model.document().selection().is_empty() {
+            cx.info("select handles first: G moves, R rotates and S scales the selection");
             return;
         }
         // The model keeps the pose the transform starts from.
-        self.apply(Command::BeginGesture(GestureKind::Transform));
-        let start_pose = self.model.document().pose();
+        cx.apply(Command::BeginGesture(GestureKind::Transform));
+        let document = cx.model.document();
         self.viewport.modal = Some(Modal {
             kind,
             pane,
-            pivot: self.pivot_of(start_pose),
+            pivot: pivot_of(document, cx.pose_tools, document.pose()),
             start_pointer: pointer,
             pointer,
             axis: None,
@@ -160,12 +181,13 @@ impl EditorApp {
     pub(in crate::app) fn begin_transform_at_pointer(
         &mut self,
         ctx: &egui::Context,
+        cx: &mut ViewportContext,
         kind: TransformKind,
     ) -> bool {
         let pointer = ctx.input(|i| i.pointer.hover_pos());
         let pane = pointer.and_then(|p| self.viewport.pane_at(p));
         if let (Some(pointer), Some(pane)) = (pointer, pane) {
-            self.begin_transform(kind, pane, pointer);
+            self.begin_transform(cx, kind, pane, pointer);
             return true;
         }
         false
@@ -173,7 +195,11 @@ impl EditorApp {
 
     /// The keys of the transform under way, its own keymap as in Blender: an
     /// axis, a typed amount, Enter and Esc. False when none is under way.
-    pub(in crate::app) fn steer_transform(&mut self, ctx: &egui::Context) -> bool {
+    pub(in crate::app) fn steer_transform(
+        &mut self,
+        ctx: &egui::Context,
+        cx: &mut ViewportContext,
+    ) -> bool {
         let Some(modal) = &mut self.viewport.modal else {
             return false;
         };
@@ -208,18 +234,22 @@ impl EditorApp {
             modal.typed.pop();
         }
         if escape {
-            self.cancel_transform();
+            self.cancel_transform(cx);
         } else if enter {
-            self.confirm_transform();
+            self.confirm_transform(cx);
         } else {
-            self.preview_transform();
+            self.preview_transform(cx);
         }
         true
     }
 
     /// The pointer of a transform under way: follow it, confirm on a click,
     /// cancel on a right click.
-    pub(super) fn transform_pointer(&mut self, response: &egui::Response) {
+    pub(super) fn transform_pointer(
+        &mut self,
+        cx: &mut ViewportContext,
+        response: &egui::Response,
+    ) {
         let Some(modal) = &mut self.viewport.modal else {
             return;
         };
@@ -227,39 +257,39 @@ impl EditorApp {
             modal.pointer = pointer;
         }
         if response.clicked_by(egui::PointerButton::Primary) {
-            self.confirm_transform();
+            self.confirm_transform(cx);
         } else if response.clicked_by(egui::PointerButton::Secondary) {
-            self.cancel_transform();
+            self.cancel_transform(cx);
         } else {
-            self.preview_transform();
+            self.preview_transform(cx);
         }
     }
 
-    fn preview_transform(&mut self) {
+    fn preview_transform(&mut self, cx: &mut ViewportContext) {
         let Some(modal) = &self.viewport.modal else {
             return;
         };
         // A transform whose document was replaced has ended.
-        let Some(start) = self.model.gesture_start(GestureKind::Transform) else {
+        let Some(start) = cx.model.gesture_start(GestureKind::Transform) else {
             self.viewport.modal = None;
             return;
         };
         let transform = self.modal_transform(modal);
-        let pose = self.pose_transformed(start, &transform);
-        self.apply(Command::PreviewGesture(pose));
+        let pose = pose_transformed(cx.model.document(), cx.pose_tools, start, &transform);
+        cx.apply(Command::PreviewGesture(pose));
     }
 
-    fn confirm_transform(&mut self) {
-        self.preview_transform();
+    fn confirm_transform(&mut self, cx: &mut ViewportContext) {
+        self.preview_transform(cx);
         if let Some(modal) = self.viewport.modal.take() {
             let action = format!("{} handles", modal.kind.verb().to_lowercase());
-            self.apply(Command::EndGesture { action });
+            cx.apply(Command::EndGesture { action });
         }
     }
 
-    fn cancel_transform(&mut self) {
+    fn cancel_transform(&mut self, cx: &mut ViewportContext) {
         if self.viewport.modal.take().is_some() {
-            self.apply(Command::CancelGesture);
+            cx.apply(Command::CancelGesture);
         }
     }
 
@@ -324,11 +354,17 @@ impl EditorApp {
     }
 
     /// The line from the pivot to the pointer, and what the transform does.
-    pub(super) fn draw_transform(&self, painter: &egui::Painter, pane: usize, rect: Rect) {
+    pub(super) fn draw_transform(
+        &self,
+        cx: &ViewportContext,
+        painter: &egui::Painter,
+        pane: usize,
+        rect: Rect,
+    ) {
         let Some(modal) = &self.viewport.modal else {
-            if self.pose_tools.pivot == Pivot::Cursor {
+            if cx.pose_tools.pivot == Pivot::Cursor {
                 if let Some((_, projection)) = self.viewport.pane(pane) {
-                    if let Some(at) = projection.project_world(self.pose_tools.cursor) {
+                    if let Some(at) = projection.project_world(cx.pose_tools.cursor) {
                         let at = Pos2::new(at.x, at.y);
                         painter.circle_stroke(
                             at,
@@ -388,9 +424,14 @@ impl EditorApp {
         );
     }
 
-    fn mesh_point_under(&mut self, pane: usize, pointer: Pos2) -> Option<DVec3> {
+    fn mesh_point_under(
+        &mut self,
+        document: &Document,
+        pane: usize,
+        pointer: Pos2,
+    ) -> Option<DVec3> {
         let (kind, projection) = self.viewport.pane(pane)?;
-        let positions = self.deformed_on_cpu(kind.method())?;
+        let positions = self.deformed_on_cpu(document, kind.method())?;
         let vertex = crate::app::compare::vertex_under_pointer(
             &positions,
             projection.view_projection,
@@ -406,20 +447,21 @@ impl EditorApp {
 
     /// Shift+right click: the 3D cursor goes to the handle or mesh vertex under
     /// the pointer, and becomes the pivot.
-    pub(super) fn place_cursor(&mut self, pane: usize, pointer: Pos2) {
+    pub(super) fn place_cursor(&mut self, cx: &mut ViewportContext, pane: usize, pointer: Pos2) {
+        let document = cx.model.document();
         let handle = self
-            .pick(pointer)
-            .and_then(|h| self.model.document().pose().get(h).copied());
+            .pick(document, pointer)
+            .and_then(|h| document.pose().get(h).copied());
         let target = match handle {
             Some(at) => Some(at),
-            None => self.mesh_point_under(pane, pointer),
+            None => self.mesh_point_under(document, pane, pointer),
         };
         match target {
             Some(at) => {
-                self.pose_tools.cursor = at;
-                self.pose_tools.pivot = Pivot::Cursor;
+                cx.pose_tools.cursor = at;
+                cx.pose_tools.pivot = Pivot::Cursor;
             }
-            None => self.info("Shift+right click on a handle or the mesh places the 3D cursor"),
+            None => cx.info("Shift+right click on a handle or the mesh places the 3D cursor"),
         }
     }
 }

@@ -2,8 +2,9 @@
 //! the cursor whose weights the hover box reads out.
 
 use crate::app::compare::{self, HoverReadout};
-use crate::app::editor::EditorApp;
-use crate::app::model::Selection;
+use crate::app::document::Document;
+use crate::app::model::{Command, Selection};
+use crate::app::views::{ViewportContext, Views};
 use crate::app::widgets::hover_box;
 use egui::{Pos2, Rect};
 use glam::Vec2;
@@ -15,18 +16,17 @@ const PICK_MARGIN: f32 = 5.0;
 /// The hover read-out picks mesh vertices within this many points of the cursor.
 const HOVER_RADIUS: f32 = 6.0;
 
-impl EditorApp {
+impl Views {
     /// The handle nearest to `pointer` within the pick radius, in the view under it.
-    pub(super) fn pick(&self, pointer: Pos2) -> Option<usize> {
-        if !self.view.show_cage {
+    pub(super) fn pick(&self, document: &Document, pointer: Pos2) -> Option<usize> {
+        if !self.settings.show_cage {
             return None;
         }
-        let radius = PICK_RADIUS.max(self.view.handle_size + PICK_MARGIN);
+        let radius = PICK_RADIUS.max(self.settings.handle_size + PICK_MARGIN);
         let pane = self.viewport.pane_at(pointer)?;
         let projection = self.viewport.projection(pane)?;
         let pointer = Vec2::new(pointer.x, pointer.y);
-        self.model
-            .document()
+        document
             .pose()
             .iter()
             .enumerate()
@@ -41,14 +41,20 @@ impl EditorApp {
 
     /// Select the handles inside `band` in view `pane` (added to the selection
     /// when `additive`).
-    pub(super) fn box_select(&mut self, pane: usize, band: Rect, additive: bool) {
-        if !self.view.show_cage {
+    pub(super) fn box_select(
+        &mut self,
+        cx: &mut ViewportContext,
+        pane: usize,
+        band: Rect,
+        additive: bool,
+    ) {
+        if !self.settings.show_cage {
             return;
         }
         let Some(projection) = self.viewport.projection(pane) else {
             return;
         };
-        let inside: Vec<usize> = self
+        let inside: Vec<usize> = cx
             .model
             .document()
             .pose()
@@ -61,33 +67,38 @@ impl EditorApp {
             })
             .map(|(i, _)| i)
             .collect();
-        if additive {
-            self.select(Selection::More(inside));
+        let selection = if additive {
+            Selection::More(inside)
         } else {
-            self.select(Selection::Only(inside.into_iter().collect()));
-        }
+            Selection::Only(inside.into_iter().collect())
+        };
+        cx.apply(Command::Select(selection));
     }
 
     /// Find the mesh vertex under the cursor and read out its weights.
-    pub(super) fn update_hover(&mut self, ui: &egui::Ui, hovered: Option<(usize, Option<Pos2>)>) {
+    pub(super) fn update_hover(
+        &mut self,
+        ui: &egui::Ui,
+        cx: &ViewportContext,
+        hovered: Option<(usize, Option<Pos2>)>,
+    ) {
         let target = match hovered {
             // Not in `--screenshot` runs, where the pointer rests wherever the
             // display server put it, and not while dragging, so that a drag frame
             // never deforms the mesh on the CPU.
-            Some((pane, Some(pointer)))
-                if self.viewport.drag.is_none() && self.screenshot.is_none() =>
-            {
+            Some((pane, Some(pointer))) if self.viewport.drag.is_none() && !cx.facts.scripted => {
                 Some((pane, pointer))
             }
             _ => None,
         };
         let readout = target.and_then(|(pane, pointer)| {
             let (kind, projection) = self.viewport.pane(pane)?;
-            if !self.view.shows_hover(kind) {
+            if !self.settings.shows_hover(kind) {
                 return None;
             }
             let method = kind.method();
-            let positions = self.deformed_on_cpu(method)?;
+            let document = cx.model.document();
+            let positions = self.deformed_on_cpu(document, method)?;
             let vertex = compare::vertex_under_pointer(
                 &positions,
                 projection.view_projection,
@@ -96,8 +107,8 @@ impl EditorApp {
                 Vec2::new(pointer.x, pointer.y),
                 HOVER_RADIUS,
             )?;
-            let cage_vertices = self.model.document().cage().vertex_count();
-            let weights = self.model.document().weights(method)?;
+            let cage_vertices = document.cage().vertex_count();
+            let weights = document.weights(method)?;
             let readout = HoverReadout::new(weights, method, vertex, cage_vertices)?;
             Some((pane, pointer, readout))
         });

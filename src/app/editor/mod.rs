@@ -1,18 +1,26 @@
-//! The editor application: the state that ties the [`Document`], the
-//! [`BindQueue`] and the viewport together, and the frame loop. What happens in
-//! each part of the window lives beside it: binding control in `binding.rs`, file
-//! actions in `files.rs`, the CPU read-outs behind the views in `readouts.rs`, the
-//! viewport in `viewport/`, and one file per panel in `ui/`.
+//! The editor application: the shell that holds the model, the bind queue,
+//! the views and the panels, and brings them together each frame. Its fields
+//! are private to this module: panels see only a [`PanelContext`] and send
+//! actions, which the one runner (`runner.rs`) carries out; the panes draw
+//! through a [`ViewportContext`]. `frame.rs` is the frame loop, `gpu.rs` the GPU
+//! copy (uploads driven by the model's changes, and what the GPU drew, read
+//! back), and `api.rs` the thin wrappers that tests and scripts call.
+
+mod api;
+mod frame;
+mod gpu;
+mod runner;
 
 use super::actions::Action;
 use super::bind_queue::BindQueue;
+use super::binding::{self, Binding};
 use super::cage_generation::CageGeneration;
-use super::compare::{HoverReadout, Pane, ViewSettings};
+use super::compare::ViewSettings;
 use super::document::Document;
 use super::exports::ImageRequest;
-use super::model::{Applied, Command, Model, Outcome, Selection, SessionView, Swapped};
-use super::pose_tools::PoseToolSettings;
-use super::readouts::ReadoutCache;
+use super::files::SceneChange;
+use super::focus::KeyboardFocus;
+use super::model::{Command, Model, Outcome, SessionView, Swapped};
 use super::recent::RecentFiles;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
@@ -20,9 +28,10 @@ use super::ui::drop_dialog::DropDialog;
 use super::ui::file_dialog::FileDialogs;
 use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
+use super::ui::pose_panel::PosePanel;
 use super::ui::quit_dialog::QuitDialog;
 use super::ui::statistics::StatisticsPanel;
-use super::viewport::ViewportState;
+use super::views::Views;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
 use crate::gpu::{Backend, BackendRequest, GpuContext};
@@ -91,47 +100,59 @@ pub enum FileRole {
 }
 
 pub struct EditorApp {
-    pub(super) gpu: Option<GpuHandles>,
+    gpu: Option<GpuHandles>,
     /// The document, its undo log, the gesture under way and the save point.
-    pub(super) model: Model,
-    pub(super) queue: BindQueue,
-    /// The method a single view shows (`method`) and every family's parameters.
-    pub(super) bind_options: BindOptions,
-    /// What the viewport compares and how the mesh is coloured.
-    pub(super) view: ViewSettings,
-    pub(super) viewport: ViewportState,
-    pub(super) readouts: ReadoutCache,
-    pub(super) notices: Notices,
-    pub(super) statistics: StatisticsPanel,
-    pub(super) highlight_outside: bool,
-    pub(super) recent: RecentFiles,
-    /// The session file last opened or saved: File > Save session writes there.
-    pub(super) session_path: Option<PathBuf>,
-    /// The rest-to-pose blend slider's state.
-    pub(super) pose_blend: PoseBlend,
-    /// Pivot, symmetry and soft selection of pose edits.
-    pub(super) pose_tools: PoseToolSettings,
-    /// File > Save image… waiting for the next frame.
-    pub(super) image_request: ImageRequest,
+    model: Model,
+    /// The bind queue and the options the families are bound with.
+    binding: Binding,
+    /// What the viewport shows and keeps: view settings, cameras, read-outs.
+    views: Views,
+    panels: Panels,
+    files: FileState,
+    run: RunState,
+    /// What the panels and shortcuts asked for, run by `runner.rs`.
+    actions: Vec<Action>,
+}
+
+/// The panels, each owning its state.
+#[derive(Default)]
+struct Panels {
+    notices: Notices,
+    statistics: StatisticsPanel,
+    /// The Poses section: names being typed, the blend slider.
+    named_poses: PoseBlend,
+    /// The Posing tools section: pivot, symmetry, soft selection, 3D cursor.
+    pose_tools: PosePanel,
     /// The system's or the in-window file dialog.
-    pub(super) file_dialogs: FileDialogs,
+    file_dialogs: FileDialogs,
     /// Quitting asks first when the pose is unsaved.
-    pub(super) quit: QuitDialog,
-    pub(super) screenshot: Option<ScreenshotState>,
-    /// Frames drawn, up to a limit, for asking for keyboard focus at start.
-    pub(super) focus_frames: u32,
-    /// After a cancel, views stop asking for binds until the user binds again.
-    pub(super) binding_paused: bool,
-    /// Show no timings, so frames are deterministic (snapshot tests).
-    pub(super) hide_timings: bool,
-    /// The first run's line saying what to look at, until it is dismissed.
-    pub(super) first_run_hint: bool,
+    quit: QuitDialog,
     /// A file dropped on the window, waiting for the user to say what it is.
-    pub(super) drop_dialog: DropDialog,
-    /// What the panels asked for this frame, run after them (`actions.rs`).
-    pub(super) actions: Vec<Action>,
+    drop: DropDialog,
     /// File > Generate cage…: its window, job and proposal.
-    pub(super) cage_generation: CageGeneration,
+    cage_window: CageGeneration,
+    /// The first run's line saying what to look at, until it is dismissed.
+    first_run_hint: bool,
+}
+
+/// Where the scene's files are and go.
+#[derive(Default)]
+struct FileState {
+    recent: RecentFiles,
+    /// The session file last opened or saved: File > Save session writes there.
+    session_path: Option<PathBuf>,
+    /// File > Save image… waiting for the next frame.
+    image_request: ImageRequest,
+}
+
+/// How this run of the editor goes.
+#[derive(Default)]
+struct RunState {
+    /// `--screenshot` (and `--drag`): a scripted run.
+    screenshot: Option<ScreenshotState>,
+    focus: KeyboardFocus,
+    /// Show no timings, so frames are deterministic (snapshot tests).
+    hide_timings: bool,
 }
 
 impl EditorApp {
@@ -175,39 +196,33 @@ impl EditorApp {
         // The comb is generated, so it cannot fail to load.
         let (mesh, cage) = (scenes::comb_mesh(), scenes::comb_cage());
         let mut bind_options = BindOptions::for_method(options.method.unwrap_or(Method::Pmvc));
-        let refused_parameters = super::binding::with_asked_parameters(&mut bind_options, &options);
+        let refused_parameters = binding::with_asked_parameters(&mut bind_options, &options);
+        let queue = BindQueue::new(backend, request, move || wake_ctx.request_repaint());
         let mut app = Self {
             gpu,
             model: Model::new(
                 Document::new(BundledScene::Comb.title(), mesh, cage)
                     .bundled_as(BundledScene::Comb),
             ),
-            queue: BindQueue::new(backend, request, move || wake_ctx.request_repaint()),
-            bind_options,
-            view: options.view,
-            viewport: ViewportState::default(),
-            readouts: ReadoutCache::default(),
-            notices: Notices::default(),
-            statistics: StatisticsPanel::default(),
-            highlight_outside: false,
-            recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
-            session_path: None,
-            pose_blend: PoseBlend::default(),
-            image_request: ImageRequest::default(),
-            pose_tools: PoseToolSettings::default(),
-            file_dialogs: FileDialogs::default(),
-            quit: QuitDialog::default(),
-            screenshot: options
-                .screenshot
-                .clone()
-                .map(|path| ScreenshotState::new(path, options.drag_handle)),
-            focus_frames: 0,
-            binding_paused: false,
-            hide_timings: options.hide_timings,
-            first_run_hint: false,
-            drop_dialog: DropDialog::default(),
+            binding: Binding::new(queue, bind_options),
+            views: Views::new(options.view),
+            panels: Panels {
+                cage_window: CageGeneration::new(cc.egui_ctx.clone()),
+                ..Panels::default()
+            },
+            files: FileState {
+                recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
+                ..FileState::default()
+            },
+            run: RunState {
+                screenshot: options
+                    .screenshot
+                    .clone()
+                    .map(|path| ScreenshotState::new(path, options.drag_handle)),
+                focus: KeyboardFocus::default(),
+                hide_timings: options.hide_timings,
+            },
             actions: Vec::new(),
-            cage_generation: CageGeneration::new(cc.egui_ctx.clone()),
         };
         for refused in refused_parameters {
             app.error(refused);
@@ -217,19 +232,7 @@ impl EditorApp {
         } else if app.gpu.is_none() {
             app.error("no wgpu device: the viewport cannot draw (run with the wgpu renderer)");
         }
-        let mut opened = false;
-        match (&options.mesh, &options.cage, &options.session) {
-            (_, _, Some(session)) => {
-                opened = app.open_session(session);
-                if opened {
-                    app.command_line_over_session(&options);
-                }
-            }
-            (Some(mesh), Some(cage), None) => opened = app.open_pair(mesh, cage),
-            (Some(mesh), None, None) => opened = app.open_mesh_alone(mesh),
-            (None, None, None) => {}
-            _ => app.error("give a mesh with the cage; showing the default scene"),
-        }
+        let opened = app.open_what_was_asked(&options);
         if !opened {
             app.install_document(app.model.document().clone());
         }
@@ -239,115 +242,107 @@ impl EditorApp {
             let pose = scenes::comb_demo_pose(app.model.document().cage());
             app.model.apply(Command::edit_pose(pose));
             // Bundled, so there is nothing to lose on quitting.
-            app.mark_pose_saved();
-            app.first_run_hint = true;
+            app.apply(Command::MarkSaved);
+            app.panels.first_run_hint = true;
             app.frame_scene();
         }
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
         }
-        let cage_vertices = app.model.document().pose().len();
-        if options.view.heat_vertex >= cage_vertices {
-            app.error(format!(
-                "--heatmap {}: the cage has {cage_vertices} vertices (0 to {}); showing vertex {}",
-                options.view.heat_vertex,
-                cage_vertices.saturating_sub(1),
-                app.view.heat_vertex
-            ));
-        }
-        let cage_triangles = app.model.document().cage().triangle_count();
-        if let Some(asked) = options.view.heat_triangle.filter(|&t| t >= cage_triangles) {
-            app.error(format!(
-                "--heatmap-triangle {asked}: the cage has {cage_triangles} triangles (0 to {}); showing triangle {}",
-                cage_triangles.saturating_sub(1),
-                app.view.heat_triangle.unwrap_or(0)
-            ));
-        }
+        app.report_heatmap_out_of_range(&options.view);
         // What was opened above has started its binds; starting again would
         // cancel them, and a cancel pauses binding until the user asks.
         if !opened {
-            app.start_bind();
+            app.bind_wanted();
         }
         app
     }
 
-    // ---- read access, for the panels and for tests ------------------------------
-
-    pub fn document(&self) -> &Document {
-        self.model.document()
-    }
-
-    pub fn view(&self) -> &ViewSettings {
-        &self.view
-    }
-
-    pub fn view_mut(&mut self) -> &mut ViewSettings {
-        &mut self.view
-    }
-
-    /// The camera of the first view, and of every view while they are locked;
-    /// its target is in scene coordinates ([`Self::scene_origin`]).
-    pub fn camera(&self) -> OrbitCamera {
-        self.viewport.camera_of(0, self.view.cameras_locked)
-    }
-
-    /// The camera view `pane` is drawn with (in scene coordinates).
-    pub fn camera_of(&self, pane: usize) -> OrbitCamera {
-        self.viewport.camera_of(pane, self.view.cameras_locked)
-    }
-
-    /// The bind options of the method a single view shows.
-    pub fn bind_options(&self) -> BindOptions {
-        self.bind_options
-    }
-
-    /// The options `method` is bound with: its family's current parameters.
-    pub fn options_for(&self, method: Method) -> BindOptions {
-        BindOptions {
-            method,
-            ..self.bind_options
+    /// Open the session, pair or mesh `pmvc edit` was given; true when one opened.
+    fn open_what_was_asked(&mut self, options: &EditorOptions) -> bool {
+        match (&options.mesh, &options.cage, &options.session) {
+            (_, _, Some(session)) => {
+                let opened = self.open_session(session);
+                if opened {
+                    self.command_line_over_session(options);
+                }
+                opened
+            }
+            (Some(mesh), Some(cage), None) => self.open_pair(mesh, cage),
+            (Some(mesh), None, None) => {
+                let change = super::files::open_mesh_alone(mesh);
+                self.change_scene(change)
+            }
+            (None, None, None) => false,
+            _ => {
+                self.error("give a mesh with the cage; showing the default scene");
+                false
+            }
         }
     }
 
-    /// Binds started so far (a method switch to bound weights must not add one).
-    pub fn bind_count(&self) -> usize {
-        self.queue.jobs_started()
+    /// What `pmvc edit --session` was told beside the session wins over it.
+    fn command_line_over_session(&mut self, options: &EditorOptions) {
+        self.views.settings =
+            super::session::view_with_overrides(self.views.settings, options.view);
+        if let Some(method) = options.method {
+            self.binding.options.method = method;
+        }
+        for refused in binding::with_asked_parameters(&mut self.binding.options, options) {
+            self.error(refused);
+        }
     }
 
-    /// (done, total) vertices of the last bind when it ended.
-    pub fn last_bind_progress(&self) -> Option<(usize, usize)> {
-        self.queue.last_progress()
+    /// `--heatmap` or `--heatmap-triangle` beyond the cage is said, and the
+    /// nearest one shown.
+    fn report_heatmap_out_of_range(&mut self, asked: &ViewSettings) {
+        let cage_vertices = self.model.document().pose().len();
+        if asked.heat_vertex >= cage_vertices {
+            self.error(format!(
+                "--heatmap {}: the cage has {cage_vertices} vertices (0 to {}); showing vertex {}",
+                asked.heat_vertex,
+                cage_vertices.saturating_sub(1),
+                self.views.settings.heat_vertex
+            ));
+        }
+        let cage_triangles = self.model.document().cage().triangle_count();
+        if let Some(shown) = asked.heat_triangle.filter(|&t| t >= cage_triangles) {
+            self.error(format!(
+                "--heatmap-triangle {shown}: the cage has {cage_triangles} triangles (0 to {}); showing triangle {}",
+                cage_triangles.saturating_sub(1),
+                self.views.settings.heat_triangle.unwrap_or(0)
+            ));
+        }
     }
 
-    /// The weights under the cursor, and the view they were read in.
-    pub fn hover_readout(&self) -> Option<&(usize, HoverReadout)> {
-        self.viewport.hover_readout.as_ref()
-    }
-
-    /// A dialog (file, quit or dropped file) waits for the user.
-    pub fn modal_dialog_open(&self) -> bool {
-        self.file_dialogs.is_open() || self.quit.is_asking() || self.drop_dialog.is_open()
-    }
-
-    /// Use the in-window file dialog (true) or the system's (false).
-    pub fn set_in_window_file_dialog(&mut self, in_window: bool) {
-        self.file_dialogs.in_window = in_window;
-    }
-
-    pub(super) fn error(&mut self, text: impl Into<String>) {
+    fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
         log::warn!("{text}");
-        if let Some(screenshot) = &self.screenshot {
+        if let Some(screenshot) = &self.run.screenshot {
             screenshot.record_failure(&text);
         }
-        self.notices.error(text);
+        self.panels.notices.error(text);
     }
 
-    pub(super) fn info(&mut self, text: impl Into<String>) {
-        self.notices.info(text);
+    fn info(&mut self, text: impl Into<String>) {
+        self.panels.notices.info(text);
     }
 
-    pub(super) fn with_renderer<R>(
+    /// Report an outcome: the notice, or the error.
+    fn report(&mut self, result: Result<String, String>) -> bool {
+        match result {
+            Ok(text) => {
+                self.info(text);
+                true
+            }
+            Err(text) => {
+                self.error(text);
+                false
+            }
+        }
+    }
+
+    fn with_renderer<R>(
         &self,
         f: impl FnOnce(&mut ViewportRenderer, &wgpu::Device, &wgpu::Queue) -> R,
     ) -> Option<R> {
@@ -357,26 +352,61 @@ impl EditorApp {
         Some(f(viewport, &gpu.device, &gpu.queue))
     }
 
+    /// The families the views need, the active one first.
+    fn wanted_methods_now(&self) -> Vec<Method> {
+        binding::wanted_methods(self.binding.active_method(), &self.views.settings)
+    }
+
     // ---- the document and its GPU copy ----------------------------------------
 
     /// Make `document` current: the bind queue and the views start afresh on it,
     /// and the camera frames it. Not undoable: for the start-up scene.
-    pub(super) fn install_document(&mut self, document: Document) {
+    fn install_document(&mut self, document: Document) {
         self.model
             .apply(Command::InstallDocument(Box::new(document)));
         self.document_swapped(true);
     }
 
+    /// Make a scene change read from files (or an error) current, with its
+    /// notices; true when it was made.
+    fn change_scene(&mut self, change: Result<SceneChange, String>) -> bool {
+        let change = match change {
+            Ok(change) => change,
+            Err(error) => {
+                self.error(error);
+                return false;
+            }
+        };
+        for note in change.notes {
+            self.info(note);
+        }
+        self.replace_document_then_bind(change.replacement);
+        if let Some(path) = change.session {
+            self.files.session_path = Some(path);
+        }
+        if let Some(entry) = change.recent {
+            self.files.recent.remember(entry);
+        }
+        if let Some(done) = change.done {
+            self.info(done);
+        }
+        if change.offer_cage {
+            let vertices = self.model.document().cage().vertex_count();
+            self.panels.cage_window.open_window(vertices);
+        }
+        true
+    }
+
     /// Replace the whole document, as one undo step, and bind it: the one way
     /// opening files, sessions and scenes and editing the cage change it.
-    pub(super) fn replace_document_then_bind(&mut self, replacement: Replacement) {
+    fn replace_document_then_bind(&mut self, replacement: Replacement) {
         let Replacement {
             document,
             action,
             cameras,
             settings,
         } = replacement;
-        let kept = self.viewport.cameras();
+        let kept = self.views.viewport.cameras();
         // Undo brings back the view settings a session replaces, too.
         let view = settings.is_some().then(|| self.session_view());
         self.apply(Command::ReplaceDocument {
@@ -387,30 +417,30 @@ impl EditorApp {
         self.document_swapped(true);
         match cameras {
             Cameras::Frame => {}
-            Cameras::Keep => self.viewport.set_cameras(kept),
+            Cameras::Keep => self.views.viewport.set_cameras(kept),
             // Relative to the origin the new document set.
-            Cameras::Session(cameras) => self.viewport.set_first_cameras(&cameras),
+            Cameras::Session(cameras) => self.views.viewport.set_first_cameras(&cameras),
         }
         if let Some((bind_options, view)) = settings {
-            self.bind_options = bind_options;
-            self.view = view;
+            self.binding.options = bind_options;
+            self.views.settings = view;
             // A session's pose is on disk: quitting keeps it.
             self.apply(Command::MarkSaved);
         }
-        self.start_bind();
+        self.bind_wanted();
     }
 
     /// The view settings a session holds, as shown now.
     fn session_view(&self) -> SessionView {
         SessionView {
-            bind_options: self.bind_options,
-            view: self.view,
-            cameras: self.viewport.cameras(),
+            bind_options: self.binding.options,
+            view: self.views.settings,
+            cameras: self.views.viewport.cameras(),
         }
     }
 
     /// Change the model; a pose refused (of another length) is reported.
-    pub(super) fn apply(&mut self, command: Command) -> Applied {
+    fn apply(&mut self, command: Command) -> super::model::Applied {
         let applied = self.model.apply(command);
         if let Outcome::Refused(why) = &applied.outcome {
             log::warn!("refused: {why}");
@@ -422,22 +452,23 @@ impl EditorApp {
     /// on it, and the camera frames it if asked.
     fn document_swapped(&mut self, frame: bool) {
         let document = self.model.document();
-        self.queue.set_scene(
+        self.binding.queue.set_scene(
             document.mesh().positions.as_slice().into(),
             Arc::clone(document.cage()),
         );
-        self.readouts.clear();
+        self.views.readouts.clear();
         // A drag or a transform under way belonged to the old document.
-        self.viewport.reset_interaction();
-        self.viewport.modal = None;
+        self.views.viewport.reset_interaction();
+        self.views.viewport.modal = None;
         let cage_vertices = document.pose().len();
-        self.view.heat_vertex = self.view.heat_vertex.min(cage_vertices.saturating_sub(1));
+        let settings = &mut self.views.settings;
+        settings.heat_vertex = settings.heat_vertex.min(cage_vertices.saturating_sub(1));
         let cage_triangles = document.cage().triangle_count();
-        self.view.heat_triangle = (self.view.heat_triangle)
-            .map(|triangle| triangle.min(cage_triangles.saturating_sub(1)));
-        self.binding_paused = false;
+        settings.heat_triangle =
+            (settings.heat_triangle).map(|triangle| triangle.min(cage_triangles.saturating_sub(1)));
+        self.binding.paused = false;
         // Before framing: the cameras are relative to the new document's origin.
-        self.viewport.set_origin(self.document_origin());
+        self.views.viewport.set_origin(self.document_origin());
         if frame {
             self.frame_scene();
         }
@@ -450,18 +481,23 @@ impl EditorApp {
     fn reinstate_document(&mut self, swapped: &Swapped) {
         self.document_swapped(!swapped.same_mesh);
         if let Some(view) = swapped.view {
-            self.bind_options = view.bind_options;
-            self.view = view.view;
-            self.viewport.set_cameras(view.cameras);
+            self.binding.options = view.bind_options;
+            self.views.settings = view.view;
+            self.views.viewport.set_cameras(view.cameras);
         }
-        self.sync_parameters_with_weights();
+        self.binding
+            .sync_parameters_with_weights(self.model.document());
     }
 
-    // ---- pose editing -----------------------------------------------------------
+    /// Bind the methods the views show, the active one first, replacing any
+    /// running bind.
+    fn bind_wanted(&mut self) {
+        self.binding.start(&self.views.settings);
+    }
 
     /// Undo the last step: a pose edit, or an action that replaced the document
     /// (opening a file or a session, switching scenes, subdividing, resting the cage).
-    pub fn undo(&mut self) {
+    fn undo_step(&mut self) {
         let applied = self.apply(Command::Undo(self.session_view()));
         if let Some(swapped) = applied.swapped {
             self.reinstate_document(&swapped);
@@ -470,7 +506,7 @@ impl EditorApp {
     }
 
     /// Redo what undo reversed last.
-    pub fn redo(&mut self) {
+    fn redo_step(&mut self) {
         let applied = self.apply(Command::Redo(self.session_view()));
         if let Some(swapped) = applied.swapped {
             self.reinstate_document(&swapped);
@@ -478,73 +514,31 @@ impl EditorApp {
         }
     }
 
-    /// What Undo would reverse, for its menu entry ("move handles", "open cage.obj").
-    pub fn undo_label(&self) -> Option<String> {
-        self.model.undo_label().map(Into::into)
-    }
-
-    /// What Redo would repeat, for its menu entry.
-    pub fn redo_label(&self) -> Option<String> {
-        self.model.redo_label().map(Into::into)
-    }
-
-    pub fn reset_pose(&mut self) {
-        let rest = self.model.document().cage().positions().to_vec();
-        self.apply(Command::edit_pose(rest));
-    }
-
-    /// Move one handle to `position`, recording the change for undo.
-    pub fn set_handle_position(&mut self, handle: usize, position: DVec3) {
-        let mut pose = self.model.document().pose().to_vec();
-        if let Some(moved) = pose.get_mut(handle) {
-            *moved = position;
-            self.apply(Command::edit_pose(pose));
-        }
-    }
-
-    pub fn select_only(&mut self, handles: impl IntoIterator<Item = usize>) {
-        self.select(Selection::only(handles));
-    }
-
-    pub(super) fn select(&mut self, selection: Selection) {
-        self.apply(Command::Select(selection));
-    }
-
-    pub fn frame_scene(&mut self) {
+    fn frame_scene_now(&mut self) {
         let (centre, radius) = self.model.document().bounding_sphere();
-        self.viewport.frame(centre, radius);
+        self.views.viewport.frame(centre, radius);
     }
 
     /// Frame the selected handles (F), or the whole scene when none is selected.
     /// A single handle is framed with room around it: a tenth of the cage.
-    pub fn frame_selection(&mut self) {
-        let pose = self.model.document().pose();
-        let selected: Vec<DVec3> = self
-            .model
-            .document()
-            .selection()
-            .iter()
-            .map(|&i| pose[i])
-            .collect();
+    fn frame_selection_now(&mut self) {
+        let document = self.model.document();
+        let pose = document.pose();
+        let selected: Vec<DVec3> = document.selection().iter().map(|&i| pose[i]).collect();
         if selected.is_empty() {
-            self.frame_scene();
+            self.frame_scene_now();
             return;
         }
         let (lo, hi) = crate::geometry::bounds_of(&selected);
-        let radius = ((hi - lo).length() / 2.0).max(0.1 * self.model.document().cage().diagonal());
-        self.viewport.frame((lo + hi) / 2.0, radius);
-    }
-
-    /// The views drawn last frame and their screen rectangles.
-    pub fn pane_rects(&self) -> Vec<(Pane, egui::Rect)> {
-        self.viewport.pane_rects()
+        let radius = ((hi - lo).length() / 2.0).max(0.1 * document.cage().diagonal());
+        self.views.viewport.frame((lo + hi) / 2.0, radius);
     }
 
     /// Lock all views to one camera (the first view's) or give each its own.
-    pub fn set_cameras_locked(&mut self, locked: bool) {
-        if locked != self.view.cameras_locked {
-            self.view.cameras_locked = locked;
-            self.viewport.unify_cameras();
+    fn lock_cameras(&mut self, locked: bool) {
+        if locked != self.views.settings.cameras_locked {
+            self.views.settings.cameras_locked = locked;
+            self.views.viewport.unify_cameras();
         }
     }
 }
