@@ -199,3 +199,119 @@ fn dismissing_a_notice_is_queued_and_removes_that_notice_when_run() {
         .collect();
     assert_eq!(left, ["first"]);
 }
+
+/// A panel drawn alone over the comb: what it shows, and what it sent.
+struct PanelScene {
+    model: Model,
+    shown: Shown,
+    actions: Vec<Action>,
+}
+
+fn panel_harness(
+    draw: fn(&mut egui::Ui, &mut PanelContext),
+    shown: Shown,
+) -> Harness<'static, PanelScene> {
+    let model = Model::new(Document::new(
+        "comb",
+        scenes::comb_mesh(),
+        scenes::comb_cage(),
+    ));
+    let scene = PanelScene {
+        model,
+        shown,
+        actions: Vec::new(),
+    };
+    let mut harness = Harness::new_ui_state(
+        move |ui, scene: &mut PanelScene| {
+            let mut context = PanelContext::new(&scene.model, &scene.shown, &mut scene.actions);
+            draw(ui, &mut context);
+        },
+        scene,
+    );
+    harness.run();
+    harness
+}
+
+#[test]
+fn an_idle_toolbar_sends_nothing() {
+    // With every control drawn: the difference with a fixed scale (a value
+    // shown in % and read back), a heatmap of a triangle.
+    let mut shown = Shown::default();
+    shown.view.layout = pmvc::app::compare::Layout::Difference;
+    shown.view.difference_limit = Some(0.0123);
+    shown.view.overlay = pmvc::app::compare::Overlay::Heatmap;
+    shown.view.heat_triangle = Some(2);
+    let mut harness = panel_harness(pmvc::app::ui::toolbar::toolbar, shown);
+    harness.run_steps(3);
+    assert!(
+        harness.state().actions.is_empty(),
+        "{:?}",
+        harness.state().actions
+    );
+}
+
+#[test]
+fn the_toolbar_sends_new_view_settings_and_the_method_and_changes_nothing() {
+    let mut harness = panel_harness(pmvc::app::ui::toolbar::toolbar, Shown::default());
+    harness.get_by_label("Difference").click();
+    harness.run();
+    let before = harness.state().shown.view;
+    let sent = std::mem::take(&mut harness.state_mut().actions);
+    match sent.as_slice() {
+        [Action::SetView(view)] => {
+            assert_eq!(view.layout, pmvc::app::compare::Layout::Difference);
+            assert_eq!(
+                pmvc::app::compare::ViewSettings {
+                    layout: before.layout,
+                    ..*view
+                },
+                before,
+                "only the layout changes"
+            );
+        }
+        other => panic!("expected one SetView, got {other:?}"),
+    }
+    assert_eq!(
+        harness.state().shown.view,
+        before,
+        "the panel only asks: what it shows is the editor's"
+    );
+
+    harness.get_by_label("MVC").click();
+    harness.run();
+    assert!(
+        matches!(
+            harness.state().actions.as_slice(),
+            [Action::SetMethod(pmvc::coords::Method::Mvc)]
+        ),
+        "{:?}",
+        harness.state().actions
+    );
+}
+
+#[test]
+fn the_edit_menu_offers_undo_by_the_models_label_and_sends_it() {
+    let mut harness = panel_harness(pmvc::app::ui::menu::menu_bar, Shown::default());
+    let rest = harness.state().model.document().pose().to_vec();
+    let mut pose = rest.clone();
+    pose[3] += DVec3::new(0.0, 0.5, 0.0);
+    harness
+        .state_mut()
+        .model
+        .apply(Command::edit_pose(pose.clone()));
+    harness.run();
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness.get_by_label("Undo pose edit (Ctrl+Z)").click();
+    harness.run();
+    assert!(
+        matches!(harness.state().actions.as_slice(), [Action::Undo]),
+        "{:?}",
+        harness.state().actions
+    );
+    assert_eq!(
+        harness.state().model.document().pose(),
+        pose.as_slice(),
+        "the menu changes nothing itself"
+    );
+}
