@@ -105,6 +105,8 @@ pub enum Action {
     CageWindow(CageRequest),
     /// Hide the first run's line.
     HideFirstRunLine,
+    /// Help > Shortcuts.
+    ShowShortcuts,
 }
 
 /// A step of the blend slider's gesture.

@@ -39,7 +39,7 @@ mod screenshot;
 mod scripted_drag;
 pub mod session;
 pub mod session_checks;
-mod shortcuts;
+pub mod shortcuts;
 pub mod ui;
 mod viewport;
 pub mod views;

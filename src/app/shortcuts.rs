@@ -7,7 +7,7 @@ use super::actions::Action;
 use super::model::{Command, Selection};
 use super::ui::file_dialog::FileAction;
 use super::viewport::TransformKind;
-use egui::{Key, KeyboardShortcut, Modifiers};
+use egui::{Key, Modifiers};
 
 /// What a shortcut does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -28,9 +28,9 @@ pub enum Shortcut {
 }
 
 /// How a shortcut's keys are pressed.
-#[derive(Clone, Copy)]
-enum Keys {
-    /// With these modifiers (consumed, so a longer shortcut listed first wins).
+#[derive(Clone, Copy, Debug)]
+pub enum Keys {
+    /// With exactly these modifiers (the press is consumed).
     With(Modifiers, Key),
     /// Alone, with no modifier held.
     Plain(Key),
@@ -39,7 +39,7 @@ enum Keys {
 }
 
 /// When a shortcut's keys are live.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scope {
     /// Always, even over a dialog.
     Always,
@@ -58,7 +58,7 @@ const COMMAND_SHIFT: Modifiers = Modifiers {
 };
 
 /// Every shortcut, in the order they are checked.
-const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
+pub const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
     (Keys::With(COMMAND, Key::Q), Scope::Always, Shortcut::Quit),
     (
         Keys::Plain(Key::G),
@@ -113,25 +113,101 @@ const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
     ),
 ];
 
-/// The actions of `scope` whose keys were pressed this frame, in table order.
+/// The shortcuts of `scope` whose keys were pressed this frame, in table order.
+/// Each key press is matched with the modifiers it was pressed with, exactly:
+/// not with the modifiers held at the end of the frame, which a quick tap has
+/// already released, so that Ctrl+S is never also S.
 pub fn pressed(ctx: &egui::Context, scope: Scope) -> Vec<Shortcut> {
-    let mut actions: Vec<Shortcut> = Vec::new();
-    for &(keys, _, action) in SHORTCUTS.iter().filter(|(_, s, _)| *s == scope) {
+    let mut found: Vec<Shortcut> = Vec::new();
+    for &(keys, _, shortcut) in SHORTCUTS.iter().filter(|(_, s, _)| *s == scope) {
         let hit = ctx.input_mut(|i| match keys {
-            Keys::With(modifiers, key) => {
-                i.consume_shortcut(&KeyboardShortcut::new(modifiers, key))
-            }
-            Keys::Plain(key) => i.key_pressed(key) && i.modifiers.is_none(),
-            Keys::Any(key) => i.key_pressed(key),
+            // Consumed, so that no other entry or widget sees the press again.
+            Keys::With(wanted, key) => take_press(&mut i.events, key, Some(wanted)),
+            Keys::Plain(key) => pressed_with(&i.events, key, Some(Modifiers::NONE)),
+            Keys::Any(key) => pressed_with(&i.events, key, None),
         });
-        if hit && !actions.contains(&action) {
-            actions.push(action);
+        if hit && !found.contains(&shortcut) {
+            found.push(shortcut);
         }
     }
-    actions
+    found
+}
+
+/// Whether `event` presses `key` with exactly `modifiers` (any, for `None`).
+fn presses(event: &egui::Event, key: Key, modifiers: Option<Modifiers>) -> bool {
+    matches!(
+        event,
+        egui::Event::Key { key: pressed, pressed: true, modifiers: held, .. }
+            if *pressed == key && modifiers.is_none_or(|wanted| held.matches_exact(wanted))
+    )
+}
+
+fn pressed_with(events: &[egui::Event], key: Key, modifiers: Option<Modifiers>) -> bool {
+    events.iter().any(|event| presses(event, key, modifiers))
+}
+
+/// Remove the presses of `key` with exactly `modifiers`; true when there was one.
+fn take_press(events: &mut Vec<egui::Event>, key: Key, modifiers: Option<Modifiers>) -> bool {
+    let before = events.len();
+    events.retain(|event| !presses(event, key, modifiers));
+    events.len() < before
+}
+
+impl Scope {
+    /// When its keys work, for Help > Shortcuts.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Scope::Always => "always",
+            Scope::Viewport => "not in a text field or dialog, nor during a transform",
+            Scope::Files => "not in a text field or dialog",
+        }
+    }
+}
+
+impl Keys {
+    /// The keys as a person reads them: "Ctrl+Shift+Z", "G", "Esc".
+    pub fn label(self) -> String {
+        let (modifiers, key) = match self {
+            Keys::With(modifiers, key) => (modifiers, key),
+            Keys::Plain(key) | Keys::Any(key) => (Modifiers::NONE, key),
+        };
+        let mut parts = Vec::new();
+        if modifiers.command || modifiers.ctrl || modifiers.mac_cmd {
+            parts.push("Ctrl");
+        }
+        if modifiers.alt {
+            parts.push("Alt");
+        }
+        if modifiers.shift {
+            parts.push("Shift");
+        }
+        parts.push(key.name());
+        parts.join("+")
+    }
 }
 
 impl Shortcut {
+    /// What it does, for Help > Shortcuts.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Shortcut::Quit => "Quit (asks first when the pose is unsaved)",
+            Shortcut::BeginTransform(TransformKind::Grab) => "Move the selected handles",
+            Shortcut::BeginTransform(TransformKind::Rotate) => "Rotate the selected handles",
+            Shortcut::BeginTransform(TransformKind::Scale) => "Scale the selected handles",
+            Shortcut::Redo => "Redo",
+            Shortcut::Undo => "Undo",
+            Shortcut::Deselect => "Deselect every handle",
+            Shortcut::FrameSelection => "Frame the selection",
+            Shortcut::FrameAll => "Frame the whole scene",
+            Shortcut::NextMethod => "Show the next family",
+            Shortcut::ToggleCage => "Show or hide the cage and its handles",
+            Shortcut::ToggleSoftSelection => "Soft selection on or off",
+            Shortcut::SaveSessionAs => "Save the session as…",
+            Shortcut::SaveSession => "Save the session",
+            Shortcut::OpenSession => "Open a session…",
+        }
+    }
+
     /// The action the runner carries out; a transform begins in the viewport
     /// instead (it needs the pointer's view).
     pub fn action(self) -> Option<Action> {

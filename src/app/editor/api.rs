@@ -9,7 +9,7 @@ use crate::app::cage_generation::CageGeneration;
 use crate::app::compare::{HoverReadout, Pane, ValueRange, ViewSettings};
 use crate::app::document::Document;
 use crate::app::model::{Command, Selection};
-use crate::app::pose_tools::Transform;
+use crate::app::pose_tools::{PoseToolSettings, Transform};
 use crate::app::recent::{RecentEntry, RecentFiles};
 use crate::app::scenes::BundledScene;
 use crate::app::ui::drop_dialog::DroppedFile;
@@ -175,6 +175,11 @@ impl EditorApp {
     /// The blend shown, 0 to 1 (1 when no blend is under way).
     pub fn pose_blend_amount(&self) -> f64 {
         self.panels.named_poses.shown_amount(self.model.document())
+    }
+
+    /// Pivot, symmetry, soft selection and the 3D cursor.
+    pub fn pose_tool_settings(&self) -> PoseToolSettings {
+        self.panels.pose_tools.tools
     }
 
     /// The 3D cursor, in world coordinates.

@@ -76,6 +76,7 @@ impl eframe::App for EditorApp {
             self.panels.file_dialogs.window(&ctx, cx);
             generate_cage::window(&mut self.panels.cage_window, &ctx, cx);
         });
+        self.panels.shortcuts_help.window(&ctx);
         self.run_actions(&ctx);
         self.request_wanted_binds();
         if self.panels.statistics.is_shown() {

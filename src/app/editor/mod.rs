@@ -30,6 +30,7 @@ use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
 use super::ui::pose_panel::PosePanel;
 use super::ui::quit_dialog::QuitDialog;
+use super::ui::shortcuts_help::ShortcutsHelp;
 use super::ui::statistics::StatisticsPanel;
 use super::views::Views;
 use super::{BindOn, EditorOptions};
@@ -133,6 +134,8 @@ struct Panels {
     cage_window: CageGeneration,
     /// The first run's line saying what to look at, until it is dismissed.
     first_run_hint: bool,
+    /// Help > Shortcuts.
+    shortcuts_help: ShortcutsHelp,
 }
 
 /// Where the scene's files are and go.

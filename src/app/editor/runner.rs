@@ -137,6 +137,7 @@ impl EditorApp {
             Action::SetInWindowDialog(in_window) => self.panels.file_dialogs.in_window = in_window,
             Action::CageWindow(request) => self.cage_window(request),
             Action::HideFirstRunLine => self.panels.first_run_hint = false,
+            Action::ShowShortcuts => self.panels.shortcuts_help.open = true,
         }
     }
 

@@ -22,6 +22,11 @@ pub fn menu_bar(ui: &mut egui::Ui, cx: &mut PanelContext) {
                 }
             }
         });
+        ui.menu_button("Help", |ui| {
+            if ui.button("Shortcuts").clicked() {
+                cx.send(Action::ShowShortcuts);
+            }
+        });
     });
 }
 

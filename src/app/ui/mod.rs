@@ -13,6 +13,7 @@ pub mod notices;
 pub mod pose_panel;
 pub mod quality_table;
 pub mod quit_dialog;
+pub mod shortcuts_help;
 pub mod side_panel;
 pub mod statistics;
 pub mod toolbar;

@@ -1,0 +1,178 @@
+//! Shortcuts matched with the modifiers each key was pressed with: Ctrl+S is
+//! only Save and S only Scale, Ctrl+O only Open session and O only soft
+//! selection, whatever else arrives in the same frame (a quick tap brings the
+//! modifier's press, the key and the modifier's release together). Every entry
+//! of the table is tried with and without each modifier.
+
+mod common;
+
+use common::editor::*;
+use egui::{Event, Key, Modifiers, RawInput};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use pmvc::app::shortcuts::{pressed, Keys, Scope, Shortcut, SHORTCUTS};
+use pmvc::app::ui::file_dialog::FileAction;
+use pmvc::app::EditorApp;
+
+/// Put the pointer in the first view, away from the handles.
+fn hover_view(harness: &mut Harness<'static, EditorApp>) {
+    let (_, rect) = harness.state().pane_rects()[0];
+    harness.hover_at(rect.left_top() + egui::vec2(60.0, 120.0));
+    harness.run_steps(2);
+}
+
+/// A quick tap of `key` with `modifiers`, as X11 delivers it to one frame:
+/// the modifiers pressed, the key down and up, the modifiers released.
+fn tap(harness: &mut Harness<'static, EditorApp>, modifiers: Modifiers, key: Key) {
+    for event in tap_events(modifiers, key) {
+        harness.event(event);
+    }
+    harness.run_steps(2);
+}
+
+fn tap_events(modifiers: Modifiers, key: Key) -> Vec<Event> {
+    let key_event = |pressed| Event::Key {
+        key,
+        physical_key: None,
+        pressed,
+        repeat: false,
+        modifiers,
+    };
+    vec![
+        Event::ModifiersChanged(modifiers),
+        key_event(true),
+        key_event(false),
+        Event::ModifiersChanged(Modifiers::NONE),
+    ]
+}
+
+#[test]
+fn ctrl_s_saves_and_does_not_also_scale() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    harness.state_mut().select_only([10, 11]);
+    hover_view(&mut harness);
+    let pose = harness.state().document().pose().to_vec();
+    tap(&mut harness, Modifiers::COMMAND, Key::S);
+    assert_eq!(
+        harness.state().transform_under_way(),
+        None,
+        "Ctrl+S began a transform"
+    );
+    assert_eq!(
+        harness.state().open_file_dialog(),
+        Some(FileAction::SaveSession)
+    );
+    assert_eq!(harness.state().document().pose(), pose.as_slice());
+}
+
+#[test]
+fn ctrl_o_opens_a_session_and_does_not_toggle_soft_selection() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    hover_view(&mut harness);
+    let soft = harness.state().pose_tool_settings().soft_selection;
+    tap(&mut harness, Modifiers::COMMAND, Key::O);
+    assert_eq!(
+        harness.state().pose_tool_settings().soft_selection,
+        soft,
+        "Ctrl+O toggled soft selection"
+    );
+    assert_eq!(
+        harness.state().open_file_dialog(),
+        Some(FileAction::OpenSession)
+    );
+}
+
+#[test]
+fn plain_s_still_scales_and_o_still_toggles_soft_selection() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().select_only([10, 11]);
+    hover_view(&mut harness);
+    harness.key_press(Key::S);
+    harness.run_steps(2);
+    assert!(harness.state().transform_under_way().is_some());
+    harness.key_press(Key::Escape);
+    harness.run_steps(2);
+    let soft = harness.state().pose_tool_settings().soft_selection;
+    harness.key_press(Key::O);
+    harness.run_steps(2);
+    assert_ne!(harness.state().pose_tool_settings().soft_selection, soft);
+}
+
+/// Which shortcuts of `scope` one frame with `key` pressed, held with
+/// `modifiers` the way a quick tap arrives (the modifiers pressed, the key, the
+/// modifiers released, all in the frame), gives.
+fn fired(scope: Scope, modifiers: Modifiers, key: Key) -> Vec<Shortcut> {
+    let ctx = egui::Context::default();
+    let input = RawInput {
+        events: tap_events(modifiers, key),
+        ..RawInput::default()
+    };
+    let mut found = Vec::new();
+    let _ = ctx.run_ui(input, |ui| found = pressed(ui.ctx(), scope));
+    found
+}
+
+const TRIED: [Modifiers; 6] = [
+    Modifiers::NONE,
+    Modifiers::COMMAND,
+    Modifiers::SHIFT,
+    Modifiers::ALT,
+    Modifiers {
+        shift: true,
+        ..Modifiers::COMMAND
+    },
+    Modifiers {
+        alt: true,
+        ..Modifiers::COMMAND
+    },
+];
+
+#[test]
+fn every_entry_fires_with_its_own_modifiers_and_no_others() {
+    let mut wrong = Vec::new();
+    for (keys, scope, shortcut) in SHORTCUTS {
+        for modifiers in TRIED {
+            let (key, expected) = match *keys {
+                Keys::With(own, key) => (key, own == modifiers),
+                Keys::Plain(key) => (key, modifiers.is_none()),
+                Keys::Any(key) => (key, true),
+            };
+            let found = fired(*scope, modifiers, key);
+            // One key press is one shortcut of its scope at most.
+            if found.contains(shortcut) != expected || found.len() > 1 {
+                wrong.push(format!("{} with {modifiers:?}: {found:?}", keys.label()));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn help_shortcuts_lists_every_entry_of_the_table() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.get_by_label("Help").click();
+    harness.run();
+    harness.get_by_label("Shortcuts").click();
+    harness.run();
+    for (keys, _, shortcut) in SHORTCUTS {
+        let label = keys.label();
+        assert!(
+            harness.query_all_by_label(&label).next().is_some(),
+            "{label} is not listed"
+        );
+        assert!(
+            harness
+                .query_all_by_label(shortcut.describe())
+                .next()
+                .is_some(),
+            "{} is not listed",
+            shortcut.describe()
+        );
+    }
+}
