@@ -376,3 +376,68 @@ fn ctrl_s_asks_once_with_the_name_ready_to_type_over_then_saves_in_place() {
     let json = read_json(&saved);
     assert_eq!(json["pose"][0][1], rest[0].y - 0.5);
 }
+
+/// Ctrl+S as a user presses it, with the pointer over the first view.
+fn press_save(harness: &mut egui_kittest::Harness<'static, pmvc::app::EditorApp>) {
+    let (_, rect) = harness.state().pane_rects()[0];
+    harness.hover_at(rect.left_top() + egui::vec2(60.0, 120.0));
+    harness.run_steps(2);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    harness.run_steps(2);
+}
+
+#[test]
+fn save_after_opening_another_scene_asks_for_a_name_from_its_mesh_and_keeps_the_old_session() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage, _, _) = common::comb_scene(dir.path(), 200);
+    let Some(mut harness) = editor_with(EditorOptions {
+        mesh: Some(mesh.clone()),
+        cage: Some(cage.clone()),
+        resolution: Some(TEST_RESOLUTION),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_in_window_file_dialog(true);
+    let session = dir.path().join("first.session.json");
+    assert!(harness.state_mut().save_session(&session));
+    let saved = std::fs::read_to_string(&session).unwrap();
+
+    // An edit of the same scene stays that session: Ctrl+S writes it at once.
+    assert!(harness.state_mut().subdivide_cage());
+    run_until_bound(&mut harness);
+    press_save(&mut harness);
+    assert_eq!(harness.state().open_file_dialog(), None);
+    let resaved = std::fs::read_to_string(&session).unwrap();
+    assert_ne!(
+        resaved, saved,
+        "the subdivided cage is saved in the session"
+    );
+
+    // Another scene: Save asks, offering the new mesh's name.
+    let other_mesh = dir.path().join("hydrant.obj");
+    let other_cage = dir.path().join("hydrant_cage.obj");
+    std::fs::copy(&mesh, &other_mesh).unwrap();
+    std::fs::copy(&cage, &other_cage).unwrap();
+    assert!(harness.state_mut().open_pair(&other_mesh, &other_cage));
+    run_until_bound(&mut harness);
+    let rest = harness.state().document().pose()[3];
+    harness
+        .state_mut()
+        .set_handle_position(3, rest + DVec3::new(0.0, 0.25, 0.0));
+    press_save(&mut harness);
+    assert_eq!(
+        harness.state().open_file_dialog(),
+        Some(pmvc::app::ui::file_dialog::FileAction::SaveSession)
+    );
+    assert_eq!(
+        harness.state().file_dialog_name(),
+        Some("hydrant.session.json")
+    );
+    assert_eq!(
+        std::fs::read_to_string(&session).unwrap(),
+        resaved,
+        "the first scene's session is left as it was"
+    );
+}

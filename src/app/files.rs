@@ -35,6 +35,10 @@ pub struct SceneChange {
     pub recent: Option<RecentEntry>,
     /// The session file it came from: File > Save session writes there.
     pub session: Option<PathBuf>,
+    /// An edit of the scene shown (its cage subdivided, its mesh rested in the
+    /// pose, a generated cage), which stays the session it was; anything opened
+    /// is another scene, which Save session asks a name for.
+    pub same_session: bool,
     /// Open the Generate cage window (a mesh with no cage of its own).
     pub offer_cage: bool,
 }
@@ -47,8 +51,15 @@ impl SceneChange {
             done: None,
             recent: None,
             session: None,
+            same_session: false,
             offer_cage: false,
         }
+    }
+
+    /// An edit of the scene shown: the session stays.
+    fn edit(mut self) -> Self {
+        self.same_session = true;
+        self
     }
 
     fn done(mut self, text: String) -> Self {
@@ -186,9 +197,11 @@ pub fn subdivide_cage(current: &Document) -> Result<SceneChange, String> {
         subdivided.pose,
     );
     Ok(
-        SceneChange::new(Replacement::in_place(document, "subdivide the cage")).done(format!(
-            "subdivided the cage: {before} -> {after} vertices; rebinding"
-        )),
+        SceneChange::new(Replacement::in_place(document, "subdivide the cage"))
+            .edit()
+            .done(format!(
+                "subdivided the cage: {before} -> {after} vertices; rebinding"
+            )),
     )
 }
 
@@ -210,9 +223,11 @@ pub fn pose_as_rest(current: &Document, method: Method) -> Result<SceneChange, S
         current.cage_path().map(Into::into),
     );
     Ok(
-        SceneChange::new(Replacement::in_place(document, "use pose as rest shape")).done(format!(
-            "the mesh now rests as {method} deformed it, in the posed cage; rebinding"
-        )),
+        SceneChange::new(Replacement::in_place(document, "use pose as rest shape"))
+            .edit()
+            .done(format!(
+                "the mesh now rests as {method} deformed it, in the posed cage; rebinding"
+            )),
     )
 }
 
@@ -226,6 +241,7 @@ pub fn use_generated_cage(current: &Document, proposal: Proposal) -> SceneChange
         document,
         format!("use the generated {vertices}-vertex cage"),
     ))
+    .edit()
     .done(format!(
         "using the generated cage of {vertices} vertices; binding"
     ))

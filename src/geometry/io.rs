@@ -241,8 +241,10 @@ pub fn write_obj_to(
 /// An OBJ source keeps everything but its vertex positions and normals: faces,
 /// texture coordinates, groups, materials and comments are copied. Normals are
 /// recomputed from the deformed positions ([`vertex_normals`], one `vn` per
-/// vertex, written before the first face), and every face corner refers to its
-/// vertex's normal.
+/// vertex, written before the first face under a comment that says so), and
+/// every face corner refers to its vertex's normal. Comments that speak of
+/// normals (MeshLab's "# 39028 vertices, 0 vertices normals") would then be
+/// wrong, so they are left out.
 pub fn write_deformed_mesh(
     file: &MeshFile,
     positions: &[DVec3],
@@ -272,6 +274,7 @@ pub fn write_deformed_mesh(
                     }
                     // Stale after the deformation: recomputed below.
                     Some("vn") => {}
+                    Some(first) if first.starts_with('#') && speaks_of_normals(line) => {}
                     Some("f") => {
                         if !normals_written {
                             write_normals(out, &normals)?;
@@ -326,8 +329,18 @@ pub fn write_mesh_with_normals(
     })
 }
 
-/// `vn` lines, one per vertex, in vertex order.
+/// A comment about the source's normals, which a deformation recomputes.
+fn speaks_of_normals(comment: &str) -> bool {
+    comment.to_ascii_lowercase().contains("normal")
+}
+
+/// `vn` lines, one per vertex, in vertex order, under a comment saying what they are.
 fn write_normals(out: &mut dyn Write, normals: &[DVec3]) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "# {} vertex normals, recomputed by pmvc from the deformed positions",
+        normals.len()
+    )?;
     for n in normals {
         writeln!(
             out,

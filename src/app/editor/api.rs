@@ -172,6 +172,11 @@ impl EditorApp {
         self.panels.file_dialogs.open_for()
     }
 
+    /// The file name the in-window dialog holds, if it is open.
+    pub fn file_dialog_name(&self) -> Option<&str> {
+        self.panels.file_dialogs.typed_name()
+    }
+
     /// The blend shown, 0 to 1 (1 when no blend is under way).
     pub fn pose_blend_amount(&self) -> f64 {
         self.panels.named_poses.shown_amount(self.model.document())

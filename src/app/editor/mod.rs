@@ -384,8 +384,12 @@ impl EditorApp {
             self.info(note);
         }
         self.replace_document_then_bind(change.replacement);
-        if let Some(path) = change.session {
-            self.files.session_path = Some(path);
+        // Save session writes where this scene came from: a session file, or
+        // for anything else opened, a name the user gives.
+        match change.session {
+            Some(path) => self.files.session_path = Some(path),
+            None if !change.same_session => self.files.session_path = None,
+            None => {}
         }
         if let Some(entry) = change.recent {
             self.files.recent.remember(entry);

@@ -425,7 +425,8 @@ impl EditorApp {
     /// Ask for a file for `action` and carry it out: the system's dialog when it
     /// works, else the in-window one (which answers in a later frame).
     pub(super) fn ask_for_file_now(&mut self, action: FileAction) {
-        match self.panels.file_dialogs.ask(action) {
+        let name = (action == FileAction::SaveSession).then(|| self.session_name());
+        match self.panels.file_dialogs.ask(action, name) {
             DialogAnswer::Chosen(path) => {
                 self.finish_file_action(action, &path);
             }
@@ -439,6 +440,25 @@ impl EditorApp {
                 }
             }
         }
+    }
+
+    /// The name a new session file is offered: the mesh's, as
+    /// "hydrant.session.json" for hydrant.obj.
+    fn session_name(&self) -> String {
+        let document = self.model.document();
+        let title = match document.mesh_file() {
+            Some(file) => file
+                .path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned()),
+            None => Path::new(document.title())
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned()),
+        };
+        let stem = title
+            .filter(|t| !t.trim().is_empty())
+            .unwrap_or_else(|| "scene".into());
+        format!("{stem}.session.json")
     }
 
     /// Carry out `action` on `path`; true when it succeeded.

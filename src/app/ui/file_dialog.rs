@@ -119,16 +119,19 @@ struct FileBrowser {
     /// The name field takes the keyboard when the dialog opens, so a typed name
     /// and Enter work at once.
     focus_name: bool,
+    /// The name offered when the dialog opened, offered again in each folder.
+    suggested: String,
 }
 
 impl FileBrowser {
-    fn new(action: FileAction, folder: PathBuf) -> Self {
+    fn new(action: FileAction, folder: PathBuf, name: String) -> Self {
         let mut browser = Self {
             action,
             folder: PathBuf::new(),
             folder_text: String::new(),
             entries: Vec::new(),
-            name: action.default_name().into(),
+            name: name.clone(),
+            suggested: name,
             problem: None,
             confirm_replace: None,
             focus_name: true,
@@ -250,13 +253,15 @@ pub enum DialogAnswer {
 }
 
 impl FileDialogs {
-    /// Ask for a file for `action`: the system's dialog when it works, else the
+    /// Ask for a file for `action`, offering `name` (else the action's usual
+    /// name) where a file is saved: the system's dialog when it works, else the
     /// in-window one.
-    pub fn ask(&mut self, action: FileAction) -> DialogAnswer {
+    pub fn ask(&mut self, action: FileAction, name: Option<String>) -> DialogAnswer {
+        let name = name.unwrap_or_else(|| action.default_name().into());
         let mut fell_back = false;
         if !self.in_window {
             let asked = Instant::now();
-            match system_dialog(action, &self.start_folder()) {
+            match system_dialog(action, &self.start_folder(), &name) {
                 Some(path) => return DialogAnswer::Chosen(path),
                 None if asked.elapsed() >= SYSTEM_DIALOG_MIN_TIME => {
                     return DialogAnswer::Cancelled;
@@ -268,13 +273,18 @@ impl FileDialogs {
             }
         }
         let folder = self.start_folder();
-        self.browser = Some(FileBrowser::new(action, folder));
+        self.browser = Some(FileBrowser::new(action, folder, name));
         DialogAnswer::InWindow { fell_back }
     }
 
     /// The action the in-window dialog is open for, if it is.
     pub fn open_for(&self) -> Option<FileAction> {
         self.browser.as_ref().map(|b| b.action)
+    }
+
+    /// The file name the in-window dialog holds, if it is open.
+    pub fn typed_name(&self) -> Option<&str> {
+        self.browser.as_ref().map(|b| b.name.as_str())
     }
 
     /// The next in-window dialog starts in the folder of `path`.
@@ -411,7 +421,7 @@ impl FileDialogs {
         }
         if path.is_dir() {
             browser.enter(path);
-            browser.name = action.default_name().into();
+            browser.name = browser.suggested.clone();
             return;
         }
         if !action.saves() && !path.is_file() {
@@ -433,7 +443,7 @@ impl FileDialogs {
 }
 
 /// The system's file dialog for `action`; None when cancelled or not shown.
-fn system_dialog(action: FileAction, folder: &Path) -> Option<PathBuf> {
+fn system_dialog(action: FileAction, folder: &Path, name: &str) -> Option<PathBuf> {
     let dialog = rfd::FileDialog::new()
         .set_title(action.title())
         .set_directory(folder);
@@ -441,7 +451,7 @@ fn system_dialog(action: FileAction, folder: &Path) -> Option<PathBuf> {
     let kind = extensions.join("/").to_uppercase();
     if action.saves() {
         dialog
-            .set_file_name(action.default_name())
+            .set_file_name(name)
             .add_filter(&kind, &extensions[..1])
             .save_file()
     } else {
