@@ -226,3 +226,84 @@ fn soft_selection_pulls_near_handles_part_of_the_way_and_far_ones_not_at_all() {
     assert!(partial >= 1, "some handles follow part of the way");
     assert!(still >= 1, "far handles stay");
 }
+
+/// The comb's cage with every vertex moved by up to 1% of its mean edge, in a
+/// fixed pseudo-random direction: symmetric only to within a tolerance, as an
+/// artist's cage is.
+fn roughly_symmetric_comb(dir: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let (mesh, _, cage, _) = common::comb_scene(dir, 200);
+    let rest = cage.positions();
+    let edge = pmvc::app::pose_tools::mean_edge_length(rest, cage.triangles());
+    let moved: Vec<DVec3> = rest
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let k = i as f64;
+            let wobble = DVec3::new((k * 1.7).sin(), (k * 2.3).cos(), (k * 0.9).sin());
+            p + wobble.normalize() * 0.01 * edge
+        })
+        .collect();
+    let path = common::write(
+        dir,
+        "rough_cage.obj",
+        &common::cage_obj(&cage.with_positions(moved)),
+    );
+    (mesh, path)
+}
+
+#[test]
+fn symmetry_pairs_a_cage_symmetric_to_within_one_percent_of_an_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage) = roughly_symmetric_comb(dir.path());
+    let Some(mut harness) = editor_with(pmvc::app::EditorOptions {
+        mesh: Some(mesh),
+        cage: Some(cage),
+        resolution: Some(TEST_RESOLUTION),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    let handles = harness.state().document().pose().len();
+    harness.state_mut().pose_tool_settings_mut().symmetry = Some(2);
+    // Exact matching finds no partner on such a cage.
+    harness
+        .state_mut()
+        .pose_tool_settings_mut()
+        .mirror_tolerance = 0.0;
+    assert_eq!(harness.state().handles_without_partner(), handles);
+    // The default tolerance, a tenth of the mean edge, pairs every handle.
+    harness
+        .state_mut()
+        .pose_tool_settings_mut()
+        .mirror_tolerance = pmvc::app::pose_tools::PoseToolSettings::default().mirror_tolerance;
+    assert_eq!(harness.state().handles_without_partner(), 0);
+    harness.run_steps(2);
+    use egui_kittest::kittest::Queryable;
+    let report = format!("{handles} of {handles} handles have a mirror partner");
+    assert!(
+        harness.query_by_label(&report).is_some(),
+        "the panel says how many handles are paired"
+    );
+
+    // An edit of one handle moves its partner the mirrored way.
+    let start = harness.state().document().pose().to_vec();
+    let back = 0;
+    harness.state_mut().select_only([back]);
+    hover_view(&mut harness);
+    press(&mut harness, Key::G);
+    press(&mut harness, Key::Z);
+    type_number(&mut harness, "-0.25");
+    press(&mut harness, Key::Enter);
+    let pose = harness.state().document().pose().to_vec();
+    let moved: Vec<usize> = (0..handles)
+        .filter(|&i| !close(pose[i], start[i]))
+        .collect();
+    assert_eq!(moved.len(), 2, "the handle and its partner: {moved:?}");
+    let front = moved.into_iter().find(|&i| i != back).unwrap();
+    assert!(close(pose[back], start[back] + DVec3::new(0.0, 0.0, -0.25)));
+    assert!(close(
+        pose[front],
+        start[front] + DVec3::new(0.0, 0.0, 0.25)
+    ));
+}

@@ -53,7 +53,14 @@ pub struct PoseToolSettings {
     pub soft_selection: bool,
     /// How far they follow from, as a fraction of the cage diagonal.
     pub soft_radius: f64,
+    /// How far a handle's mirror image may be from its partner's rest
+    /// position, as a fraction of the rest cage's mean edge: artists' cages are
+    /// symmetric only to within a tolerance.
+    pub mirror_tolerance: f64,
 }
+
+/// The mirror tolerances offered, as fractions of the mean cage edge.
+pub const MIRROR_TOLERANCES: std::ops::RangeInclusive<f64> = 0.0..=0.5;
 
 impl Default for PoseToolSettings {
     fn default() -> Self {
@@ -63,6 +70,7 @@ impl Default for PoseToolSettings {
             symmetry: None,
             soft_selection: false,
             soft_radius: 0.15,
+            mirror_tolerance: 0.1,
         }
     }
 }
@@ -71,14 +79,17 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 
 /// Each handle's mirror partner across the plane `axis = centre`, matched by rest
 /// position within `tolerance`: itself for a handle on the plane, `None` for one
-/// with no partner.
+/// with no partner. Partners are mutual: a handle is paired with the nearest
+/// handle to its mirror image only when it is that handle's nearest too, so a
+/// wide tolerance never gives two handles one partner.
 pub fn mirror_partners(
     rest: &[DVec3],
     axis: usize,
     centre: f64,
     tolerance: f64,
 ) -> Vec<Option<usize>> {
-    rest.iter()
+    let nearest: Vec<Option<usize>> = rest
+        .iter()
         .map(|&p| {
             let mut mirrored = p;
             mirrored[axis] = 2.0 * centre - p[axis];
@@ -89,7 +100,31 @@ pub fn mirror_partners(
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(j, _)| j)
         })
+        .collect();
+    nearest
+        .iter()
+        .enumerate()
+        .map(|(i, &partner)| partner.filter(|&j| nearest[j] == Some(i)))
         .collect()
+}
+
+/// The mean length of the edges of `triangles` over `positions`, each edge
+/// counted once.
+pub fn mean_edge_length(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let edges: BTreeSet<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    let lengths = edges.iter().filter_map(|&(a, b)| {
+        Some((*positions.get(a as usize)? - *positions.get(b as usize)?).length())
+    });
+    let (sum, count) = lengths.fold((0.0, 0usize), |(s, n), l| (s + l, n + 1));
+    if count == 0 {
+        0.0
+    } else {
+        sum / count as f64
+    }
 }
 
 /// The centre of `points`' bounding box along `axis`.
@@ -209,6 +244,33 @@ mod tests {
         assert_eq!(centre, 0.0);
         let partners = mirror_partners(&rest, 0, centre, 1e-9);
         assert_eq!(partners, vec![Some(2), Some(1), Some(0), None]);
+    }
+
+    #[test]
+    fn partners_within_a_tolerance_are_mutual() {
+        // 0 and 2 mirror each other to 1% off; 3 is as near to 2's image as 0
+        // is, but 2 is nearer to 0's image: 3 gets no partner of its own.
+        let rest = [
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(0.0, 2.0, 0.0),
+            DVec3::new(1.01, 0.0, 0.0),
+            DVec3::new(-1.0, 0.02, 0.0),
+        ];
+        assert_eq!(
+            mirror_partners(&rest, 0, 0.0, 1e-9),
+            vec![None, Some(1), None, None]
+        );
+        let partners = mirror_partners(&rest, 0, 0.0, 0.05);
+        assert_eq!(partners, vec![Some(2), Some(1), Some(0), None]);
+    }
+
+    #[test]
+    fn the_mean_edge_counts_each_edge_once() {
+        let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        // Four sides of 1 and one diagonal of √2, the shared edge once.
+        let mean = mean_edge_length(&square, &[[0, 1, 2], [0, 2, 3]]);
+        assert!((mean - (4.0 + 2f64.sqrt()) / 5.0).abs() < 1e-12);
+        assert_eq!(mean_edge_length(&square, &[]), 0.0);
     }
 
     #[test]

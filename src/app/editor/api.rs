@@ -187,6 +187,11 @@ impl EditorApp {
         self.panels.pose_tools.tools
     }
 
+    /// The posing tools' settings, to change as the Posing tools section does.
+    pub fn pose_tool_settings_mut(&mut self) -> &mut PoseToolSettings {
+        &mut self.panels.pose_tools.tools
+    }
+
     /// The 3D cursor, in world coordinates.
     pub fn cursor(&self) -> DVec3 {
         self.panels.pose_tools.tools.cursor

@@ -3,7 +3,7 @@
 
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
-use crate::app::pose_tools::{Pivot, PoseToolSettings, AXIS_NAMES};
+use crate::app::pose_tools::{Pivot, PoseToolSettings, AXIS_NAMES, MIRROR_TOLERANCES};
 use crate::app::viewport::handles_without_partner;
 
 /// The section and the settings it owns, which the viewport's edits read.
@@ -35,7 +35,34 @@ impl PosePanel {
             }
         });
         if self.tools.symmetry.is_some() {
+            ui.horizontal(|ui| {
+                let mut percent = self.tools.mirror_tolerance * 100.0;
+                let range = MIRROR_TOLERANCES;
+                let slider = ui
+                    .add(
+                        egui::Slider::new(
+                            &mut percent,
+                            range.start() * 100.0..=range.end() * 100.0,
+                        )
+                        .suffix("%")
+                        .max_decimals(0)
+                        .text("tolerance"),
+                    )
+                    .on_hover_text(
+                        "How far a handle's mirror image may be from its partner in the rest \
+                         cage, in % of the cage's mean edge: artists' cages are symmetric only \
+                         to within a tolerance",
+                    );
+                if slider.changed() {
+                    self.tools.mirror_tolerance = percent / 100.0;
+                }
+            });
             let unpaired = handles_without_partner(cx.document(), &self.tools);
+            let handles = cx.document().pose().len();
+            ui.label(format!(
+                "{} of {handles} handles have a mirror partner",
+                handles - unpaired
+            ));
             if unpaired > 0 {
                 ui.colored_label(
                     ui.visuals().warn_fg_color,

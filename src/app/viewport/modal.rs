@@ -8,15 +8,12 @@
 use crate::app::document::Document;
 use crate::app::model::{Command, GestureKind};
 use crate::app::pose_tools::{
-    follow_weights, mid_plane, mirror_partners, posed, Pivot, PoseToolSettings, Transform,
-    AXIS_NAMES,
+    follow_weights, mean_edge_length, mid_plane, mirror_partners, posed, Pivot, PoseToolSettings,
+    Transform, AXIS_NAMES,
 };
 use crate::app::views::{ViewportContext, Views};
 use egui::{Color32, Key, Pos2, Rect, Stroke};
 use glam::{DVec3, Vec2};
-
-/// Partners are matched within this fraction of the cage diagonal.
-const MIRROR_TOLERANCE: f64 = 1e-3;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TransformKind {
@@ -55,21 +52,10 @@ pub fn pose_transformed(
     start: &[DVec3],
     transform: &Transform,
 ) -> Vec<DVec3> {
-    let rest = document.cage().positions();
     let diagonal = document.cage().diagonal();
     let soft = tools.soft_selection.then_some(tools.soft_radius * diagonal);
     let weights = follow_weights(start, document.selection(), soft);
-    let partners = tools.symmetry.map(|axis| {
-        (
-            axis,
-            mirror_partners(
-                rest,
-                axis,
-                mid_plane(rest, axis),
-                MIRROR_TOLERANCE * diagonal,
-            ),
-        )
-    });
+    let partners = symmetry_partners(document, tools);
     let symmetry = partners.as_ref().map(|(axis, p)| (*axis, p.as_slice()));
     posed(
         start,
@@ -95,15 +81,26 @@ fn pivot_of(document: &Document, tools: &PoseToolSettings, pose: &[DVec3]) -> DV
 
 /// Handles with no mirror partner under the symmetry in use.
 pub fn handles_without_partner(document: &Document, tools: &PoseToolSettings) -> usize {
-    let Some(axis) = tools.symmetry else {
-        return 0;
-    };
-    let rest = document.cage().positions();
-    let tolerance = MIRROR_TOLERANCE * document.cage().diagonal();
-    mirror_partners(rest, axis, mid_plane(rest, axis), tolerance)
-        .iter()
-        .filter(|p| p.is_none())
-        .count()
+    symmetry_partners(document, tools).map_or(0, |(_, partners)| {
+        partners.iter().filter(|p| p.is_none()).count()
+    })
+}
+
+/// Under the symmetry in use, its axis and each handle's mirror partner in the
+/// rest cage, across the plane through the cage's bounding-box centre, within
+/// the tools' tolerance (a share of the mean cage edge).
+pub fn symmetry_partners(
+    document: &Document,
+    tools: &PoseToolSettings,
+) -> Option<(usize, Vec<Option<usize>>)> {
+    let axis = tools.symmetry?;
+    let cage = document.cage();
+    let rest = cage.positions();
+    let tolerance = tools.mirror_tolerance * mean_edge_length(rest, cage.triangles());
+    Some((
+        axis,
+        mirror_partners(rest, axis, mid_plane(rest, axis), tolerance),
+    ))
 }
 
 /// Apply `transform` to the selection as one undo step.
