@@ -30,6 +30,22 @@ fn type_number(harness: &mut Harness<'static, EditorApp>, text: &str) {
     harness.run_steps(2);
 }
 
+/// Select `handle` alone and move it along z by the typed `amount` (G, Z, the
+/// number, Enter); the pose after.
+fn move_along_z(
+    harness: &mut Harness<'static, EditorApp>,
+    handle: usize,
+    amount: &str,
+) -> Vec<DVec3> {
+    harness.state_mut().select_only([handle]);
+    hover_view(harness);
+    press(harness, Key::G);
+    press(harness, Key::Z);
+    type_number(harness, amount);
+    press(harness, Key::Enter);
+    harness.state().document().pose().to_vec()
+}
+
 fn close(a: DVec3, b: DVec3) -> bool {
     (a - b).length() < 1e-9
 }
@@ -173,13 +189,7 @@ fn symmetry_mirrors_a_move_onto_the_partner_handle() {
     harness.run_steps(2);
     assert_eq!(harness.state().handles_without_partner(), 0);
 
-    harness.state_mut().select_only([back]);
-    hover_view(&mut harness);
-    press(&mut harness, Key::G);
-    press(&mut harness, Key::Z);
-    type_number(&mut harness, "-0.25");
-    press(&mut harness, Key::Enter);
-    let pose = harness.state().document().pose().to_vec();
+    let pose = move_along_z(&mut harness, back, "-0.25");
     assert!(close(pose[back], start[back] + DVec3::new(0.0, 0.0, -0.25)));
     assert!(
         close(pose[front], start[front] + DVec3::new(0.0, 0.0, 0.25)),
@@ -289,13 +299,7 @@ fn symmetry_pairs_a_cage_symmetric_to_within_one_percent_of_an_edge() {
     // An edit of one handle moves its partner the mirrored way.
     let start = harness.state().document().pose().to_vec();
     let back = 0;
-    harness.state_mut().select_only([back]);
-    hover_view(&mut harness);
-    press(&mut harness, Key::G);
-    press(&mut harness, Key::Z);
-    type_number(&mut harness, "-0.25");
-    press(&mut harness, Key::Enter);
-    let pose = harness.state().document().pose().to_vec();
+    let pose = move_along_z(&mut harness, back, "-0.25");
     let moved: Vec<usize> = (0..handles)
         .filter(|&i| !close(pose[i], start[i]))
         .collect();
