@@ -304,3 +304,53 @@ fn a_generated_cage_binds_and_its_handles_drag_the_mesh() {
     let moved = max_distance(&drawn, &rest_drawn);
     assert!(moved > 1e-3, "the drawn mesh moved by {moved}");
 }
+
+#[test]
+fn a_mesh_inside_the_cages_box_but_outside_the_cage_gets_a_box_and_the_window() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let cage = harness.state().document().cage().clone();
+    // A point in the cage's bounding box but outside the cage: between fingers.
+    let (lo, hi) = pmvc::geometry::bounds_of(cage.positions());
+    let steps = 64;
+    let grid: Vec<DVec3> = (1..steps)
+        .flat_map(|i| (1..steps).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let t = DVec3::new(i as f64, j as f64, steps as f64 / 2.0) / steps as f64;
+            lo + (hi - lo) * t
+        })
+        .collect();
+    let classes = classify_points(&cage, &grid);
+    let gap = grid[*classes.outside.first().expect("the comb has gaps") as usize];
+    let size = 1e-3 * cage.diagonal();
+    let tetra = [
+        gap,
+        gap + DVec3::X * size,
+        gap + DVec3::Y * size,
+        gap + DVec3::Z * size,
+    ];
+    assert_eq!(
+        classify_points(&cage, &tetra).outside.len(),
+        4,
+        "the test mesh is wholly outside the cage"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = common::write(
+        dir.path(),
+        "between.obj",
+        &common::triangles_obj(&tetra, &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]),
+    );
+    assert!(harness
+        .state_mut()
+        .open_file(pmvc::app::FileRole::Mesh, &path));
+    harness.run_steps(2);
+    let app = harness.state();
+    assert!(
+        app.cage_generation().is_open(),
+        "a mesh the cage holds none of is offered a cage"
+    );
+    assert_eq!(app.document().cage().vertex_count(), 8);
+    assert!(classify_points(app.document().cage(), &tetra)
+        .outside
+        .is_empty());
+}

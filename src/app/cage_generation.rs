@@ -385,13 +385,25 @@ pub fn loose_box_cage(mesh: &TriMesh) -> Option<Cage> {
     Cage::new(cage).ok().map(|(cage, _)| cage)
 }
 
-/// Whether any vertex of `mesh` lies in the bounding box of `cage`: a cage that
-/// holds none of the mesh is no cage for it.
+/// Whether any vertex of `mesh` is inside `cage` (or on it): a cage that holds
+/// none of the mesh is no cage for it, even when the mesh lies within its
+/// bounding box (in the gaps between a hand's fingers, say). Only vertices in
+/// the bounding box are classified, a block at a time, stopping at the first
+/// block that has one inside.
 pub fn cage_reaches(cage: &Cage, mesh: &TriMesh) -> bool {
+    /// Vertices classified at a time: a mesh that is inside stops after one.
+    const BLOCK: usize = 4096;
     let (lo, hi) = crate::geometry::bounds_of(cage.positions());
-    mesh.positions
+    let in_box: Vec<DVec3> = mesh
+        .positions
         .iter()
-        .any(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+        .copied()
+        .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+        .collect();
+    in_box.chunks(BLOCK).any(|block| {
+        let classes = crate::geometry::classify_points(cage, block);
+        classes.outside.len() < block.len()
+    })
 }
 
 #[cfg(test)]
