@@ -176,3 +176,56 @@ fn help_shortcuts_lists_every_entry_of_the_table() {
         );
     }
 }
+
+#[test]
+fn blenders_selection_keys_select_all_none_and_the_inverse() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    hover_view(&mut harness);
+    let handles = harness.state().document().pose().len();
+    tap(&mut harness, Modifiers::NONE, Key::A);
+    assert_eq!(harness.state().document().selection().len(), handles);
+    tap(&mut harness, Modifiers::ALT, Key::A);
+    assert!(harness.state().document().selection().is_empty());
+    harness.state_mut().select_only([0, 3]);
+    tap(&mut harness, Modifiers::COMMAND, Key::I);
+    let selection = harness.state().document().selection();
+    assert_eq!(selection.len(), handles - 2);
+    assert!(!selection.contains(&0) && !selection.contains(&3));
+}
+
+#[test]
+fn number_keys_look_from_the_front_right_top_and_with_ctrl_the_opposite_sides() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    hover_view(&mut harness);
+    let before = harness.state().camera();
+    let cases = [
+        (Modifiers::NONE, Key::Num1, (0.0, 0.0)),
+        (Modifiers::COMMAND, Key::Num1, (std::f32::consts::PI, 0.0)),
+        (
+            Modifiers::NONE,
+            Key::Num3,
+            (std::f32::consts::FRAC_PI_2, 0.0),
+        ),
+        (
+            Modifiers::COMMAND,
+            Key::Num3,
+            (-std::f32::consts::FRAC_PI_2, 0.0),
+        ),
+        (Modifiers::NONE, Key::Num7, (0.0, 89f32.to_radians())),
+        (Modifiers::COMMAND, Key::Num7, (0.0, -89f32.to_radians())),
+    ];
+    for (modifiers, key, (yaw, pitch)) in cases {
+        tap(&mut harness, modifiers, key);
+        let camera = harness.state().camera();
+        assert!(
+            (camera.yaw - yaw).abs() < 1e-6 && (camera.pitch - pitch).abs() < 1e-6,
+            "{modifiers:?}+{key:?}: yaw {} pitch {}",
+            camera.yaw,
+            camera.pitch
+        );
+        assert_eq!(camera.target, before.target, "the target stays");
+        assert_eq!(camera.distance, before.distance, "the distance stays");
+    }
+}

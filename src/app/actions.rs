@@ -8,6 +8,7 @@ use super::editor::FileRole;
 use super::model::Command;
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
+use super::shortcuts::ViewSide;
 use super::ui::file_dialog::FileAction;
 use crate::coords::{Method, Parameter};
 use glam::DVec3;
@@ -107,6 +108,12 @@ pub enum Action {
     HideFirstRunLine,
     /// Help > Shortcuts.
     ShowShortcuts,
+    /// Select every handle (A).
+    SelectAll,
+    /// Select the handles not selected, and only those (Ctrl+I).
+    InvertSelection,
+    /// Every view looks at the scene from this side.
+    ViewFrom(ViewSide),
 }
 
 /// A step of the blend slider's gesture.

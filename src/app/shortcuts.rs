@@ -17,6 +17,10 @@ pub enum Shortcut {
     Redo,
     Undo,
     Deselect,
+    SelectAll,
+    InvertSelection,
+    /// Look at the scene from one side (Blender's numpad views).
+    ViewFrom(ViewSide),
     FrameSelection,
     FrameAll,
     NextMethod,
@@ -25,6 +29,44 @@ pub enum Shortcut {
     SaveSessionAs,
     SaveSession,
     OpenSession,
+}
+
+/// A side to look at the scene from, as Blender's numpad views: the scene's y
+/// axis is up, and the front looks along −z.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewSide {
+    Front,
+    Back,
+    Right,
+    Left,
+    Top,
+    Bottom,
+}
+
+impl ViewSide {
+    /// The camera's yaw and pitch (radians) for this side.
+    pub fn yaw_pitch(self) -> (f32, f32) {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        match self {
+            ViewSide::Front => (0.0, 0.0),
+            ViewSide::Back => (PI, 0.0),
+            ViewSide::Right => (FRAC_PI_2, 0.0),
+            ViewSide::Left => (-FRAC_PI_2, 0.0),
+            ViewSide::Top => (0.0, FRAC_PI_2),
+            ViewSide::Bottom => (0.0, -FRAC_PI_2),
+        }
+    }
+
+    fn describe(self) -> &'static str {
+        match self {
+            ViewSide::Front => "View from the front (+z)",
+            ViewSide::Back => "View from the back (−z)",
+            ViewSide::Right => "View from the right (+x)",
+            ViewSide::Left => "View from the left (−x)",
+            ViewSide::Top => "View from the top (+y)",
+            ViewSide::Bottom => "View from below (−y)",
+        }
+    }
 }
 
 /// How a shortcut's keys are pressed.
@@ -52,6 +94,7 @@ pub enum Scope {
 }
 
 const COMMAND: Modifiers = Modifiers::COMMAND;
+const ALT: Modifiers = Modifiers::ALT;
 const COMMAND_SHIFT: Modifiers = Modifiers {
     shift: true,
     ..Modifiers::COMMAND
@@ -83,6 +126,43 @@ pub const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
     (Keys::With(COMMAND, Key::Y), Scope::Viewport, Shortcut::Redo),
     (Keys::With(COMMAND, Key::Z), Scope::Viewport, Shortcut::Undo),
     (Keys::Any(Key::Escape), Scope::Viewport, Shortcut::Deselect),
+    (Keys::Plain(Key::A), Scope::Viewport, Shortcut::SelectAll),
+    (Keys::With(ALT, Key::A), Scope::Viewport, Shortcut::Deselect),
+    (
+        Keys::With(COMMAND, Key::I),
+        Scope::Viewport,
+        Shortcut::InvertSelection,
+    ),
+    (
+        Keys::Plain(Key::Num1),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Front),
+    ),
+    (
+        Keys::With(COMMAND, Key::Num1),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Back),
+    ),
+    (
+        Keys::Plain(Key::Num3),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Right),
+    ),
+    (
+        Keys::With(COMMAND, Key::Num3),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Left),
+    ),
+    (
+        Keys::Plain(Key::Num7),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Top),
+    ),
+    (
+        Keys::With(COMMAND, Key::Num7),
+        Scope::Viewport,
+        Shortcut::ViewFrom(ViewSide::Bottom),
+    ),
     (
         Keys::Plain(Key::F),
         Scope::Viewport,
@@ -197,6 +277,9 @@ impl Shortcut {
             Shortcut::Redo => "Redo",
             Shortcut::Undo => "Undo",
             Shortcut::Deselect => "Deselect every handle",
+            Shortcut::SelectAll => "Select every handle",
+            Shortcut::InvertSelection => "Invert the selection",
+            Shortcut::ViewFrom(side) => side.describe(),
             Shortcut::FrameSelection => "Frame the selection",
             Shortcut::FrameAll => "Frame the whole scene",
             Shortcut::NextMethod => "Show the next family",
@@ -217,6 +300,9 @@ impl Shortcut {
             Shortcut::Redo => Action::Redo,
             Shortcut::Undo => Action::Undo,
             Shortcut::Deselect => Action::Apply(Command::Select(Selection::only([]))),
+            Shortcut::SelectAll => Action::SelectAll,
+            Shortcut::InvertSelection => Action::InvertSelection,
+            Shortcut::ViewFrom(side) => Action::ViewFrom(side),
             Shortcut::FrameSelection => Action::FrameSelection,
             Shortcut::FrameAll => Action::FrameAll,
             Shortcut::NextMethod => Action::NextMethod,

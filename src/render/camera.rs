@@ -19,6 +19,9 @@ fn fov_y(aspect: f32) -> f32 {
     }
 }
 
+/// How far above or below the xz plane a camera may look from.
+const PITCH_LIMIT_DEGREES: f32 = 89.0;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitCamera {
     /// In scene coordinates, except in session files, which hold world ones.
@@ -82,9 +85,15 @@ impl OrbitCamera {
 
     /// Rotate by a mouse motion of `delta` pixels.
     pub fn orbit(&mut self, delta: Vec2) {
-        self.yaw -= delta.x * 0.008;
-        let limit = 89f32.to_radians();
-        self.pitch = (self.pitch + delta.y * 0.008).clamp(-limit, limit);
+        self.look_from(self.yaw - delta.x * 0.008, self.pitch + delta.y * 0.008);
+    }
+
+    /// Look from `yaw` and `pitch` (radians), the pitch kept inside ±89° so
+    /// that the view's up stays defined; the target and distance stay.
+    pub fn look_from(&mut self, yaw: f32, pitch: f32) {
+        let limit = PITCH_LIMIT_DEGREES.to_radians();
+        self.yaw = yaw;
+        self.pitch = pitch.clamp(-limit, limit);
     }
 
     /// Move the target with the mouse by `delta` pixels in a viewport whose shorter

@@ -9,7 +9,7 @@ use crate::app::bind_queue::{Finished, JobError};
 use crate::app::compare::Pane;
 use crate::app::document::WeightSet;
 use crate::app::files;
-use crate::app::model::{Command, GestureKind, Outcome};
+use crate::app::model::{Command, GestureKind, Outcome, Selection};
 use crate::app::recent::RecentEntry;
 use crate::app::session::SessionSettings;
 use crate::app::ui::file_dialog::{DialogAnswer, FileAction};
@@ -138,6 +138,22 @@ impl EditorApp {
             Action::CageWindow(request) => self.cage_window(request),
             Action::HideFirstRunLine => self.panels.first_run_hint = false,
             Action::ShowShortcuts => self.panels.shortcuts_help.open = true,
+            Action::SelectAll => {
+                let handles = self.model.document().pose().len();
+                self.apply(Command::Select(Selection::only(0..handles)));
+            }
+            Action::InvertSelection => {
+                let document = self.model.document();
+                let selected = document.selection();
+                let others: Vec<usize> = (0..document.pose().len())
+                    .filter(|i| !selected.contains(i))
+                    .collect();
+                self.apply(Command::Select(Selection::only(others)));
+            }
+            Action::ViewFrom(side) => {
+                let (yaw, pitch) = side.yaw_pitch();
+                self.views.viewport.look_from(yaw, pitch);
+            }
         }
     }
 

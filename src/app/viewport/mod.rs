@@ -91,6 +91,14 @@ impl ViewportState {
         }
     }
 
+    /// Every camera looks from `yaw` and `pitch` (radians; the pitch kept
+    /// within the cameras' limit), at the same target and distance.
+    pub fn look_from(&mut self, yaw: f32, pitch: f32) {
+        for camera in &mut self.cameras {
+            camera.look_from(yaw, pitch);
+        }
+    }
+
     /// Every view takes the first view's camera.
     pub fn unify_cameras(&mut self) {
         self.cameras = [self.cameras[0]; MAX_VIEWS];
