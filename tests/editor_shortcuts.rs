@@ -229,3 +229,33 @@ fn number_keys_look_from_the_front_right_top_and_with_ctrl_the_opposite_sides() 
         assert_eq!(camera.distance, before.distance, "the distance stays");
     }
 }
+
+#[test]
+fn alt_drag_orbits_even_when_it_starts_on_a_handle() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    let (handle, at) = isolated_handle(&harness);
+    let pose = harness.state().document().pose().to_vec();
+    let camera = harness.state().camera();
+    drag(
+        &mut harness,
+        at,
+        at + egui::vec2(80.0, 30.0),
+        Modifiers::ALT,
+    );
+    assert_eq!(
+        harness.state().document().pose(),
+        pose.as_slice(),
+        "handle {handle} did not move"
+    );
+    assert_ne!(harness.state().camera().yaw, camera.yaw, "the view orbited");
+    // Without Alt a drag from the handle, where it now is, moves it.
+    let at = harness.state().handle_screen_position(handle).unwrap();
+    drag(
+        &mut harness,
+        at,
+        at + egui::vec2(0.0, -30.0),
+        Modifiers::NONE,
+    );
+    assert_ne!(harness.state().document().pose(), pose.as_slice());
+}

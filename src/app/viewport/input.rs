@@ -117,7 +117,11 @@ impl Views {
         if response.drag_started() {
             let origin = press_origin.unwrap_or(rect.center());
             self.viewport.drag = Some(if response.dragged_by(PointerButton::Primary) {
-                if modifiers.command || ui.input(|i| i.key_down(Key::B)) {
+                // Alt+drag orbits wherever it starts, a handle included, as in
+                // Blender with "emulate three-button mouse".
+                if modifiers.alt {
+                    Drag::Orbit
+                } else if modifiers.command || ui.input(|i| i.key_down(Key::B)) {
                     Drag::Box {
                         origin,
                         additive: modifiers.shift,

@@ -343,6 +343,7 @@ impl Views {
                 Color32::from_gray(200),
             );
         }
+        self.draw_axes(&painter, index, rect);
         self.draw_transform(cx, &painter, index, rect);
         if let Some(proposal) = cx.facts.proposal {
             self.draw_proposed_cage(proposal, &painter, index);
@@ -354,6 +355,53 @@ impl Views {
                 let title = self.colour_bar_title(kind);
                 draw_colour_bar(&painter, rect, &shading, range, title, note);
             }
+        }
+    }
+
+    /// The world axes as view `pane`'s camera sees them, small, at its right
+    /// edge below the title and notice lines: x red, y green, z blue, those
+    /// pointing away drawn first and dimmer.
+    fn draw_axes(&self, painter: &egui::Painter, pane: usize, rect: Rect) {
+        const LENGTH: f32 = 22.0;
+        const MARGIN: f32 = 34.0;
+        /// Below the title (8 points down) and the notice under it (28).
+        const DOWN: f32 = 76.0;
+        let camera = self.camera_of(pane);
+        let (right, up) = camera.right_up();
+        let towards_viewer = (camera.eye() - camera.target).normalize_or_zero();
+        let centre = rect.right_top() + egui::vec2(-MARGIN, DOWN);
+        let colours = [
+            Color32::from_rgb(230, 80, 80),
+            Color32::from_rgb(110, 200, 90),
+            Color32::from_rgb(90, 140, 240),
+        ];
+        let mut axes: Vec<(usize, glam::Vec3)> = [glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z]
+            .into_iter()
+            .enumerate()
+            .collect();
+        axes.sort_by(|a, b| a.1.dot(towards_viewer).total_cmp(&b.1.dot(towards_viewer)));
+        for (index, axis) in axes {
+            let tip = centre + egui::vec2(axis.dot(right), -axis.dot(up)) * LENGTH;
+            let colour = if axis.dot(towards_viewer) < -1e-3 {
+                colours[index].gamma_multiply(0.5)
+            } else {
+                colours[index]
+            };
+            painter.line_segment([centre, tip], Stroke::new(2.0, colour));
+            // An axis pointing at the viewer has no direction on screen.
+            let along = tip - centre;
+            let outward = if along.length() > 1e-3 {
+                along / along.length()
+            } else {
+                egui::Vec2::ZERO
+            };
+            painter.text(
+                tip + outward * 7.0,
+                egui::Align2::CENTER_CENTER,
+                ["x", "y", "z"][index],
+                egui::FontId::proportional(12.0),
+                colour,
+            );
         }
     }
 
