@@ -311,3 +311,44 @@ fn symmetry_pairs_a_cage_symmetric_to_within_one_percent_of_an_edge() {
         start[front] + DVec3::new(0.0, 0.0, 0.25)
     ));
 }
+
+/// One turn of the wheel upwards, and the frames its smoothing takes.
+fn wheel_up(harness: &mut Harness<'static, EditorApp>) {
+    harness.event(Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        modifiers: Modifiers::NONE,
+        source: egui::MouseWheelSource::Wheel,
+    });
+    harness.run_steps(10);
+}
+
+#[test]
+fn the_wheel_during_a_transform_sets_the_soft_selection_radius() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().pose_tool_settings_mut().soft_selection = true;
+    let radius = harness.state().pose_tool_settings().soft_radius;
+    let camera = harness.state().camera();
+    harness.state_mut().select_only([10]);
+    hover_view(&mut harness);
+    press(&mut harness, Key::G);
+    assert!(harness.state().transform_under_way().is_some());
+    wheel_up(&mut harness);
+    let wider = harness.state().pose_tool_settings().soft_radius;
+    assert!(wider > radius, "the wheel up widens: {radius} -> {wider}");
+    assert_eq!(
+        harness.state().camera().distance,
+        camera.distance,
+        "no zoom"
+    );
+    assert!(harness.state().transform_under_way().is_some());
+    press(&mut harness, Key::Escape);
+    // Without soft selection the wheel leaves it alone.
+    harness.state_mut().pose_tool_settings_mut().soft_selection = false;
+    press(&mut harness, Key::G);
+    wheel_up(&mut harness);
+    assert_eq!(harness.state().pose_tool_settings().soft_radius, wider);
+    press(&mut harness, Key::Escape);
+}

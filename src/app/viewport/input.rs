@@ -25,6 +25,10 @@ pub(in crate::app) enum Drag {
     },
 }
 
+/// The soft-selection radii the wheel reaches during a transform, as fractions
+/// of the cage diagonal: those the Posing tools' slider offers.
+const SOFT_RADII: (f64, f64) = (0.01, 1.0);
+
 /// The axis held down (X, Y or Z) that constrains a move.
 fn held_axis(ui: &egui::Ui) -> Option<DVec3> {
     ui.input(|i| {
@@ -59,9 +63,16 @@ impl Views {
             )
         });
 
-        // A G, R or S transform takes the pointer until it is confirmed or cancelled.
+        // A G, R or S transform takes the pointer until it is confirmed or
+        // cancelled; with soft selection on, its wheel sets the radius, as
+        // Blender's proportional size.
         if self.viewport.modal.is_some() {
             if response.hovered() {
+                if cx.pose_tools.soft_selection && scroll != 0.0 {
+                    // Wheel up (scroll > 0) widens, as zooming in does not.
+                    let radius = cx.pose_tools.soft_radius * f64::from((scroll * 0.004).exp());
+                    cx.pose_tools.soft_radius = radius.clamp(SOFT_RADII.0, SOFT_RADII.1);
+                }
                 self.transform_pointer(cx, response);
             }
             return;

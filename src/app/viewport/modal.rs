@@ -385,6 +385,21 @@ impl Views {
                     Stroke::new(1.0, Color32::from_gray(220)),
                 );
                 painter.circle_filled(pivot, 3.0, Color32::WHITE);
+                if cx.pose_tools.soft_selection {
+                    // The soft-selection radius about the pivot, in the view
+                    // plane: what the wheel sets during the transform.
+                    let radius = cx.pose_tools.soft_radius * cx.model.document().cage().diagonal();
+                    let (right, _) = self.camera_of(pane).right_up();
+                    let rim = projection.project_world(modal.pivot + right.as_dvec3() * radius);
+                    if let Some(rim) = rim {
+                        let on_screen = Pos2::new(rim.x, rim.y).distance(pivot);
+                        painter.circle_stroke(
+                            pivot,
+                            on_screen,
+                            Stroke::new(1.0, Color32::from_rgb(255, 170, 60)),
+                        );
+                    }
+                }
             }
         }
         let transform = self.modal_transform(modal);
