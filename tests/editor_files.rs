@@ -252,3 +252,73 @@ fn the_coloured_export_has_the_colours_the_gpu_draws() {
         "the heatmap is in the colours"
     );
 }
+
+/// A cube of six quads from -1 to 1, faces outward, as an artist's cage file.
+const QUAD_CUBE: &str =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+/// A face's corners from its `f` line, rotated to start at the smallest.
+fn face_key(line: &str) -> Vec<u32> {
+    let corners: Vec<u32> = line
+        .split_whitespace()
+        .skip(1)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    let first = (0..corners.len()).min_by_key(|&i| corners[i]).unwrap();
+    corners[first..]
+        .iter()
+        .chain(&corners[..first])
+        .copied()
+        .collect()
+}
+
+fn faces_of(text: &str) -> Vec<Vec<u32>> {
+    let mut faces: Vec<Vec<u32>> = text
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(face_key)
+        .collect();
+    faces.sort();
+    faces
+}
+
+#[test]
+fn save_cage_keeps_the_quads_and_writes_the_pose_beside_it_never_over_the_cage_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let cage = common::write(dir.path(), "cube_cage.obj", QUAD_CUBE);
+    let mesh = common::write(
+        dir.path(),
+        "inner.obj",
+        "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0 0.5 -0.5\nv 0 0 0.5\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+    );
+    let Some(mut harness) = editor_on_files(&mesh, &cage) else {
+        return;
+    };
+    let moved = glam::DVec3::new(1.5, 1.25, 1.0);
+    harness.state_mut().set_handle_position(6, moved);
+
+    // The cage read is an input: never written over.
+    assert!(!harness.state_mut().save_cage(&cage));
+    assert_eq!(std::fs::read_to_string(&cage).unwrap(), QUAD_CUBE);
+
+    let out = dir.path().join("cube_cage-edited.obj");
+    assert!(
+        harness.state_mut().save_cage(&out),
+        "{:?}",
+        harness.state().last_error()
+    );
+    let rest = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(faces_of(&rest), faces_of(QUAD_CUBE), "the quads as read");
+    let posed_path = dir.path().join("cube_cage-edited.posed.obj");
+    let posed = std::fs::read_to_string(&posed_path).unwrap();
+    assert_eq!(faces_of(&posed), faces_of(QUAD_CUBE));
+    let rest_cage = pmvc::geometry::load_mesh(&out).unwrap().mesh;
+    let posed_cage = pmvc::geometry::load_mesh(&posed_path).unwrap().mesh;
+    assert_eq!(rest_cage.positions[6], glam::DVec3::new(1.0, 1.0, 1.0));
+    assert_eq!(posed_cage.positions[6], moved);
+    assert_eq!(
+        posed_cage.positions.as_slice(),
+        harness.state().document().pose()
+    );
+}

@@ -265,15 +265,9 @@ fn roughly_symmetric_comb(dir: &std::path::Path) -> (std::path::PathBuf, std::pa
 fn symmetry_pairs_a_cage_symmetric_to_within_one_percent_of_an_edge() {
     let dir = tempfile::tempdir().unwrap();
     let (mesh, cage) = roughly_symmetric_comb(dir.path());
-    let Some(mut harness) = editor_with(pmvc::app::EditorOptions {
-        mesh: Some(mesh),
-        cage: Some(cage),
-        resolution: Some(TEST_RESOLUTION),
-        ..Default::default()
-    }) else {
+    let Some(mut harness) = editor_on_files(&mesh, &cage) else {
         return;
     };
-    run_until_bound(&mut harness);
     let handles = harness.state().document().pose().len();
     harness.state_mut().pose_tool_settings_mut().symmetry = Some(2);
     // Exact matching finds no partner on such a cage.

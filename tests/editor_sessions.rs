@@ -390,15 +390,9 @@ fn press_save(harness: &mut egui_kittest::Harness<'static, pmvc::app::EditorApp>
 fn save_after_opening_another_scene_asks_for_a_name_from_its_mesh_and_keeps_the_old_session() {
     let dir = tempfile::tempdir().unwrap();
     let (mesh, cage, _, _) = common::comb_scene(dir.path(), 200);
-    let Some(mut harness) = editor_with(EditorOptions {
-        mesh: Some(mesh.clone()),
-        cage: Some(cage.clone()),
-        resolution: Some(TEST_RESOLUTION),
-        ..Default::default()
-    }) else {
+    let Some(mut harness) = editor_on_files(&mesh, &cage) else {
         return;
     };
-    run_until_bound(&mut harness);
     harness.state_mut().set_in_window_file_dialog(true);
     let session = dir.path().join("first.session.json");
     assert!(harness.state_mut().save_session(&session));

@@ -13,8 +13,8 @@ use super::session::{self, SessionSettings};
 use crate::coords::Method;
 use crate::geometry::shown_path;
 use crate::geometry::{
-    load_cage, load_mesh, refuse_same_file, subdivide_midpoint, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, MeshFile, TriMesh,
+    load_cage, load_mesh, refuse_same_file, subdivide_midpoint, write_cage_and_pose,
+    write_deformed_mesh, write_mesh_with_normals, write_obj, MeshFile, TriMesh,
 };
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -297,6 +297,35 @@ pub fn save_pose(path: &Path, current: &Document) -> Result<String, String> {
     };
     write_obj(path, &posed).map_err(|error| error.to_string())?;
     Ok(format!("saved pose {}", shown_path(path)))
+}
+
+/// Where Save cage puts the pose beside the rest cage at `path`:
+/// `hand_cage.obj` → `hand_cage.posed.obj`.
+pub fn posed_cage_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "cage".into(), |s| s.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}.posed.obj"))
+}
+
+/// Write the rest cage to `path`, its polygons as read (quads stay quads), and
+/// the current pose beside it ([`posed_cage_path`]); both or neither.
+pub fn save_cage(path: &Path, current: &Document) -> Result<String, String> {
+    let posed = posed_cage_path(path);
+    refuse_overwriting_open_files(path, current)?;
+    refuse_overwriting_open_files(&posed, current)?;
+    let cage = current.cage();
+    let rest = TriMesh {
+        positions: cage.positions().to_vec(),
+        triangles: cage.triangles().to_vec(),
+        triangle_faces: cage.triangle_faces().to_vec(),
+    };
+    write_cage_and_pose(path, &posed, &rest, current.pose()).map_err(|e| e.to_string())?;
+    Ok(format!(
+        "saved the cage {} and its pose {}",
+        shown_path(path),
+        shown_path(&posed)
+    ))
 }
 
 /// Write the session: the document and `settings`.

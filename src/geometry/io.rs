@@ -236,6 +236,38 @@ pub fn write_obj_to(
     Ok(())
 }
 
+/// Write a cage as the artist made it and its pose beside it: `rest_path` gets
+/// the rest positions and `posed_path` the pose, both with the polygons the
+/// cage was read with (quads stay quads), replaced together or not at all.
+pub fn write_cage_and_pose(
+    rest_path: &Path,
+    posed_path: &Path,
+    cage: &TriMesh,
+    pose: &[DVec3],
+) -> Result<(), WriteError> {
+    let faces = super::polygons_of(cage);
+    let outputs = super::OutputSet::create(&[rest_path, posed_path])?;
+    outputs.finish(|index, out| {
+        let positions = if index == 0 {
+            &cage.positions[..]
+        } else {
+            pose
+        };
+        writeln!(out, "# written by pmvc")?;
+        for p in positions {
+            write_vertex(out, *p)?;
+        }
+        for face in &faces {
+            write!(out, "f")?;
+            for corner in face {
+                write!(out, " {}", corner + 1)?;
+            }
+            writeln!(out)?;
+        }
+        Ok(())
+    })
+}
+
 /// Write `file` with its vertices moved to `positions` (one per `v` line, in order).
 ///
 /// An OBJ source keeps everything but its vertex positions and normals: faces,

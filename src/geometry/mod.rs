@@ -17,6 +17,7 @@ mod off;
 mod output;
 mod ply;
 mod points_npy;
+mod polygons;
 pub mod procedural;
 pub mod subdivide;
 pub mod twisted_bar;
@@ -29,8 +30,8 @@ pub use classify::{
 pub use error::{shown_path, CageError, CageLoadError, LoadError, WriteError};
 pub use intersect::{find_crossing, Crossing};
 pub use io::{
-    cage_from_file, load_cage, load_mesh, parse_mesh, write_deformed_mesh, write_mesh_with_normals,
-    write_obj, write_obj_to,
+    cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
+    write_mesh_with_normals, write_obj, write_obj_to,
 };
 pub use normals::vertex_normals;
 pub use output::{
@@ -39,6 +40,7 @@ pub use output::{
 };
 pub use ply::{colour_byte, write_coloured_ply};
 pub use points_npy::write_points_npy;
+pub use polygons::{polygons_of, triangulate_faces};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;

@@ -21,7 +21,6 @@
 mod arrays;
 mod binding;
 mod errors;
-mod polygons;
 mod scene;
 mod weights;
 

@@ -3,12 +3,12 @@
 use super::arrays::{faces_list, positions, positions_array, triangles_array};
 use super::binding::{run_interruptible, Interruptible};
 use super::errors::{cage_load_error, error, load_error, Kind};
-use super::polygons::{polygons, triangulate};
 use crate::coords::family::ColumnLayout;
 use crate::coords::metadata::class_codes;
 use crate::coords::Method;
 use crate::geometry::autocage::{self, CageOptions};
 use crate::geometry::{self, classify_points, Cage, CageReport};
+use crate::geometry::{polygons_of, triangulate_faces};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -34,7 +34,7 @@ pub(super) struct PyCage {
 
 impl PyCage {
     fn validated(mesh: geometry::TriMesh, path: Option<PathBuf>, py: Python<'_>) -> PyResult<Self> {
-        let mut faces = polygons(&mesh);
+        let mut faces = polygons_of(&mesh);
         let (cage, report) = py.detach(|| Cage::new(mesh)).map_err(|cause| match &path {
             Some(path) => cage_load_error(&geometry::CageLoadError::Invalid {
                 path: path.clone(),
@@ -69,7 +69,7 @@ impl PyCage {
     ) -> PyResult<Self> {
         let vertices = positions(vertices, "cage vertices")?;
         let faces = super::arrays::faces(faces, vertices.len(), "cage faces")?;
-        Self::validated(triangulate(&faces, &vertices), None, py)
+        Self::validated(triangulate_faces(&faces, &vertices), None, py)
     }
 
     /// Read and validate a cage from an OBJ or OFF file.
@@ -168,7 +168,7 @@ pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'
         .detach(|| geometry::load_mesh(&path))
         .map_err(|cause| load_error(&cause))?;
     let vertices = positions_array(py, &file.mesh.positions)?;
-    let faces = faces_list(py, &polygons(&file.mesh))?;
+    let faces = faces_list(py, &polygons_of(&file.mesh))?;
     PyTuple::new(py, [vertices.into_any(), faces.into_any()])
 }
 
@@ -213,7 +213,7 @@ pub(super) fn generate_cage<'py>(
     })?;
     let vertices = positions(vertices, "mesh vertices")?;
     let faces = super::arrays::faces(faces, vertices.len(), "mesh faces")?;
-    let mesh = triangulate(&faces, &vertices);
+    let mesh = triangulate_faces(&faces, &vertices);
     let options = CageOptions {
         clearance,
         cell_size,

@@ -88,6 +88,21 @@ pub fn editor_with(options: EditorOptions) -> Option<Harness<'static, EditorApp>
     Some(editor_on(render_state()?, options))
 }
 
+/// The editor on `mesh` in `cage` (at [`TEST_RESOLUTION`]), bound.
+pub fn editor_on_files(
+    mesh: &std::path::Path,
+    cage: &std::path::Path,
+) -> Option<Harness<'static, EditorApp>> {
+    let mut harness = editor_with(EditorOptions {
+        mesh: Some(mesh.to_owned()),
+        cage: Some(cage.to_owned()),
+        resolution: Some(TEST_RESOLUTION),
+        ..Default::default()
+    })?;
+    run_until_bound(&mut harness);
+    Some(harness)
+}
+
 /// The editor with `options` on the device of `state`.
 pub fn editor_on(
     state: eframe::egui_wgpu::RenderState,

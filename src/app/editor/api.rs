@@ -420,6 +420,12 @@ impl EditorApp {
         self.save_pose_now(path)
     }
 
+    /// Write the rest cage (polygons kept) and its pose beside it; true when
+    /// both were written.
+    pub fn save_cage(&mut self, path: &Path) -> bool {
+        self.save_cage_now(path)
+    }
+
     /// Save the session to `path`; true when it was written.
     pub fn save_session(&mut self, path: &Path) -> bool {
         self.save_session_now(path)

@@ -395,6 +395,10 @@ impl EditorApp {
         saved
     }
 
+    pub(super) fn save_cage_now(&mut self, path: &Path) -> bool {
+        self.report(files::save_cage(path, self.model.document()))
+    }
+
     pub(super) fn save_session_now(&mut self, path: &Path) -> bool {
         let settings = SessionSettings {
             bind_options: self.binding.options,
@@ -441,7 +445,11 @@ impl EditorApp {
     /// Ask for a file for `action` and carry it out: the system's dialog when it
     /// works, else the in-window one (which answers in a later frame).
     pub(super) fn ask_for_file_now(&mut self, action: FileAction) {
-        let name = (action == FileAction::SaveSession).then(|| self.session_name());
+        let name = match action {
+            FileAction::SaveSession => Some(self.session_name()),
+            FileAction::SaveCage => Some(self.cage_name()),
+            _ => None,
+        };
         match self.panels.file_dialogs.ask(action, name) {
             DialogAnswer::Chosen(path) => {
                 self.finish_file_action(action, &path);
@@ -477,6 +485,21 @@ impl EditorApp {
         format!("{stem}.session.json")
     }
 
+    /// The name a saved cage is offered: the cage file's with "-edited" (the
+    /// file itself is an input, never overwritten), or the mesh's with "_cage"
+    /// for a cage that came from no file (generated, a box, bundled).
+    fn cage_name(&self) -> String {
+        let document = self.model.document();
+        let stem = |path: &Path| path.file_stem().map(|s| s.to_string_lossy().into_owned());
+        match document.cage_path().and_then(stem) {
+            Some(cage) => format!("{cage}-edited.obj"),
+            None => {
+                let mesh = self.session_name();
+                format!("{}_cage.obj", mesh.trim_end_matches(".session.json"))
+            }
+        }
+    }
+
     /// Carry out `action` on `path`; true when it succeeded.
     pub(super) fn finish_file_action(&mut self, action: FileAction, path: &Path) -> bool {
         self.panels.file_dialogs.remember_folder(path);
@@ -485,6 +508,7 @@ impl EditorApp {
             FileAction::OpenCage => self.open_file_now(FileRole::Cage, path),
             FileAction::LoadPose => self.load_pose_now(path),
             FileAction::SavePose => self.save_pose_now(path),
+            FileAction::SaveCage => self.save_cage_now(path),
             FileAction::ExportMesh => self.export_deformed_now(path),
             FileAction::OpenSession => self.open_session_now(path),
             FileAction::SaveSession => self.save_session_now(path),

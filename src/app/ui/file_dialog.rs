@@ -21,6 +21,8 @@ pub enum FileAction {
     OpenCage,
     LoadPose,
     SavePose,
+    /// The rest cage, polygons kept, and its pose beside it.
+    SaveCage,
     ExportMesh,
     OpenSession,
     SaveSession,
@@ -35,6 +37,7 @@ impl FileAction {
             FileAction::OpenCage => "Open cage",
             FileAction::LoadPose => "Load pose",
             FileAction::SavePose => "Save pose",
+            FileAction::SaveCage => "Save cage",
             FileAction::ExportMesh => "Export deformed mesh",
             FileAction::OpenSession => "Open session",
             FileAction::SaveSession => "Save session",
@@ -47,6 +50,7 @@ impl FileAction {
         matches!(
             self,
             FileAction::SavePose
+                | FileAction::SaveCage
                 | FileAction::ExportMesh
                 | FileAction::SaveSession
                 | FileAction::SaveImage
@@ -82,6 +86,7 @@ impl FileAction {
     fn default_name(self) -> &'static str {
         match self {
             FileAction::SavePose => "pose.obj",
+            FileAction::SaveCage => "cage.obj",
             FileAction::ExportMesh => "deformed.obj",
             FileAction::SaveSession => "scene.session.json",
             FileAction::SaveImage => "view.png",
@@ -94,7 +99,10 @@ impl FileAction {
         match self {
             FileAction::OpenMesh | FileAction::OpenCage | FileAction::OpenSession => "Open",
             FileAction::LoadPose => "Load",
-            FileAction::SavePose | FileAction::SaveSession | FileAction::SaveImage => "Save",
+            FileAction::SavePose
+            | FileAction::SaveCage
+            | FileAction::SaveSession
+            | FileAction::SaveImage => "Save",
             FileAction::ExportMesh | FileAction::ExportColouredMesh => "Export",
         }
     }

@@ -76,6 +76,16 @@ fn file_menu(ui: &mut egui::Ui, cx: &mut PanelContext) {
     if ui.button("Save pose…").clicked() {
         cx.send(Action::AskForFile(FileAction::SavePose));
     }
+    if ui
+        .button("Save cage…")
+        .on_hover_text(
+            "The rest cage with its faces as read (quads stay quads), and its current \
+             pose beside it as NAME.posed.obj",
+        )
+        .clicked()
+    {
+        cx.send(Action::AskForFile(FileAction::SaveCage));
+    }
     if ui.button("Export deformed mesh…").clicked() {
         cx.send(Action::AskForFile(FileAction::ExportMesh));
     }

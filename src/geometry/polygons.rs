@@ -1,15 +1,16 @@
-//! The file's polygons from a triangulated mesh. The readers keep, for each
-//! triangle, the face it was cut from (`TriMesh::triangle_faces`), not the
-//! face's corners; `triangulate_polygon` is deterministic, so each face's
-//! corners are the candidate whose triangulation gives back its triangles.
+//! The file's polygons from a triangulated mesh, for writing a cage as the
+//! artist made it (quads kept) and for the Python package's faces. The readers
+//! keep, for each triangle, the face it was cut from (`TriMesh::triangle_faces`),
+//! not the face's corners; `triangulate_polygon` is deterministic, so each
+//! face's corners are the candidate whose triangulation gives back its triangles.
 // The readers could keep the polygons themselves (a `faces` field of `TriMesh`),
 // which would make this module unnecessary.
 
-use crate::geometry::{triangulate_polygon, TriMesh};
+use super::{triangulate_polygon, TriMesh};
 use glam::DVec3;
 
 /// Triangles and the polygons they came from, for a mesh made from polygons.
-pub(super) fn triangulate(faces: &[Vec<u32>], positions: &[DVec3]) -> TriMesh {
+pub fn triangulate_faces(faces: &[Vec<u32>], positions: &[DVec3]) -> TriMesh {
     let mut mesh = TriMesh {
         positions: positions.to_vec(),
         ..TriMesh::default()
@@ -26,7 +27,7 @@ pub(super) fn triangulate(faces: &[Vec<u32>], positions: &[DVec3]) -> TriMesh {
 }
 
 /// The polygons of `mesh`, in file order, with their corners in file order.
-pub(super) fn polygons(mesh: &TriMesh) -> Vec<Vec<u32>> {
+pub fn polygons_of(mesh: &TriMesh) -> Vec<Vec<u32>> {
     if mesh.triangle_faces.len() != mesh.triangles.len() {
         return mesh.triangles.iter().map(|t| t.to_vec()).collect();
     }
