@@ -34,14 +34,19 @@ fn difference_editor(
     Some(harness)
 }
 
-/// Viewport samples (above the colour bar) whose colour is clearly red.
+/// Viewport samples (above the colour bar, and not where the world axes are
+/// drawn, whose x is red) whose colour is clearly red.
 fn red_samples(harness: &mut Harness<'static, EditorApp>) -> usize {
     let rect = harness.state().pane_rects()[0].1;
+    let axes = pmvc::app::axes_rect(rect);
     let image = harness.render().expect("the harness renders");
     let mut red = 0;
     let bottom = (rect.top() + rect.height() * 0.75) as u32;
     for y in (rect.top() as u32..bottom).step_by(3) {
         for x in (rect.left() as u32..rect.right() as u32).step_by(3) {
+            if axes.contains(egui::pos2(x as f32, y as f32)) {
+                continue;
+            }
             let [r, g, b, _] = image.get_pixel(x, y).0.map(i32::from);
             if r > g + 60 && r > b + 60 {
                 red += 1;

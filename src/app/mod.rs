@@ -48,7 +48,7 @@ pub mod widgets;
 pub use editor::{EditorApp, FileRole};
 pub use model::document;
 pub use offscreen::run_offscreen;
-pub use viewport::TransformKind;
+pub use viewport::{axes_rect, TransformKind};
 
 use std::path::PathBuf;
 

@@ -22,6 +22,17 @@ use egui::{Color32, Pos2, Rect, Sense, Stroke};
 use glam::{DVec3, Vec2};
 pub(super) use input::Drag;
 
+/// The length of a pane's world axes, in points.
+const AXES_LENGTH: f32 = 22.0;
+
+/// Where a pane whose rectangle is `pane` draws its world axes and their
+/// letters: at its right edge, below the title (8 points down) and the notice
+/// under it (28).
+pub fn axes_rect(pane: Rect) -> Rect {
+    let centre = pane.right_top() + egui::vec2(-34.0, 76.0);
+    Rect::from_center_size(centre, egui::Vec2::splat(2.0 * (AXES_LENGTH + 14.0)))
+}
+
 /// Gap between side-by-side views, in points.
 const PANE_GAP: f32 = 2.0;
 
@@ -362,14 +373,11 @@ impl Views {
     /// edge below the title and notice lines: x red, y green, z blue, those
     /// pointing away drawn first and dimmer.
     fn draw_axes(&self, painter: &egui::Painter, pane: usize, rect: Rect) {
-        const LENGTH: f32 = 22.0;
-        const MARGIN: f32 = 34.0;
-        /// Below the title (8 points down) and the notice under it (28).
-        const DOWN: f32 = 76.0;
+        const LENGTH: f32 = AXES_LENGTH;
         let camera = self.camera_of(pane);
         let (right, up) = camera.right_up();
         let towards_viewer = (camera.eye() - camera.target).normalize_or_zero();
-        let centre = rect.right_top() + egui::vec2(-MARGIN, DOWN);
+        let centre = axes_rect(rect).center();
         let colours = [
             Color32::from_rgb(230, 80, 80),
             Color32::from_rgb(110, 200, 90),
