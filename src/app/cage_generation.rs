@@ -388,23 +388,32 @@ pub fn loose_box_cage(mesh: &TriMesh) -> Option<Cage> {
 /// Whether any vertex of `mesh` is inside `cage` (or on it): a cage that holds
 /// none of the mesh is no cage for it, even when the mesh lies within its
 /// bounding box (in the gaps between a hand's fingers, say). Only vertices in
-/// the bounding box are classified, a block at a time, stopping at the first
-/// block that has one inside.
+/// the bounding box are classified, [`REACH_BLOCK`] at a time (so the memory
+/// used does not grow with the mesh), stopping at the first block that has
+/// one inside.
 pub fn cage_reaches(cage: &Cage, mesh: &TriMesh) -> bool {
-    /// Vertices classified at a time: a mesh that is inside stops after one.
-    const BLOCK: usize = 4096;
     let (lo, hi) = crate::geometry::bounds_of(cage.positions());
-    let in_box: Vec<DVec3> = mesh
+    let mut in_box = mesh
         .positions
         .iter()
         .copied()
-        .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all())
-        .collect();
-    in_box.chunks(BLOCK).any(|block| {
-        let classes = crate::geometry::classify_points(cage, block);
-        classes.outside.len() < block.len()
-    })
+        .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all());
+    let mut block = Vec::with_capacity(REACH_BLOCK);
+    loop {
+        block.clear();
+        block.extend(in_box.by_ref().take(REACH_BLOCK));
+        if block.is_empty() {
+            return false;
+        }
+        if crate::geometry::classify_points(cage, &block).outside.len() < block.len() {
+            return true;
+        }
+    }
 }
+
+/// Vertices [`cage_reaches`] classifies at a time: a mesh inside the cage
+/// stops after the first block.
+const REACH_BLOCK: usize = 4096;
 
 #[cfg(test)]
 mod tests {

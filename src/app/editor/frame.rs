@@ -28,13 +28,14 @@ impl eframe::App for EditorApp {
         self.poll_bind();
         let mesh = std::sync::Arc::clone(self.model.document().mesh());
         self.panels.cage_window.poll(&mesh);
+        self.run_shortcuts(&ctx);
+
+        // What the panels show, gathered once a frame: the actions they queue
+        // run after them, and what changes shows in the next frame.
         let shown = self.shown();
         with_context(&self.model, &shown, &mut self.actions, |cx| {
             self.panels.drop.take_dropped_files(&ctx, cx);
         });
-        self.run_shortcuts(&ctx);
-
-        let shown = self.shown();
         let (model, actions, panels) = (&self.model, &mut self.actions, &mut self.panels);
         egui::Panel::top("menu").show(ui, |ui| {
             with_context(model, &shown, actions, |cx| menu::menu_bar(ui, cx));
@@ -63,7 +64,6 @@ impl eframe::App for EditorApp {
                 })
             });
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
-        let shown = self.shown();
         with_context(&self.model, &shown, &mut self.actions, |cx| {
             self.panels.drop.ui(&ctx, cx);
             self.panels.quit.ui(&ctx, cx);
@@ -71,7 +71,6 @@ impl eframe::App for EditorApp {
         // After the panels that send actions; before the file dialog, so the
         // question's Save pose… opens it in this frame.
         self.run_actions(&ctx);
-        let shown = self.shown();
         with_context(&self.model, &shown, &mut self.actions, |cx| {
             self.panels.file_dialogs.window(&ctx, cx);
             generate_cage::window(&mut self.panels.cage_window, &ctx, cx);
