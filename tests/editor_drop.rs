@@ -6,35 +6,8 @@ mod common;
 
 use common::editor::*;
 use egui_kittest::kittest::Queryable;
-use egui_kittest::Harness;
 use glam::DVec3;
-use pmvc::app::EditorApp;
 use pmvc::coords::Method;
-use std::path::PathBuf;
-
-/// A file dropped on the window, as the window system hands it to egui.
-#[derive(Debug)]
-struct DroppedPath(PathBuf);
-
-impl egui::DroppedFile for DroppedPath {
-    fn path(&self) -> &std::path::Path {
-        &self.0
-    }
-
-    fn bytes(&self) -> Result<Vec<u8>, String> {
-        std::fs::read(&self.0).map_err(|e| e.to_string())
-    }
-}
-
-fn drop_files(harness: &mut Harness<'static, EditorApp>, paths: &[PathBuf]) {
-    for path in paths {
-        harness
-            .input_mut()
-            .dropped_files
-            .push(std::sync::Arc::new(DroppedPath(path.clone())));
-    }
-    harness.run_steps(3);
-}
 
 #[test]
 fn a_dropped_file_with_the_cages_vertex_count_is_offered_as_a_pose() {

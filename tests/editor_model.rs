@@ -305,6 +305,7 @@ fn undo_walks_a_mixed_history_back_to_the_start_and_redo_forward_to_the_end() {
 
     // 5: the session opened, with its view settings.
     assert!(harness.state_mut().open_session(&session));
+    open_without_saving(&mut harness);
     run_until_bound(&mut harness);
     assert_eq!(harness.state().view().wireframe, !shown.wireframe);
     checkpoints.push(checkpoint(harness.state()));

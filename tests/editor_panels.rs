@@ -13,11 +13,11 @@ use pmvc::app::document::Document;
 use pmvc::app::model::{Command, Model};
 use pmvc::app::scenes;
 use pmvc::app::ui::file_dialog::FileAction;
-use pmvc::app::ui::quit_dialog::QuitDialog;
+use pmvc::app::ui::unsaved_dialog::{UnsavedAnswer, UnsavedDialog};
 
-/// The quit dialog alone, over a model whose pose is not saved.
+/// The unsaved-work question alone, over a model whose pose is not saved.
 struct QuitScene {
-    dialog: QuitDialog,
+    dialog: UnsavedDialog,
     model: Model,
     actions: Vec<Action>,
 }
@@ -30,10 +30,10 @@ fn quit_scene() -> QuitScene {
     ));
     let pose = scenes::comb_demo_pose(model.document().cage());
     model.apply(Command::edit_pose(pose));
-    assert!(model.pose_unsaved());
-    let mut dialog = QuitDialog::default();
+    assert!(model.unsaved().only_pose());
+    let mut dialog = UnsavedDialog::default();
     assert!(
-        !dialog.request(model.pose_unsaved()),
+        !dialog.request_quit(model.unsaved()),
         "an unsaved pose asks"
     );
     QuitScene {
@@ -56,57 +56,45 @@ fn quit_harness(scene: QuitScene) -> Harness<'static, QuitScene> {
 }
 
 #[test]
-fn the_quit_dialogs_save_and_quit_is_queued_actions_not_changes() {
-    let mut harness = quit_harness(quit_scene());
-    harness.run();
-    harness.get_by_label("Save pose…").click();
-    harness.run();
-    let scene = harness.state();
-    assert!(
-        matches!(
-            scene.actions.as_slice(),
-            [Action::AskForFile(FileAction::SavePose)]
-        ),
-        "Save pose… queues the file dialog, and only that: {:?}",
-        scene.actions
-    );
-    assert!(
-        scene.model.pose_unsaved(),
-        "the save point stays until a save is run"
-    );
-    assert!(!scene.dialog.is_asking());
-    assert!(!scene.dialog.confirmed(), "nothing is saved yet");
-
-    // The save written: the dialog asks for the window to close, once.
-    harness.state_mut().actions.clear();
-    harness.state_mut().dialog.pose_save_finished(true);
-    harness.run();
-    let scene = harness.state();
-    assert!(scene.dialog.confirmed());
-    assert!(
-        matches!(scene.actions.as_slice(), [Action::CloseWindow]),
-        "{:?}",
-        scene.actions
-    );
+fn the_questions_answers_are_queued_actions_not_changes() {
+    for (button, answer) in [
+        ("Save session…", UnsavedAnswer::SaveSession),
+        ("Save pose…", UnsavedAnswer::SavePose),
+        ("Quit without saving", UnsavedAnswer::Discard),
+        ("Cancel", UnsavedAnswer::Cancel),
+    ] {
+        let mut harness = quit_harness(quit_scene());
+        harness.run();
+        harness.get_by_label(button).click();
+        harness.run();
+        let scene = harness.state();
+        assert!(
+            matches!(scene.actions.as_slice(), [Action::Unsaved(a)] if *a == answer),
+            "{button} queues its answer, and only that: {:?}",
+            scene.actions
+        );
+        assert!(
+            scene.model.pose_unsaved(),
+            "{button}: the save point stays until the editor runs the answer"
+        );
+        assert!(!scene.dialog.is_asking());
+        assert!(
+            !scene.dialog.confirmed(),
+            "{button}: quitting is the editor's to confirm"
+        );
+    }
 }
 
 #[test]
-fn quitting_without_saving_is_a_queued_close() {
-    let mut harness = quit_harness(quit_scene());
+fn a_question_about_more_than_the_pose_offers_no_pose_file() {
+    let mut scene = quit_scene();
+    scene.model.apply(Command::StoreNamedPose("raised".into()));
+    scene.dialog.request_quit(scene.model.unsaved());
+    let mut harness = quit_harness(scene);
     harness.run();
-    harness.get_by_label("Quit without saving").click();
-    harness.run();
-    let scene = harness.state();
-    assert!(scene.dialog.confirmed());
-    assert!(
-        matches!(scene.actions.as_slice(), [Action::CloseWindow]),
-        "{:?}",
-        scene.actions
-    );
-    assert!(
-        scene.model.pose_unsaved(),
-        "the pose is not saved by quitting"
-    );
+    harness.get_by_label("Save session…");
+    harness.get_by_label_contains("the pose, the named poses");
+    assert!(harness.query_by_label("Save pose…").is_none());
 }
 
 #[test]

@@ -79,6 +79,7 @@ fn undo_and_redo_walk_back_through_opened_cages_subdivision_and_scene_switches()
     );
     let larger_path = write(dir.path(), "larger_cage.obj", &cage_obj(&larger));
     assert!(harness.state_mut().open_file(FileRole::Cage, &larger_path));
+    open_without_saving(&mut harness);
     run_until_bound(&mut harness);
     let opened = scene_state(harness.state());
     assert_eq!(
@@ -96,6 +97,7 @@ fn undo_and_redo_walk_back_through_opened_cages_subdivision_and_scene_switches()
     harness
         .state_mut()
         .open_bundled(pmvc::app::scenes::BundledScene::Scan);
+    open_without_saving(&mut harness);
     run_until_bound(&mut harness);
     let scan = scene_state(harness.state());
     assert_eq!(scan.mesh_vertices, 2775);
@@ -234,18 +236,6 @@ fn saving_over_the_open_mesh_or_cage_is_refused() {
     assert!(elsewhere.exists());
 }
 
-/// The window system's close button, as eframe hands it to egui.
-fn close_window(harness: &mut Harness<'static, EditorApp>) {
-    harness
-        .input_mut()
-        .viewports
-        .entry(egui::ViewportId::ROOT)
-        .or_default()
-        .events
-        .push(egui::ViewportEvent::Close);
-    harness.run_steps(2);
-}
-
 #[test]
 fn quitting_with_an_unsaved_pose_asks_first() {
     use egui_kittest::kittest::Queryable;
@@ -276,15 +266,7 @@ fn quitting_with_an_unsaved_pose_asks_first() {
     harness.run_steps(2);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("before-quit.obj");
-    harness.get_by_label("File name:").focus();
-    harness.step();
-    harness.key_press_modifiers(Modifiers::COMMAND, Key::A);
-    harness
-        .get_by_label("File name:")
-        .type_text(path.to_str().unwrap());
-    harness.step();
-    harness.key_press(Key::Enter);
-    harness.run_steps(2);
+    answer_file_dialog(&mut harness, &path);
     let saved = pmvc::geometry::load_mesh(&path).expect("the pose was saved");
     assert_eq!(saved.mesh.positions, harness.state().document().pose());
     assert!(harness.state().quit_confirmed());

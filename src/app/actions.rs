@@ -10,6 +10,7 @@ use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::shortcuts::ViewSide;
 use super::ui::file_dialog::FileAction;
+use super::ui::unsaved_dialog::UnsavedAnswer;
 use crate::coords::{Method, Parameter};
 use glam::DVec3;
 use std::path::PathBuf;
@@ -21,6 +22,8 @@ pub enum Action {
     Quit,
     /// Close the window: the user confirmed quitting.
     CloseWindow,
+    /// The answer to "Save changes before quitting (or opening)?".
+    Unsaved(UnsavedAnswer),
     /// Open the file dialog for `FileAction`.
     AskForFile(FileAction),
     /// The in-window dialog's answer: carry out `FileAction` on the path.
@@ -38,6 +41,8 @@ pub enum Action {
     OpenRecent(RecentEntry),
     /// Open a bundled scene.
     OpenBundled(BundledScene),
+    /// Open a session file (one dropped on the window).
+    OpenSession(PathBuf),
     /// Use the vertices read from `path` as the cage's pose.
     TakePose {
         path: PathBuf,

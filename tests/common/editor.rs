@@ -108,8 +108,17 @@ pub fn editor_on(
     state: eframe::egui_wgpu::RenderState,
     options: EditorOptions,
 ) -> Harness<'static, EditorApp> {
+    editor_sized(state, options, egui::vec2(1100.0, 700.0))
+}
+
+/// The editor with `options` in a window of `size` points.
+pub fn editor_sized(
+    state: eframe::egui_wgpu::RenderState,
+    options: EditorOptions,
+    size: egui::Vec2,
+) -> Harness<'static, EditorApp> {
     let harness = Harness::builder()
-        .with_size(egui::vec2(1100.0, 700.0))
+        .with_size(size)
         .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
             state,
         ))
@@ -226,4 +235,71 @@ pub fn max_distance(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
 pub fn rest_positions(app: &EditorApp) -> Vec<glam::Vec3> {
     let mesh = app.document().mesh();
     mesh.positions.iter().map(|p| p.as_vec3()).collect()
+}
+
+/// The window system's close button, as eframe hands it to egui.
+pub fn close_window(harness: &mut Harness<'static, EditorApp>) {
+    harness
+        .input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    harness.run_steps(2);
+}
+
+/// A file dropped on the window, as the window system hands it to egui.
+#[derive(Debug)]
+struct DroppedPath(std::path::PathBuf);
+
+impl egui::DroppedFile for DroppedPath {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+pub fn drop_files(harness: &mut Harness<'static, EditorApp>, paths: &[std::path::PathBuf]) {
+    for path in paths {
+        harness
+            .input_mut()
+            .dropped_files
+            .push(std::sync::Arc::new(DroppedPath(path.clone())));
+    }
+    harness.run_steps(3);
+}
+
+/// Answer "Save changes before opening …?" with Open without saving; the
+/// question must be shown.
+pub fn open_without_saving(harness: &mut Harness<'static, EditorApp>) {
+    use egui_kittest::kittest::Queryable;
+    harness.run_steps(2);
+    assert!(
+        matches!(
+            harness.state().unsaved_question(),
+            Some(pmvc::app::ui::unsaved_dialog::Question::Open(_))
+        ),
+        "opening asks first: {:?}",
+        harness.state().unsaved()
+    );
+    harness.get_by_label("Open without saving").click();
+    harness.run_steps(2);
+}
+
+/// Type `path` into the in-window dialog's name field and press Enter.
+pub fn answer_file_dialog(harness: &mut Harness<'static, EditorApp>, path: &std::path::Path) {
+    use egui_kittest::kittest::Queryable;
+    harness.get_by_label("File name:").focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness
+        .get_by_label("File name:")
+        .type_text(path.to_str().unwrap());
+    harness.step();
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
 }

@@ -8,13 +8,14 @@ use crate::app::bind_queue::JobStatus;
 use crate::app::cage_generation::CageGeneration;
 use crate::app::compare::{HoverReadout, Pane, ValueRange, ViewSettings};
 use crate::app::document::Document;
-use crate::app::model::{Command, Selection};
+use crate::app::model::{Command, Selection, Unsaved};
 use crate::app::pose_tools::{PoseToolSettings, Transform};
 use crate::app::recent::{RecentEntry, RecentFiles};
 use crate::app::scenes::BundledScene;
 use crate::app::ui::drop_dialog::DroppedFile;
 use crate::app::ui::file_dialog::FileAction;
 use crate::app::ui::notices::Notices;
+use crate::app::ui::unsaved_dialog::Question;
 use crate::app::viewport::{self, TransformKind};
 use crate::coords::{BindOptions, Method, Parameter};
 use crate::render::{Colouring, OrbitCamera, Shading};
@@ -102,7 +103,7 @@ impl EditorApp {
     /// A dialog (file, quit or dropped file) waits for the user.
     pub fn modal_dialog_open(&self) -> bool {
         let panels = &self.panels;
-        panels.file_dialogs.is_open() || panels.quit.is_asking() || panels.drop.is_open()
+        panels.file_dialogs.is_open() || panels.unsaved.is_asking() || panels.drop.is_open()
     }
 
     /// What Undo would reverse, for its menu entry ("move handles", "open cage.obj").
@@ -135,12 +136,22 @@ impl EditorApp {
 
     /// The quit question is shown.
     pub fn is_asking_to_quit(&self) -> bool {
-        self.panels.quit.is_asking()
+        self.panels.unsaved.question() == Some(&Question::Quit)
+    }
+
+    /// The unsaved-work question shown, if one is.
+    pub fn unsaved_question(&self) -> Option<&Question> {
+        self.panels.unsaved.question()
+    }
+
+    /// What quitting or opening another scene would lose now.
+    pub fn unsaved(&self) -> Unsaved {
+        self.model.unsaved()
     }
 
     /// The window was told to close.
     pub fn quit_confirmed(&self) -> bool {
-        self.panels.quit.confirmed()
+        self.panels.unsaved.confirmed()
     }
 
     /// The dropped file waiting for a choice, if any.

@@ -22,8 +22,10 @@ impl eframe::App for EditorApp {
             .statistics
             .frames_mut()
             .record_frame(ctx.input(|i| i.time));
-        let (scripted, unsaved) = (self.run.screenshot.is_some(), self.model.pose_unsaved());
-        panels.quit.intercept_close(&ctx, scripted, unsaved);
+        let (scripted, unsaved) = (self.run.screenshot.is_some(), self.model.unsaved());
+        if panels.unsaved.intercept_close(&ctx, scripted, unsaved) {
+            self.files.waiting = Some(super::Waiting::Quit);
+        }
         self.run.focus.ask(&ctx, frame);
         self.poll_bind();
         let mesh = std::sync::Arc::clone(self.model.document().mesh());
@@ -63,10 +65,14 @@ impl eframe::App for EditorApp {
                     });
                 })
             });
-        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        let viewport = egui::CentralPanel::no_frame()
+            .show(ui, |ui| self.viewport(ui))
+            .response
+            .rect;
         with_context(&self.model, &shown, &mut self.actions, |cx| {
             self.panels.drop.ui(&ctx, cx);
-            self.panels.quit.ui(&ctx, cx);
+            self.panels.unsaved.ui(&ctx, cx);
+            (self.panels.notices).toasts(&ctx, viewport, shown.hide_timings, cx);
         });
         // After the panels that send actions; before the file dialog, so the
         // question's Save pose… opens it in this frame.

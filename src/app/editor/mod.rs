@@ -29,9 +29,9 @@ use super::ui::file_dialog::FileDialogs;
 use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
 use super::ui::pose_panel::PosePanel;
-use super::ui::quit_dialog::QuitDialog;
 use super::ui::shortcuts_help::ShortcutsHelp;
 use super::ui::statistics::StatisticsPanel;
+use super::ui::unsaved_dialog::{Question, UnsavedDialog};
 use super::views::Views;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
@@ -126,8 +126,8 @@ struct Panels {
     pose_tools: PosePanel,
     /// The system's or the in-window file dialog.
     file_dialogs: FileDialogs,
-    /// Quitting asks first when the pose is unsaved.
-    quit: QuitDialog,
+    /// Quitting or opening another scene asks first when work is unsaved.
+    unsaved: UnsavedDialog,
     /// A file dropped on the window, waiting for the user to say what it is.
     drop: DropDialog,
     /// File > Generate cage…: its window, job and proposal.
@@ -146,6 +146,15 @@ struct FileState {
     session_path: Option<PathBuf>,
     /// File > Save image… waiting for the next frame.
     image_request: ImageRequest,
+    /// What waits for the answer to "Save changes?".
+    waiting: Option<Waiting>,
+}
+
+/// What the unsaved-work question holds back until it is answered.
+enum Waiting {
+    Quit,
+    /// Another scene, read and checked, to replace the document.
+    Open(Box<SceneChange>),
 }
 
 /// How this run of the editor goes.
@@ -372,6 +381,9 @@ impl EditorApp {
 
     /// Make a scene change read from files (or an error) current, with its
     /// notices; true when it was made.
+    /// Open another scene, or edit this one: another scene waits for the
+    /// answer to "Save changes?" when work would be lost. True when the change
+    /// was read and checked (it may still wait).
     fn change_scene(&mut self, change: Result<SceneChange, String>) -> bool {
         let change = match change {
             Ok(change) => change,
@@ -380,6 +392,19 @@ impl EditorApp {
                 return false;
             }
         };
+        let unsaved = self.model.unsaved();
+        if !change.same_session && unsaved.any() {
+            let what = change.replacement.document.title().to_owned();
+            self.panels.unsaved.ask(Question::Open(what), unsaved);
+            self.files.waiting = Some(Waiting::Open(Box::new(change)));
+            return true;
+        }
+        self.apply_scene_change(change);
+        true
+    }
+
+    /// Replace the document by `change` and bind it.
+    fn apply_scene_change(&mut self, change: SceneChange) {
         for note in change.notes {
             self.info(note);
         }
@@ -401,7 +426,10 @@ impl EditorApp {
             let vertices = self.model.document().cage().vertex_count();
             self.panels.cage_window.open_window(vertices);
         }
-        true
+        // Another scene's files are on disk: nothing of it is unsaved yet.
+        if !change.same_session {
+            self.apply(Command::MarkSessionSaved);
+        }
     }
 
     /// Replace the whole document, as one undo step, and bind it: the one way
@@ -432,7 +460,7 @@ impl EditorApp {
             self.binding.options = bind_options;
             self.views.settings = view;
             // A session's pose is on disk: quitting keeps it.
-            self.apply(Command::MarkSaved);
+            self.apply(Command::MarkSessionSaved);
         }
         self.bind_wanted();
     }

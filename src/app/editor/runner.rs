@@ -3,7 +3,7 @@
 //! writes, returning values) and change the model through commands; this is
 //! also where a finished bind's weights go to the model.
 
-use super::{EditorApp, FileRole};
+use super::{EditorApp, FileRole, Waiting};
 use crate::app::actions::{Action, BlendStep, CageRequest};
 use crate::app::bind_queue::{Finished, JobError};
 use crate::app::compare::Pane;
@@ -14,6 +14,8 @@ use crate::app::recent::RecentEntry;
 use crate::app::session::SessionSettings;
 use crate::app::ui::file_dialog::{DialogAnswer, FileAction};
 use crate::app::ui::named_poses::blend_poses;
+use crate::app::ui::unsaved_dialog::Question;
+use crate::app::ui::unsaved_dialog::UnsavedAnswer;
 use crate::render::Colouring;
 use std::path::Path;
 use std::sync::Arc;
@@ -39,10 +41,13 @@ impl EditorApp {
     pub(super) fn run_action(&mut self, ctx: &egui::Context, action: Action) {
         match action {
             Action::Quit => {
-                if self.panels.quit.request(self.model.pose_unsaved()) {
+                if self.panels.unsaved.request_quit(self.model.unsaved()) {
                     ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                } else {
+                    self.files.waiting = Some(Waiting::Quit);
                 }
             }
+            Action::Unsaved(answer) => self.answer_unsaved(answer),
             Action::CloseWindow => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             Action::AskForFile(file_action) => self.ask_for_file_now(file_action),
             Action::FileChosen(file_action, path) => self.in_window_answer(file_action, &path),
@@ -55,6 +60,9 @@ impl EditorApp {
             }
             Action::OpenRecent(entry) => {
                 self.open_recent_now(&entry);
+            }
+            Action::OpenSession(path) => {
+                self.open_session_now(&path);
             }
             Action::OpenBundled(bundled) => {
                 self.change_scene(files::open_bundled(bundled));
@@ -407,7 +415,7 @@ impl EditorApp {
         };
         let saved = self.report(files::save_session(path, self.model.document(), &settings));
         if saved {
-            self.apply(Command::MarkSaved);
+            self.apply(Command::MarkSessionSaved);
             self.files.session_path = Some(path.to_owned());
             self.files
                 .recent
@@ -515,15 +523,74 @@ impl EditorApp {
             FileAction::SaveImage => self.save_image_now(path),
             FileAction::ExportColouredMesh => self.export_coloured_mesh_now(path),
         };
-        if action == FileAction::SavePose {
-            self.panels.quit.pose_save_finished(done);
+        if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
+            if done {
+                self.go_on_after_save();
+            } else if !self.panels.file_dialogs.is_open() {
+                // The system's dialog is gone with the error: the user answers
+                // again when quitting or opening again.
+                self.files.waiting = None;
+            }
         }
         done
     }
 
     fn file_action_cancelled(&mut self, action: FileAction) {
-        if action == FileAction::SavePose {
-            self.panels.quit.pose_save_finished(false);
+        if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
+            self.files.waiting = None;
+        }
+    }
+
+    // ---- unsaved work ---------------------------------------------------------------
+
+    /// The answer to "Save changes before quitting (or opening)?".
+    fn answer_unsaved(&mut self, answer: UnsavedAnswer) {
+        match answer {
+            UnsavedAnswer::Cancel => self.files.waiting = None,
+            UnsavedAnswer::Discard => self.go_on(),
+            UnsavedAnswer::SaveSession => match self.files.session_path.clone() {
+                Some(path) => {
+                    if self.save_session_now(&path) {
+                        self.go_on_after_save();
+                    } else {
+                        self.files.waiting = None;
+                    }
+                }
+                None => self.ask_for_file_now(FileAction::SaveSession),
+            },
+            UnsavedAnswer::SavePose => self.ask_for_file_now(FileAction::SavePose),
+        }
+    }
+
+    /// A save finished: what waited goes on, unless work is still unsaved (a
+    /// pose file keeps only the pose), when the question comes back.
+    fn go_on_after_save(&mut self) {
+        let Some(waiting) = self.files.waiting.take() else {
+            return;
+        };
+        let unsaved = self.model.unsaved();
+        if unsaved.any() {
+            let question = match &waiting {
+                Waiting::Quit => Question::Quit,
+                Waiting::Open(change) => Question::Open(change.replacement.document.title().into()),
+            };
+            self.panels.unsaved.ask(question, unsaved);
+            self.files.waiting = Some(waiting);
+            return;
+        }
+        self.files.waiting = Some(waiting);
+        self.go_on();
+    }
+
+    /// Carry out what waited for the question: quit, or open the scene.
+    fn go_on(&mut self) {
+        match self.files.waiting.take() {
+            Some(Waiting::Quit) => {
+                self.panels.unsaved.confirm_quit();
+                self.actions.push(Action::CloseWindow);
+            }
+            Some(Waiting::Open(change)) => self.apply_scene_change(*change),
+            None => {}
         }
     }
 

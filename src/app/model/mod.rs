@@ -10,7 +10,8 @@ mod undo_log;
 use super::compare::ViewSettings;
 use super::viewport::ViewCameras;
 use crate::coords::{BindOptions, Method};
-use document::{Changes, Document, WeightSet};
+use crate::geometry::{Cage, TriMesh};
+use document::{Changes, Document, NamedPose, WeightSet};
 use glam::DVec3;
 use std::collections::BTreeSet;
 use std::sync::Arc;
@@ -108,6 +109,9 @@ pub enum Command {
     Redo(SessionView),
     /// The current pose is saved (the quit dialog compares against it).
     MarkSaved,
+    /// The whole document is on disk: a session was saved or opened, or a scene
+    /// was opened from its files. The pose is saved too.
+    MarkSessionSaved,
 }
 
 impl Command {
@@ -161,6 +165,67 @@ impl Applied {
     }
 }
 
+/// What the last session save, or the opening of a scene, left on disk: the
+/// mesh and cage (by identity: every edit makes new ones) and the named poses.
+#[derive(Debug)]
+struct SessionMark {
+    mesh: Arc<TriMesh>,
+    cage: Arc<Cage>,
+    named_poses: Arc<Vec<NamedPose>>,
+}
+
+impl SessionMark {
+    fn of(document: &Document) -> Self {
+        Self {
+            mesh: Arc::clone(document.mesh()),
+            cage: Arc::clone(document.cage()),
+            named_poses: document.named_poses_shared(),
+        }
+    }
+}
+
+/// What quitting or opening another scene would lose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Unsaved {
+    /// The pose differs from the rest pose and from the one last saved.
+    pub pose: bool,
+    /// Named poses were stored, renamed or deleted since the session was saved.
+    pub named_poses: bool,
+    /// The rest cage is not on disk (generated, subdivided, rested in a pose).
+    pub cage: bool,
+    /// The rest mesh is not on disk (Use pose as rest shape).
+    pub mesh: bool,
+}
+
+impl Unsaved {
+    pub fn any(&self) -> bool {
+        self.pose || self.named_poses || self.cage || self.mesh
+    }
+
+    /// Only the pose: a pose file keeps everything.
+    pub fn only_pose(&self) -> bool {
+        self.pose && !(self.named_poses || self.cage || self.mesh)
+    }
+
+    /// What would be lost, in words ("the pose", "the named poses").
+    pub fn items(&self) -> Vec<&'static str> {
+        let mut items = Vec::new();
+        if self.pose {
+            items.push("the pose");
+        }
+        if self.named_poses {
+            items.push("the named poses");
+        }
+        if self.cage {
+            items.push("the edited or generated cage");
+        }
+        if self.mesh {
+            items.push("the rest mesh made from a pose");
+        }
+        items
+    }
+}
+
 #[derive(Debug)]
 pub struct Model {
     document: Document,
@@ -168,11 +233,13 @@ pub struct Model {
     gesture: Option<Gesture>,
     /// The pose last saved (a session or a pose file), or opened as saved.
     saved_pose: Vec<DVec3>,
+    session_mark: SessionMark,
 }
 
 impl Model {
     pub fn new(document: Document) -> Self {
         Self {
+            session_mark: SessionMark::of(&document),
             document,
             log: UndoLog::default(),
             gesture: None,
@@ -208,6 +275,19 @@ impl Model {
     pub fn pose_unsaved(&self) -> bool {
         let pose = self.document.pose();
         pose != self.document.cage().positions() && pose != self.saved_pose.as_slice()
+    }
+
+    /// What quitting or opening another scene would lose now.
+    pub fn unsaved(&self) -> Unsaved {
+        let document = &self.document;
+        let mark = &self.session_mark;
+        let named = document.named_poses_shared();
+        Unsaved {
+            pose: self.pose_unsaved(),
+            named_poses: !Arc::ptr_eq(&named, &mark.named_poses) && *named != *mark.named_poses,
+            cage: !Arc::ptr_eq(document.cage(), &mark.cage) && document.cage_path().is_none(),
+            mesh: !Arc::ptr_eq(document.mesh(), &mark.mesh) && document.mesh_file().is_none(),
+        }
     }
 
     /// What changed since the last call, for the GPU copy and the caches.
@@ -282,6 +362,7 @@ impl Model {
             Command::InstallDocument(document) => {
                 self.gesture = None;
                 self.document = *document;
+                self.session_mark = SessionMark::of(&self.document);
                 self.log.clear();
                 Applied::of(Outcome::Changed)
             }
@@ -293,6 +374,11 @@ impl Model {
             Command::Redo(view) => self.step_back_or_forth(false, view),
             Command::MarkSaved => {
                 self.saved_pose = self.document.pose().to_vec();
+                Applied::of(Outcome::Changed)
+            }
+            Command::MarkSessionSaved => {
+                self.saved_pose = self.document.pose().to_vec();
+                self.session_mark = SessionMark::of(&self.document);
                 Applied::of(Outcome::Changed)
             }
         }

@@ -9,6 +9,13 @@ use crate::app::editor::FileRole;
 use crate::geometry::{load_mesh, MeshFile};
 use std::path::PathBuf;
 
+/// A session file (`*.json`, as File > Save session writes them): dropped, it
+/// opens as a session.
+fn is_session(path: &std::path::Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
 /// A dropped file, read, waiting for the user's choice.
 pub struct DroppedFile {
     pub path: PathBuf,
@@ -59,6 +66,7 @@ impl DropDialog {
         });
         match dropped.as_slice() {
             [] => {}
+            [path] if is_session(path) => context.send(Action::OpenSession(path.clone())),
             [path] => match load_mesh(path) {
                 Ok(file) => {
                     self.pending = Some(DroppedFile {
