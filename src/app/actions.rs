@@ -10,6 +10,7 @@ use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::shortcuts::ViewSide;
 use super::ui::file_dialog::FileAction;
+use super::ui::recovery_dialog::RecoverAnswer;
 use super::ui::unsaved_dialog::UnsavedAnswer;
 use crate::coords::{Method, Parameter};
 use glam::DVec3;
@@ -24,6 +25,8 @@ pub enum Action {
     CloseWindow,
     /// The answer to "Save changes before quitting (or opening)?".
     Unsaved(UnsavedAnswer),
+    /// The answer about a recovery file left by an editor that did not exit.
+    Recover(PathBuf, RecoverAnswer),
     /// Open the file dialog for `FileAction`.
     AskForFile(FileAction),
     /// The in-window dialog's answer: carry out `FileAction` on the path.

@@ -34,6 +34,7 @@ mod offscreen;
 pub mod pose_tools;
 mod readouts;
 pub mod recent;
+pub mod recovery;
 pub mod scenes;
 mod screenshot;
 mod scripted_drag;
@@ -81,6 +82,9 @@ pub struct EditorOptions {
     /// Show no timings (bind and elapsed times), so that frames are deterministic
     /// (snapshot tests).
     pub hide_timings: bool,
+    /// Autosave unsaved work here, and offer what an editor left here at start-up
+    /// (`None`: no autosave, as in tests and scripted runs).
+    pub recovery_dir: Option<PathBuf>,
     /// Start the bundled comb in its demonstration pose (`scenes::comb_demo_pose`),
     /// with a line saying what to look at: what `pmvc` with no arguments opens.
     pub demo_pose: bool,
@@ -155,6 +159,12 @@ pub fn run_editor(options: EditorOptions) -> Result<(), EditorError> {
         &mut native_options.wgpu_options.wgpu_setup
     {
         setup.device_descriptor = std::sync::Arc::new(editor_device_descriptor);
+    }
+    let mut options = options;
+    if options.screenshot.is_none() && options.recovery_dir.is_none() {
+        options.recovery_dir = std::env::var_os("PMVC_RECOVERY_DIR")
+            .map(PathBuf::from)
+            .or_else(|| eframe::storage_dir("pmvc editor").map(|dir| dir.join("recovery")));
     }
     let failures: std::sync::Arc<std::sync::Mutex<Vec<String>>> = Default::default();
     let failures_of_run = std::sync::Arc::clone(&failures);

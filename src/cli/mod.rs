@@ -330,6 +330,7 @@ impl EditArgs {
             },
             view,
             hide_timings: false,
+            recovery_dir: None,
             demo_pose: self.demo,
         }
     }

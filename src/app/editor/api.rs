@@ -139,6 +139,26 @@ impl EditorApp {
         self.panels.unsaved.question() == Some(&Question::Quit)
     }
 
+    /// Write the recovery file now, as the timer would.
+    pub fn autosave(&mut self) -> Result<(), String> {
+        self.autosave_now()
+    }
+
+    /// This editor's recovery file, when it keeps one.
+    pub fn recovery_file(&self) -> Option<&Path> {
+        self.files.recovery.as_ref().map(|r| r.file())
+    }
+
+    /// The recovery question is shown.
+    pub fn is_offering_recovery(&self) -> bool {
+        self.panels.recovery.is_open()
+    }
+
+    /// The session file Save session writes to, if it has one.
+    pub fn session_path(&self) -> Option<&Path> {
+        self.files.session_path.as_deref()
+    }
+
     /// The unsaved-work question shown, if one is.
     pub fn unsaved_question(&self) -> Option<&Question> {
         self.panels.unsaved.question()

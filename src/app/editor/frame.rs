@@ -17,6 +17,7 @@ use crate::app::views::{ViewportContext, ViewportFacts, Views};
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.run.clock = ctx.input(|i| i.time);
         let panels = &mut self.panels;
         panels
             .statistics
@@ -72,6 +73,7 @@ impl eframe::App for EditorApp {
         with_context(&self.model, &shown, &mut self.actions, |cx| {
             self.panels.drop.ui(&ctx, cx);
             self.panels.unsaved.ui(&ctx, cx);
+            self.panels.recovery.ui(&ctx, cx);
             (self.panels.notices).toasts(&ctx, viewport, shown.hide_timings, cx);
         });
         // After the panels that send actions; before the file dialog, so the
@@ -92,6 +94,7 @@ impl eframe::App for EditorApp {
             let binding = self.binding.queue.is_busy();
             screenshot.drive(&ctx, binding, self.panels.statistics.frames_mut());
         }
+        self.autosave_when_due(&ctx);
         let panes = self.views.viewport.pane_rects().into_iter().map(|(_, r)| r);
         if let Some(report) = self.files.image_request.drive(&ctx, panes) {
             self.report(report);
@@ -115,6 +118,16 @@ impl eframe::App for EditorApp {
         };
         if let Some(error) = drag.script_input(frame, raw_input, scene) {
             self.error(error);
+        }
+    }
+
+    /// A clean exit lets the autosave go when nothing is unsaved (quitting
+    /// without saving removed it already).
+    fn on_exit(&mut self) {
+        if !self.model.unsaved().any() {
+            if let Some(recovery) = &mut self.files.recovery {
+                recovery.remove();
+            }
         }
     }
 
@@ -230,4 +243,40 @@ fn with_context<R>(
 ) -> R {
     let mut context = PanelContext::new(model, shown, actions);
     f(&mut context)
+}
+
+impl EditorApp {
+    /// Autosave unsaved work when it is due; let the file go once nothing is
+    /// unsaved.
+    fn autosave_when_due(&mut self, ctx: &egui::Context) {
+        let Some(recovery) = &mut self.files.recovery else {
+            return;
+        };
+        if !self.model.unsaved().any() {
+            recovery.remove();
+            return;
+        }
+        let now = ctx.input(|i| i.time);
+        match recovery.due_in(now, self.model.document()) {
+            None => {}
+            Some(wait) if wait > 0.0 => {
+                ctx.request_repaint_after(std::time::Duration::from_secs_f64(wait));
+            }
+            Some(_) => {
+                if let Err(error) = self.autosave_now() {
+                    self.error(error);
+                }
+            }
+        }
+    }
+
+    /// Write the session to the recovery file now.
+    pub(super) fn autosave_now(&mut self) -> Result<(), String> {
+        let settings = self.session_settings();
+        let Some(recovery) = &mut self.files.recovery else {
+            return Err("this run keeps no recovery file".into());
+        };
+        let now = self.run.clock;
+        recovery.write(now, self.model.document(), &settings)
+    }
 }

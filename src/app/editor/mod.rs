@@ -22,6 +22,7 @@ use super::files::SceneChange;
 use super::focus::KeyboardFocus;
 use super::model::{Command, Model, Outcome, SessionView, Swapped};
 use super::recent::RecentFiles;
+use super::recovery::Recovery;
 use super::scenes::{self, BundledScene};
 use super::screenshot::ScreenshotState;
 use super::ui::drop_dialog::DropDialog;
@@ -29,6 +30,7 @@ use super::ui::file_dialog::FileDialogs;
 use super::ui::named_poses::PoseBlend;
 use super::ui::notices::Notices;
 use super::ui::pose_panel::PosePanel;
+use super::ui::recovery_dialog::RecoveryDialog;
 use super::ui::shortcuts_help::ShortcutsHelp;
 use super::ui::statistics::StatisticsPanel;
 use super::ui::unsaved_dialog::{Question, UnsavedDialog};
@@ -136,6 +138,8 @@ struct Panels {
     first_run_hint: bool,
     /// Help > Shortcuts.
     shortcuts_help: ShortcutsHelp,
+    /// Work an earlier editor autosaved and left behind, offered at start-up.
+    recovery: RecoveryDialog,
 }
 
 /// Where the scene's files are and go.
@@ -148,6 +152,8 @@ struct FileState {
     image_request: ImageRequest,
     /// What waits for the answer to "Save changes?".
     waiting: Option<Waiting>,
+    /// Autosave of unsaved work, when the run has a recovery folder.
+    recovery: Option<Recovery>,
 }
 
 /// What the unsaved-work question holds back until it is answered.
@@ -165,6 +171,8 @@ struct RunState {
     focus: KeyboardFocus,
     /// Show no timings, so frames are deterministic (snapshot tests).
     hide_timings: bool,
+    /// egui's clock at the start of this frame (autosave times).
+    clock: f64,
 }
 
 impl EditorApp {
@@ -224,6 +232,10 @@ impl EditorApp {
             },
             files: FileState {
                 recent: cc.storage.map(RecentFiles::load).unwrap_or_default(),
+                recovery: (options.screenshot.is_none())
+                    .then_some(options.recovery_dir.as_deref())
+                    .flatten()
+                    .map(Recovery::new),
                 ..FileState::default()
             },
             run: RunState {
@@ -233,6 +245,7 @@ impl EditorApp {
                     .map(|path| ScreenshotState::new(path, options.drag_handle)),
                 focus: KeyboardFocus::default(),
                 hide_timings: options.hide_timings,
+                clock: 0.0,
             },
             actions: Vec::new(),
         };
@@ -262,6 +275,13 @@ impl EditorApp {
             app.load_pose(pose);
         }
         app.report_heatmap_out_of_range(&options.view);
+        if let Some(dir) = options
+            .recovery_dir
+            .as_deref()
+            .filter(|_| app.files.recovery.is_some())
+        {
+            app.panels.recovery.offer(super::recovery::left_behind(dir));
+        }
         // What was opened above has started its binds; starting again would
         // cancel them, and a cancel pauses binding until the user asks.
         if !opened {

@@ -14,6 +14,7 @@ use crate::app::recent::RecentEntry;
 use crate::app::session::SessionSettings;
 use crate::app::ui::file_dialog::{DialogAnswer, FileAction};
 use crate::app::ui::named_poses::blend_poses;
+use crate::app::ui::recovery_dialog::RecoverAnswer;
 use crate::app::ui::unsaved_dialog::Question;
 use crate::app::ui::unsaved_dialog::UnsavedAnswer;
 use crate::render::Colouring;
@@ -48,7 +49,14 @@ impl EditorApp {
                 }
             }
             Action::Unsaved(answer) => self.answer_unsaved(answer),
-            Action::CloseWindow => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
+            Action::Recover(path, answer) => self.recover(&path, answer),
+            Action::CloseWindow => {
+                // Quitting was confirmed: what was autosaved was let go.
+                if let Some(recovery) = &mut self.files.recovery {
+                    recovery.remove();
+                }
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close)
+            }
             Action::AskForFile(file_action) => self.ask_for_file_now(file_action),
             Action::FileChosen(file_action, path) => self.in_window_answer(file_action, &path),
             Action::FileCancelled(file_action) => self.file_action_cancelled(file_action),
@@ -407,12 +415,17 @@ impl EditorApp {
         self.report(files::save_cage(path, self.model.document()))
     }
 
-    pub(super) fn save_session_now(&mut self, path: &Path) -> bool {
-        let settings = SessionSettings {
+    /// What a session keeps besides the document.
+    pub(super) fn session_settings(&self) -> SessionSettings {
+        SessionSettings {
             bind_options: self.binding.options,
             view: self.views.settings,
             cameras: self.views.viewport.camera_list(),
-        };
+        }
+    }
+
+    pub(super) fn save_session_now(&mut self, path: &Path) -> bool {
+        let settings = self.session_settings();
         let saved = self.report(files::save_session(path, self.model.document(), &settings));
         if saved {
             self.apply(Command::MarkSessionSaved);
@@ -580,6 +593,38 @@ impl EditorApp {
         }
         self.files.waiting = Some(waiting);
         self.go_on();
+    }
+
+    /// The answer about a recovery file left behind.
+    fn recover(&mut self, path: &Path, answer: RecoverAnswer) {
+        match answer {
+            RecoverAnswer::Later => {}
+            RecoverAnswer::Discard => {
+                crate::app::recovery::discard(path);
+                self.info(format!(
+                    "discarded the autosaved work {}",
+                    crate::geometry::shown_path(path)
+                ));
+            }
+            RecoverAnswer::Restore => {
+                let change = files::open_session(path).map(|mut change| {
+                    // Not a session of the user's: Save session asks for a name.
+                    change.session = None;
+                    change.recent = None;
+                    change
+                });
+                if !self.change_scene(change) {
+                    return;
+                }
+                self.apply(Command::MarkRecovered);
+                self.files.session_path = None;
+                // This editor's own autosave holds it before the old file goes.
+                if self.autosave_now().is_ok() {
+                    crate::app::recovery::discard(path);
+                }
+                self.info("restored the autosaved work: File > Save session… keeps it");
+            }
+        }
     }
 
     /// Carry out what waited for the question: quit, or open the scene.

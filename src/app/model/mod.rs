@@ -112,6 +112,9 @@ pub enum Command {
     /// The whole document is on disk: a session was saved or opened, or a scene
     /// was opened from its files. The pose is saved too.
     MarkSessionSaved,
+    /// The document came from a recovery file: nothing of it counts as saved
+    /// but the files it names.
+    MarkRecovered,
 }
 
 impl Command {
@@ -233,13 +236,14 @@ pub struct Model {
     gesture: Option<Gesture>,
     /// The pose last saved (a session or a pose file), or opened as saved.
     saved_pose: Vec<DVec3>,
-    session_mark: SessionMark,
+    /// `None` after recovery: no session holds this work.
+    session_mark: Option<SessionMark>,
 }
 
 impl Model {
     pub fn new(document: Document) -> Self {
         Self {
-            session_mark: SessionMark::of(&document),
+            session_mark: Some(SessionMark::of(&document)),
             document,
             log: UndoLog::default(),
             gesture: None,
@@ -280,13 +284,24 @@ impl Model {
     /// What quitting or opening another scene would lose now.
     pub fn unsaved(&self) -> Unsaved {
         let document = &self.document;
-        let mark = &self.session_mark;
         let named = document.named_poses_shared();
+        let (named_poses, cage, mesh) = match &self.session_mark {
+            Some(mark) => (
+                !Arc::ptr_eq(&named, &mark.named_poses) && *named != *mark.named_poses,
+                !Arc::ptr_eq(document.cage(), &mark.cage),
+                !Arc::ptr_eq(document.mesh(), &mark.mesh),
+            ),
+            // Recovered: bundled files are still bundled, and named files on disk.
+            None => {
+                let generated = document.bundled().is_none();
+                (!named.is_empty(), generated, generated)
+            }
+        };
         Unsaved {
             pose: self.pose_unsaved(),
-            named_poses: !Arc::ptr_eq(&named, &mark.named_poses) && *named != *mark.named_poses,
-            cage: !Arc::ptr_eq(document.cage(), &mark.cage) && document.cage_path().is_none(),
-            mesh: !Arc::ptr_eq(document.mesh(), &mark.mesh) && document.mesh_file().is_none(),
+            named_poses,
+            cage: cage && document.cage_path().is_none(),
+            mesh: mesh && document.mesh_file().is_none(),
         }
     }
 
@@ -362,7 +377,7 @@ impl Model {
             Command::InstallDocument(document) => {
                 self.gesture = None;
                 self.document = *document;
-                self.session_mark = SessionMark::of(&self.document);
+                self.session_mark = Some(SessionMark::of(&self.document));
                 self.log.clear();
                 Applied::of(Outcome::Changed)
             }
@@ -378,7 +393,12 @@ impl Model {
             }
             Command::MarkSessionSaved => {
                 self.saved_pose = self.document.pose().to_vec();
-                self.session_mark = SessionMark::of(&self.document);
+                self.session_mark = Some(SessionMark::of(&self.document));
+                Applied::of(Outcome::Changed)
+            }
+            Command::MarkRecovered => {
+                self.saved_pose.clear();
+                self.session_mark = None;
                 Applied::of(Outcome::Changed)
             }
         }

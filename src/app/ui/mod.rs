@@ -12,6 +12,7 @@ pub mod named_poses;
 pub mod notices;
 pub mod pose_panel;
 pub mod quality_table;
+pub mod recovery_dialog;
 pub mod shortcuts_help;
 pub mod side_panel;
 pub mod statistics;
