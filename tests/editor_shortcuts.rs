@@ -259,3 +259,44 @@ fn alt_drag_orbits_even_when_it_starts_on_a_handle() {
     );
     assert_ne!(harness.state().document().pose(), pose.as_slice());
 }
+
+#[test]
+fn numpad_5_switches_every_view_to_parallel_and_back_and_handles_still_pick() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    hover_view(&mut harness);
+    assert!(!harness.state().camera().orthographic);
+    tap(&mut harness, Modifiers::NONE, Key::Num5);
+    let panes = harness.state().pane_rects().len();
+    for pane in 0..panes {
+        assert!(harness.state().camera_of(pane).orthographic, "view {pane}");
+    }
+    // A handle is picked where the parallel view draws it.
+    let (handle, at) = isolated_handle(&harness);
+    click(&mut harness, at);
+    let selection = harness.state().document().selection();
+    assert_eq!(selection.iter().copied().collect::<Vec<_>>(), [handle]);
+
+    hover_view(&mut harness);
+    tap(&mut harness, Modifiers::NONE, Key::Num5);
+    assert!(
+        !harness.state().camera().orthographic,
+        "back to perspective"
+    );
+}
+
+#[test]
+fn the_period_key_frames_the_selection_as_f_does() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().select_only([0, 1]);
+    hover_view(&mut harness);
+    tap(&mut harness, Modifiers::NONE, Key::F);
+    let framed_by_f = harness.state().camera();
+    tap(&mut harness, Modifiers::NONE, Key::Home);
+    assert_ne!(harness.state().camera().target, framed_by_f.target);
+    tap(&mut harness, Modifiers::NONE, Key::Period);
+    let framed = harness.state().camera();
+    assert_eq!(framed.target, framed_by_f.target);
+    assert_eq!(framed.distance, framed_by_f.distance);
+}

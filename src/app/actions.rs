@@ -122,6 +122,8 @@ pub enum Action {
     InvertSelection,
     /// Every view looks at the scene from this side.
     ViewFrom(ViewSide),
+    /// Every view switches between parallel and perspective (numpad 5).
+    ToggleOrthographic,
 }
 
 /// A step of the blend slider's gesture.

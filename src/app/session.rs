@@ -64,6 +64,9 @@ pub struct CameraEntry {
     pub distance: f32,
     pub yaw: f32,
     pub pitch: f32,
+    /// A parallel view (numpad 5); absent in sessions from before it existed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub orthographic: bool,
 }
 
 /// A session file as written.
@@ -274,6 +277,7 @@ pub fn save_session(
                 distance: camera.distance,
                 yaw: camera.yaw,
                 pitch: camera.pitch,
+                orthographic: camera.orthographic,
             })
             .collect(),
     };

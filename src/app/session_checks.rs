@@ -230,6 +230,7 @@ pub fn camera_in_range(
         distance,
         yaw,
         pitch,
+        orthographic: entry.orthographic,
     }
 }
 

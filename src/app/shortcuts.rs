@@ -21,6 +21,8 @@ pub enum Shortcut {
     InvertSelection,
     /// Look at the scene from one side (Blender's numpad views).
     ViewFrom(ViewSide),
+    /// Parallel or perspective view (numpad 5).
+    ToggleOrthographic,
     FrameSelection,
     FrameAll,
     NextMethod,
@@ -164,7 +166,17 @@ pub const SHORTCUTS: &[(Keys, Scope, Shortcut)] = &[
         Shortcut::ViewFrom(ViewSide::Bottom),
     ),
     (
+        Keys::Plain(Key::Num5),
+        Scope::Viewport,
+        Shortcut::ToggleOrthographic,
+    ),
+    (
         Keys::Plain(Key::F),
+        Scope::Viewport,
+        Shortcut::FrameSelection,
+    ),
+    (
+        Keys::Plain(Key::Period),
         Scope::Viewport,
         Shortcut::FrameSelection,
     ),
@@ -280,6 +292,7 @@ impl Shortcut {
             Shortcut::SelectAll => "Select every handle",
             Shortcut::InvertSelection => "Invert the selection",
             Shortcut::ViewFrom(side) => side.describe(),
+            Shortcut::ToggleOrthographic => "Parallel (orthographic) or perspective view",
             Shortcut::FrameSelection => "Frame the selection",
             Shortcut::FrameAll => "Frame the whole scene",
             Shortcut::NextMethod => "Show the next family",
@@ -303,6 +316,7 @@ impl Shortcut {
             Shortcut::SelectAll => Action::SelectAll,
             Shortcut::InvertSelection => Action::InvertSelection,
             Shortcut::ViewFrom(side) => Action::ViewFrom(side),
+            Shortcut::ToggleOrthographic => Action::ToggleOrthographic,
             Shortcut::FrameSelection => Action::FrameSelection,
             Shortcut::FrameAll => Action::FrameAll,
             Shortcut::NextMethod => Action::NextMethod,

@@ -31,6 +31,9 @@ pub struct OrbitCamera {
     pub yaw: f32,
     /// Elevation above the xz plane, radians, kept inside ±89°.
     pub pitch: f32,
+    /// Parallel projection (Blender's numpad 5): the view at the target's
+    /// depth keeps its size, so switching does not jump.
+    pub orthographic: bool,
 }
 
 impl Default for OrbitCamera {
@@ -40,6 +43,7 @@ impl Default for OrbitCamera {
             distance: 5.0,
             yaw: 0.35,
             pitch: 0.3,
+            orthographic: false,
         }
     }
 }
@@ -67,14 +71,34 @@ impl OrbitCamera {
         let near = (self.distance * 0.01).max(1e-4);
         let far = self.distance * 100.0 + 10.0;
         let aspect = aspect.max(1e-3);
-        // wgpu's clip space is DirectX's: z in [0, 1], y up.
-        glam::camera::rh::proj::directx::perspective(fov_y(aspect), aspect, near, far)
-            * glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
+        let view = glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y);
+        if self.orthographic {
+            // What the perspective shows at the target's depth; depth reaches
+            // as far behind the eye as in front, since nothing divides by it.
+            let half_height = self.distance * (fov_y(aspect) / 2.0).tan();
+            let half_width = half_height * aspect;
+            // wgpu's clip space is DirectX's: z in [0, 1], y up.
+            return glam::camera::rh::proj::directx::orthographic(
+                -half_width,
+                half_width,
+                -half_height,
+                half_height,
+                -far,
+                far,
+            ) * view;
+        }
+        glam::camera::rh::proj::directx::perspective(fov_y(aspect), aspect, near, far) * view
     }
 
     /// World units per pixel at `depth` along the view direction, in a viewport
     /// whose shorter side is `short_side_px` (the field of view spans that side).
     pub fn units_per_pixel(&self, depth: f32, short_side_px: f32) -> f32 {
+        // A parallel view has one scale at every depth: the target's.
+        let depth = if self.orthographic {
+            self.distance
+        } else {
+            depth
+        };
         2.0 * depth.max(1e-4) * (FOV_Y / 2.0).tan() / short_side_px.max(1.0)
     }
 
@@ -174,6 +198,37 @@ mod tests {
         };
         let centre = projection.project(camera.target).unwrap();
         assert!((centre - Vec2::new(110.0, 70.0)).length() < 1e-3);
+    }
+
+    #[test]
+    fn the_parallel_view_shows_the_targets_plane_as_the_perspective_does_and_ignores_depth() {
+        let perspective = OrbitCamera::default();
+        let parallel = OrbitCamera {
+            orthographic: true,
+            ..perspective
+        };
+        let screen = |camera: &OrbitCamera, point: Vec3| {
+            ScreenProjection {
+                view_projection: camera.view_projection(1.5),
+                origin: Vec2::ZERO,
+                size: Vec2::new(300.0, 200.0),
+                scene_origin: SceneOrigin::default(),
+            }
+            .project(point)
+            .unwrap()
+        };
+        let (right, up) = perspective.right_up();
+        // On the plane through the target, both agree.
+        let on_plane = perspective.target + right * 0.7 + up * 0.4;
+        let gap = (screen(&perspective, on_plane) - screen(&parallel, on_plane)).length();
+        assert!(gap < 1e-2, "{gap}");
+        // Moved along the view direction, a point stays put only in parallel.
+        let towards = -perspective.backward() * 1.5;
+        let moved_parallel = screen(&parallel, on_plane + towards) - screen(&parallel, on_plane);
+        let moved_perspective =
+            screen(&perspective, on_plane + towards) - screen(&perspective, on_plane);
+        assert!(moved_parallel.length() < 1e-3, "{moved_parallel}");
+        assert!(moved_perspective.length() > 10.0, "{moved_perspective}");
     }
 
     #[test]

@@ -166,6 +166,7 @@ impl EditorApp {
                     .collect();
                 self.apply(Command::Select(Selection::only(others)));
             }
+            Action::ToggleOrthographic => self.views.viewport.toggle_orthographic(),
             Action::ViewFrom(side) => {
                 let (yaw, pitch) = side.yaw_pitch();
                 self.views.viewport.look_from(yaw, pitch);

@@ -110,6 +110,15 @@ impl ViewportState {
         }
     }
 
+    /// Every view switches between a parallel and a perspective view together,
+    /// as the first view was.
+    pub fn toggle_orthographic(&mut self) {
+        let parallel = !self.cameras[0].orthographic;
+        for camera in &mut self.cameras {
+            camera.orthographic = parallel;
+        }
+    }
+
     /// Every view takes the first view's camera.
     pub fn unify_cameras(&mut self) {
         self.cameras = [self.cameras[0]; MAX_VIEWS];
