@@ -17,7 +17,7 @@ pub enum LoadError {
     Empty { path: PathBuf },
     #[error("{path}: not a text mesh file (binary data near byte {offset})", path = shown_path(path))]
     Binary { path: PathBuf, offset: usize },
-    #[error("{path}: unknown mesh format (expected a .obj or .off file, or a .npy point set)", path = shown_path(path))]
+    #[error("{path}: unknown mesh format (expected a .obj, .off, .glb or .gltf file, or a .npy point set)", path = shown_path(path))]
     UnknownFormat { path: PathBuf },
     #[error("{path}:{line}: {message}", path = shown_path(path))]
     Parse {
@@ -49,6 +49,10 @@ pub enum LoadError {
     /// A `.npy` point set that is not an (n, 3) array of finite floats.
     #[error("{path}: {message}", path = shown_path(path))]
     Npy { path: PathBuf, message: String },
+    /// A glTF file that cannot be read: the message names the element
+    /// (`accessor 3: …`) and what is wrong with it.
+    #[error("{path}: {message}", path = shown_path(path))]
+    Gltf { path: PathBuf, message: String },
     #[error("{path}: {count} vertices is more than the {limit} this tool supports", path = shown_path(path))]
     TooLarge {
         path: PathBuf,

@@ -27,6 +27,7 @@ fn format_of(path: &Path) -> Result<MeshFormat, LoadError> {
         Some("obj") => Ok(MeshFormat::Obj),
         Some("off") => Ok(MeshFormat::Off),
         Some("npy") => Ok(MeshFormat::Npy),
+        Some("glb" | "gltf") => Ok(MeshFormat::Gltf),
         _ => Err(LoadError::UnknownFormat {
             path: path.to_owned(),
         }),
@@ -72,7 +73,7 @@ fn parse_memory(format: MeshFormat, text: &[u8]) -> u64 {
         // Per line at most one position; per number at most a triangle's share.
         MeshFormat::Off => [text, bytes_for(lines, 24), bytes_for(tokens, 8)],
         // Binary: never parsed as text.
-        MeshFormat::Npy => [text, 0, 0],
+        MeshFormat::Npy | MeshFormat::Gltf => [text, 0, 0],
     };
     total.into_iter().fold(0, u64::saturating_add)
 }
@@ -97,8 +98,9 @@ fn count_lines(text: &[u8]) -> (u64, u64, u64, u64) {
     (lines, tokens, vertices, corners)
 }
 
-/// Read an OBJ or OFF file, or a `.npy` point set (chosen by extension,
-/// case-insensitive), refusing what would not fit in memory before allocating
+/// Read an OBJ or OFF file, a `.npy` point set, or the first mesh of a glTF file
+/// (`.glb` or `.gltf`, read by [`super::gltf::load_gltf`]), chosen by extension,
+/// case-insensitive, refusing what would not fit in memory before allocating
 /// it: a regular file by its size (its text and a copy) before it is read, then
 /// every file by what its text holds ([`parse_memory`]) before it is parsed. A
 /// device or pipe, which has no size, is read up to [`MESH_FILE_LIMIT`] or half
@@ -106,8 +108,10 @@ fn count_lines(text: &[u8]) -> (u64, u64, u64, u64) {
 /// [`super::points_npy`]'s rules: an (n, 3) array of finite float32 or float64.
 pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
     let format = format_of(path)?;
-    if format == MeshFormat::Npy {
-        return read_points_npy(path, MAX_VERTICES);
+    match format {
+        MeshFormat::Npy => return read_points_npy(path, MAX_VERTICES),
+        MeshFormat::Gltf => return super::gltf::load_gltf(path, &super::gltf::MeshPick::First),
+        MeshFormat::Obj | MeshFormat::Off => {}
     }
     let io_error = |source| LoadError::Io {
         path: path.to_owned(),
@@ -175,8 +179,8 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
     parse_mesh(path, text)
 }
 
-/// Parse the text of an OBJ or OFF file named `path` (the format chosen by its
-/// extension); `path` is only used for the format and for messages. The one entry
+/// Parse the text of an OBJ, OFF or `.gltf` file named `path` (the format chosen
+/// by its extension); `path` is only used for the format and for messages. The one entry
 /// for mesh text, used by [`load_mesh`] and by the editor's bundled scenes.
 pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
     // A byte-order mark would hide the first line's keyword; old-Mac files end
@@ -197,6 +201,9 @@ pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
             path: path.to_owned(),
             message: "a .npy point set is binary; read it with load_mesh".to_owned(),
         }),
+        MeshFormat::Gltf => {
+            super::gltf::parse_gltf(path, text.as_bytes(), &super::gltf::MeshPick::First)
+        }
     }
 }
 
@@ -288,7 +295,8 @@ pub fn write_deformed_mesh(
         "one position per mesh vertex"
     );
     match (&file.format, &file.obj_text) {
-        (MeshFormat::Obj, Some(text)) => write_atomically(path, |out| {
+        // A glTF's text is OBJ written from it.
+        (MeshFormat::Obj | MeshFormat::Gltf, Some(text)) => write_atomically(path, |out| {
             let normals = vertex_normals(positions, &file.mesh.triangles);
             let mut next_vertex = positions.iter();
             // `v` lines so far: a negative index counts back from there.
@@ -398,7 +406,7 @@ fn write_vertex(out: &mut dyn Write, p: DVec3) -> std::io::Result<()> {
 /// The shortest decimal that reads back as the same f64 (0.1 stays "0.1"), with
 /// an exponent for very large or small magnitudes so that no value takes
 /// hundreds of digits.
-struct RoundTrip(f64);
+pub(super) struct RoundTrip(pub f64);
 
 impl std::fmt::Display for RoundTrip {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

@@ -8,6 +8,7 @@ pub mod budget;
 mod cage;
 mod classify;
 mod error;
+pub mod gltf;
 mod intersect;
 mod io;
 mod normals;
@@ -87,6 +88,8 @@ pub enum MeshFormat {
     Off,
     /// An (n, 3) float32 or float64 NumPy array: a point set.
     Npy,
+    /// glTF 2.0, binary (`.glb`) or JSON (`.gltf`): one mesh of it ([`gltf`]).
+    Gltf,
 }
 
 /// A mesh as read from a file, with what is needed to write it back deformed.
@@ -96,7 +99,9 @@ pub struct MeshFile {
     pub format: MeshFormat,
     pub mesh: TriMesh,
     /// The original text of an OBJ file: a deformed copy keeps its faces, texture
-    /// coordinates, groups and materials by rewriting only the `v` lines.
+    /// coordinates, groups and materials by rewriting only the `v` lines. For a
+    /// glTF file, OBJ text written from its mesh (positions, texture coordinates,
+    /// primitives as groups), which is what was parsed.
     pub obj_text: Option<String>,
 }
 

@@ -92,6 +92,7 @@ pub(super) fn load_error(error: &LoadError) -> PyErr {
         | LoadError::NoVertices { path }
         | LoadError::Obj { path, .. }
         | LoadError::Npy { path, .. }
+        | LoadError::Gltf { path, .. }
         | LoadError::TooLarge { path, .. } => (path, None),
     };
     let kind = match error {
