@@ -1,5 +1,6 @@
 //! `pmvc deform`: move every mesh vertex with the cage, with fresh weights or
-//! those `pmvc bind` stored, and write the mesh as OBJ or the points as `.npy`.
+//! those `pmvc bind` stored, and write the mesh as OBJ or glTF (with more poses
+//! as morph targets, and an animation through them) or the points as `.npy`.
 
 use super::commands::{
     check_output, compute_weights, load_input, method_label, outside_note, outside_policy, summary,
@@ -9,6 +10,7 @@ use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz}
 use super::DeformArgs;
 use crate::coords::metadata::{metadata_path, read_metadata, WeightsMetadata};
 use crate::coords::{BindOptions, Method};
+use crate::geometry::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
 use crate::geometry::{self, bounds_of, find_crossing, shown_path, Cage};
 use anyhow::{bail, Result};
 use glam::DVec3;
@@ -75,7 +77,27 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         args.deformed_cage.as_path(),
     ];
     inputs.extend(args.weights.as_deref());
-    check_output(&args.out, &inputs, &["obj", "npy"], "an OBJ mesh")?;
+    inputs.extend(args.poses.iter().map(PathBuf::as_path));
+    let gltf = is_gltf_path(&args.out);
+    if !gltf {
+        let flag = match (args.poses.is_empty(), args.animate) {
+            (_, Some(_)) => Some("--animate"),
+            (false, None) => Some("--poses"),
+            (true, None) => None,
+        };
+        if let Some(flag) = flag {
+            bail!(
+                "{}: {flag} needs glTF output (--out ending in .glb or .gltf), which holds poses as morph targets",
+                shown_path(&args.out)
+            );
+        }
+    }
+    check_output(
+        &args.out,
+        &inputs,
+        &["obj", "npy", "glb", "gltf"],
+        "an OBJ or glTF mesh",
+    )?;
     // The family of stored weights decides what the warnings say of vertices
     // outside the cage, so it is known before the inputs are read.
     let stored = match &args.weights {
@@ -104,19 +126,15 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             resident_rows: &|rows, _| if holds_weights { rows } else { 0 },
         },
     )?;
-    let pose = geometry::load_mesh(&args.deformed_cage)?;
-    let (expected, found) = (input.cage.vertex_count(), pose.mesh.positions.len());
-    if found != expected {
-        bail!(
-            "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
-            shown_path(&args.deformed_cage),
-            shown_path(&args.input.cage)
-        );
-    }
+    let pose = load_pose(&args.deformed_cage, &input.cage, &args.input.cage)?;
+    let poses = args
+        .poses
+        .iter()
+        .map(|path| load_pose(path, &input.cage, &args.input.cage))
+        .collect::<Result<Vec<_>>>()?;
     if let Some((json, metadata)) = stored.as_ref().and_then(|s| s.metadata.as_ref()) {
         metadata.check_inputs(json, &input.mesh.mesh.positions, &input.cage)?;
     }
-    warn_if_crossed(&input.cage, &pose.mesh.positions, &args.deformed_cage);
     let weights = match &args.weights {
         Some(path) => read_weights_for(path, &input, method)?,
         None => compute_weights(&input, &args.method)?,
@@ -126,10 +144,36 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     // Σλc̃ carries each weight's rounding times the cage's distance from the
     // origin, this form only times how far the cage moved. Rows were checked to
     // sum to 1 when read, so a translation of the cage moves every vertex with it.
-    let moves = method.column_displacements(&input.cage, &pose.mesh.positions);
-    let deformed: Vec<DVec3> = weights.apply_displacements(&input.mesh.mesh.positions, &moves);
+    let deform = |pose: &[DVec3]| -> Vec<DVec3> {
+        let moves = method.column_displacements(&input.cage, pose);
+        weights.apply_displacements(&input.mesh.mesh.positions, &moves)
+    };
+    let deformed = deform(&pose);
     if writes_points_npy(&args.out) {
         geometry::write_points_npy(&args.out, &deformed)?;
+    } else if gltf {
+        let shapes: Vec<(String, Vec<DVec3>)> = args
+            .poses
+            .iter()
+            .zip(&poses)
+            .map(|(path, pose)| (pose_name(path), deform(pose)))
+            .collect();
+        let targets: Vec<GltfPose> = shapes
+            .iter()
+            .map(|(name, positions)| GltfPose { name, positions })
+            .collect();
+        let keys = args
+            .animate
+            .map(|seconds| AnimationKey::evenly(targets.len(), seconds));
+        write_gltf(
+            &args.out,
+            &GltfScene {
+                mesh: &input.mesh,
+                base: &deformed,
+                poses: &targets,
+                animation: keys.as_deref(),
+            },
+        )?;
     } else {
         geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     }
@@ -142,14 +186,44 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         (Some(path), _) => format!("weights from {}", shown_path(path)),
         (None, _) => format!("{} weights", method_label(options)),
     };
+    let extra = match (args.poses.len(), args.animate) {
+        (0, _) => String::new(),
+        (poses, None) => format!(", and {poses} poses as morph targets"),
+        (poses, Some(seconds)) => format!(
+            ", and {poses} poses as morph targets with a {seconds} s animation through them"
+        ),
+    };
     summary(format_args!(
-        "wrote {}: {} vertices deformed with {source} in {:.2} s; {}",
+        "wrote {}: {} vertices deformed with {source}{extra} in {:.2} s; {}",
         shown_path(&args.out),
         deformed.len(),
         started.elapsed().as_secs_f64(),
         outside_note(&input)
     ));
     Ok(())
+}
+
+/// A pose of the cage read from `path`: its vertices, which must be as many as
+/// the cage's, in order. A pose that crosses itself gets a warning.
+fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Vec<DVec3>> {
+    let pose = geometry::load_mesh(path)?;
+    let (expected, found) = (cage.vertex_count(), pose.mesh.positions.len());
+    if found != expected {
+        bail!(
+            "{}: the deformed cage has {found} vertices, but the cage {} has {expected}; a pose must keep the cage's vertices in order",
+            shown_path(path),
+            shown_path(cage_path)
+        );
+    }
+    warn_if_crossed(cage, &pose.mesh.positions, path);
+    Ok(pose.mesh.positions)
+}
+
+/// A morph target's name: its pose file's stem (`wave` for `poses/wave.obj`).
+fn pose_name(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| path.to_string_lossy(), |stem| stem.to_string_lossy())
+        .into_owned()
 }
 
 /// A warning, not an error, when the cage in its pose crosses itself: artists

@@ -37,7 +37,7 @@ mod weights_format;
 pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
-use parse::{parse_grid, parse_percent, parse_resolution, parse_view};
+use parse::{parse_grid, parse_percent, parse_resolution, parse_seconds, parse_view};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -96,11 +96,13 @@ pub enum BackendArg {
 
 #[derive(Debug, clap::Args)]
 pub struct CageInput {
-    /// The mesh to deform (.obj or .off). A file with vertices and no faces is a
-    /// point set, and so is a .npy array of shape (n, 3), float32 or float64, in C order.
+    /// The mesh to deform (.obj, .off, or the first mesh of a .glb or .gltf). A file
+    /// with vertices and no faces is a point set, and so is a .npy array of shape
+    /// (n, 3), float32 or float64, in C order.
     #[arg(long, value_name = "MESH")]
     pub mesh: PathBuf,
-    /// The cage: a closed, consistently oriented triangle or polygon mesh (.obj or .off).
+    /// The cage: a closed, consistently oriented triangle or polygon mesh (.obj, .off,
+    /// or a .glb or .gltf, whose vertices at one position are welded).
     #[arg(long, value_name = "CAGE")]
     pub cage: PathBuf,
 }
@@ -171,9 +173,15 @@ pub struct DeformArgs {
     /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
-    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format.
-    #[arg(long, value_name = "M2.obj|P2.npy")]
+    /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format. A name ending in .glb gets binary glTF 2.0, and .gltf glTF's JSON with its buffer inside: positions, recomputed normals, texture coordinates (v flipped, as glTF has it) and the OBJ's groups as primitives.
+    #[arg(long, value_name = "M2.obj|P2.npy|M2.glb|M2.gltf")]
     pub out: PathBuf,
+    /// glTF output only: more poses of the cage (each with --cage's vertices in order), each adding the mesh deformed by it as a morph target named after the file's stem (mesh.extras.targetNames, which Blender reads as shape keys). The mesh deformed by --deformed-cage is the base.
+    #[arg(long, value_name = "POSE", num_args = 1..)]
+    pub poses: Vec<PathBuf>,
+    /// glTF output only, with --poses: an animation of the morph target weights over SECONDS, from the base at 0 s through each pose in order, evenly spaced, the last at SECONDS, blended linearly between neighbours.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, requires = "poses")]
+    pub animate: Option<f32>,
 }
 
 #[derive(Debug, clap::Args)]

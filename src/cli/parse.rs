@@ -32,6 +32,14 @@ pub(super) fn parse_percent(text: &str) -> Result<f32, String> {
     crate::app::compare::check_difference_limit(percent / 100.0).map(|_| percent)
 }
 
+/// `--animate`: a duration in seconds, finite and above 0.
+pub(super) fn parse_seconds(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(seconds) if seconds.is_finite() && seconds > 0.0 => Ok(seconds),
+        _ => Err(format!("'{text}' is not a duration in seconds above 0")),
+    }
+}
+
 pub(super) fn parse_view(value: &str) -> Result<ViewArg, String> {
     match value {
         "side-by-side" => Ok(ViewArg::SideBySide),
