@@ -346,3 +346,46 @@ fn the_wheel_during_a_transform_sets_the_soft_selection_radius() {
     assert_eq!(harness.state().pose_tool_settings().soft_radius, wider);
     press(&mut harness, Key::Escape);
 }
+
+#[test]
+fn the_mirror_plane_picked_at_the_3d_cursor_pairs_a_cage_whose_extent_is_not_symmetric() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, _, cage, _) = common::comb_scene(dir.path(), 200);
+    let rest = cage.positions();
+    let (lo, hi) = pmvc::geometry::bounds_of(rest);
+    let plane = (lo.z + hi.z) / 2.0;
+    // One handle pulled out along -z (a tail): the box's centre moves off the
+    // plane the rest of the cage is symmetric about.
+    let tail = (0..rest.len())
+        .min_by(|&a, &b| rest[a].z.total_cmp(&rest[b].z))
+        .unwrap();
+    let mut moved = rest.to_vec();
+    moved[tail].z -= hi.z - lo.z;
+    let cage_path = common::write(
+        dir.path(),
+        "tailed_cage.obj",
+        &common::cage_obj(&cage.with_positions(moved)),
+    );
+    let Some(mut harness) = editor_on_files(&mesh, &cage_path) else {
+        return;
+    };
+    let handles = harness.state().document().pose().len();
+    let tools = harness.state_mut().pose_tool_settings_mut();
+    tools.symmetry = Some(2);
+    let off_centre = harness.state().handles_without_partner();
+    assert!(
+        off_centre > handles / 3,
+        "about the box's centre many handles are unpaired: {off_centre} of {handles}"
+    );
+    let tools = harness.state_mut().pose_tool_settings_mut();
+    tools.cursor = DVec3::new(0.0, 0.0, plane);
+    tools.mirror_plane = pmvc::app::pose_tools::MirrorPlane::Cursor;
+    assert_eq!(
+        harness.state().handles_without_partner(),
+        2,
+        "only the tail and the handle it left"
+    );
+    harness.run_steps(2);
+    use egui_kittest::kittest::Queryable;
+    harness.get_by_label(&format!("Mirror plane: z = {plane:.4}"));
+}

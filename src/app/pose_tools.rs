@@ -41,14 +41,26 @@ pub enum Pivot {
     Cursor,
 }
 
+/// Where the symmetry's mirror plane passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MirrorPlane {
+    /// Through the rest cage's bounding-box centre.
+    #[default]
+    CageCentre,
+    /// Through the 3D cursor (Shift+right-click picks it on the mesh or cage),
+    /// for a cage whose extent is not symmetric (a tail, a raised arm).
+    Cursor,
+}
+
 /// The posing tools' settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PoseToolSettings {
     pub pivot: Pivot,
     pub cursor: DVec3,
-    /// Mirror edits across the plane through the rest cage's centre that is
-    /// perpendicular to this world axis (0 = x, 1 = y, 2 = z).
+    /// Mirror edits across the plane perpendicular to this world axis (0 = x,
+    /// 1 = y, 2 = z), through [`Self::mirror_plane`].
     pub symmetry: Option<usize>,
+    pub mirror_plane: MirrorPlane,
     /// Handles near the selection follow its edits.
     pub soft_selection: bool,
     /// How far they follow from, as a fraction of the cage diagonal.
@@ -68,6 +80,7 @@ impl Default for PoseToolSettings {
             pivot: Pivot::default(),
             cursor: DVec3::ZERO,
             symmetry: None,
+            mirror_plane: MirrorPlane::default(),
             soft_selection: false,
             soft_radius: 0.15,
             mirror_tolerance: 0.1,
@@ -128,6 +141,16 @@ pub fn mean_edge_length(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
 }
 
 /// The centre of `points`' bounding box along `axis`.
+impl PoseToolSettings {
+    /// Where the mirror plane crosses `axis`, for the rest cage `rest`.
+    pub fn mirror_offset(&self, rest: &[DVec3], axis: usize) -> f64 {
+        match self.mirror_plane {
+            MirrorPlane::CageCentre => mid_plane(rest, axis),
+            MirrorPlane::Cursor => self.cursor[axis],
+        }
+    }
+}
+
 pub fn mid_plane(points: &[DVec3], axis: usize) -> f64 {
     let (lo, hi) = crate::geometry::bounds_of(points);
     (lo[axis] + hi[axis]) / 2.0

@@ -3,7 +3,7 @@
 
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
-use crate::app::pose_tools::{Pivot, PoseToolSettings, AXIS_NAMES, MIRROR_TOLERANCES};
+use crate::app::pose_tools::{MirrorPlane, Pivot, PoseToolSettings, AXIS_NAMES, MIRROR_TOLERANCES};
 use crate::app::viewport::handles_without_partner;
 
 /// The section and the settings it owns, which the viewport's edits read.
@@ -29,12 +29,36 @@ impl PosePanel {
             for (axis, name) in AXIS_NAMES.iter().enumerate() {
                 ui.selectable_value(&mut self.tools.symmetry, Some(axis), *name)
                     .on_hover_text(format!(
-                        "Mirror every edit across the plane through the rest cage's centre \
-                         perpendicular to {name}"
+                        "Mirror every edit across the plane perpendicular to {name}"
                     ));
             }
         });
-        if self.tools.symmetry.is_some() {
+        if let Some(axis) = self.tools.symmetry {
+            ui.horizontal(|ui| {
+                ui.label("Plane through:");
+                ui.selectable_value(
+                    &mut self.tools.mirror_plane,
+                    MirrorPlane::CageCentre,
+                    "cage centre",
+                )
+                .on_hover_text("The rest cage's bounding-box centre");
+                ui.selectable_value(
+                    &mut self.tools.mirror_plane,
+                    MirrorPlane::Cursor,
+                    "3D cursor",
+                )
+                .on_hover_text(
+                    "The 3D cursor: Shift+right click on the mesh or a handle picks it, \
+                         for a cage whose extent is not symmetric",
+                );
+            });
+            let offset = self
+                .tools
+                .mirror_offset(cx.document().cage().positions(), axis);
+            ui.label(format!(
+                "Mirror plane: {} = {offset:.4}",
+                AXIS_NAMES[axis].to_lowercase()
+            ));
             ui.horizontal(|ui| {
                 let mut percent = self.tools.mirror_tolerance * 100.0;
                 let range = MIRROR_TOLERANCES;

@@ -8,8 +8,8 @@
 use crate::app::document::Document;
 use crate::app::model::{Command, GestureKind};
 use crate::app::pose_tools::{
-    follow_weights, mean_edge_length, mid_plane, mirror_partners, posed, Pivot, PoseToolSettings,
-    Transform, AXIS_NAMES,
+    follow_weights, mean_edge_length, mirror_partners, posed, Pivot, PoseToolSettings, Transform,
+    AXIS_NAMES,
 };
 use crate::app::views::{ViewportContext, Views};
 use egui::{Color32, Key, Pos2, Rect, Stroke};
@@ -87,8 +87,8 @@ pub fn handles_without_partner(document: &Document, tools: &PoseToolSettings) ->
 }
 
 /// Under the symmetry in use, its axis and each handle's mirror partner in the
-/// rest cage, across the plane through the cage's bounding-box centre, within
-/// the tools' tolerance (a share of the mean cage edge).
+/// rest cage, across the tools' plane (the cage's bounding-box centre or the 3D
+/// cursor), within the tools' tolerance (a share of the mean cage edge).
 pub fn symmetry_partners(
     document: &Document,
     tools: &PoseToolSettings,
@@ -99,7 +99,7 @@ pub fn symmetry_partners(
     let tolerance = tools.mirror_tolerance * mean_edge_length(rest, cage.triangles());
     Some((
         axis,
-        mirror_partners(rest, axis, mid_plane(rest, axis), tolerance),
+        mirror_partners(rest, axis, tools.mirror_offset(rest, axis), tolerance),
     ))
 }
 
