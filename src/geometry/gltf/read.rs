@@ -164,6 +164,7 @@ fn picked<'a>(document: &'a gltf::Document, pick: &MeshPick) -> Result<gltf::Mes
     };
     found.ok_or_else(|| match pick {
         _ if count == 0 => "the file has no meshes".to_owned(),
+        MeshPick::First => "the file has no meshes".to_owned(),
         MeshPick::Index(index) => {
             format!("the file has {count} meshes, so there is no mesh {index} (they count from 0)")
         }
@@ -177,7 +178,6 @@ fn picked<'a>(document: &'a gltf::Document, pick: &MeshPick) -> Result<gltf::Mes
                 names.join(", ")
             )
         }
-        MeshPick::First => unreachable!("a file with meshes has a first"),
     })
 }
 
