@@ -339,6 +339,73 @@ pub fn save_session(
     Ok(format!("saved session {}", shown_path(path)))
 }
 
+/// Write the mesh deformed with `method` as glTF: the current pose as the base
+/// shape, each named pose as a morph target named after it, and the timeline's
+/// keys, when it has two or more, as the animation.
+pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<String, String> {
+    use crate::geometry::gltf::{write_gltf, AnimationKey, GltfPose, GltfScene};
+    refuse_overwriting_open_files(path, current)?;
+    if current.weights(method).is_none() {
+        return Err(format!(
+            "{}: not exported: {} is not bound yet",
+            shown_path(path),
+            method.name()
+        ));
+    }
+    let base = current.deformed_positions(method);
+    let named = current.named_poses();
+    let deformed: Vec<Vec<DVec3>> = named
+        .iter()
+        .map(|pose| current.deformed_positions_at(method, &pose.positions))
+        .collect();
+    let poses: Vec<GltfPose> = named
+        .iter()
+        .zip(&deformed)
+        .map(|(pose, positions)| GltfPose {
+            name: &pose.name,
+            positions,
+        })
+        .collect();
+    let keys: Vec<AnimationKey> = crate::app::timeline::keys(named)
+        .into_iter()
+        .map(|(seconds, index)| AnimationKey {
+            seconds: seconds as f32,
+            pose: Some(index),
+        })
+        .collect();
+    let made;
+    let mesh = match current.mesh_file() {
+        Some(file) => file,
+        None => {
+            made = MeshFile {
+                path: PathBuf::from(current.title()),
+                format: crate::geometry::MeshFormat::Obj,
+                mesh: (**current.mesh()).clone(),
+                obj_text: None,
+            };
+            &made
+        }
+    };
+    let scene = GltfScene {
+        mesh,
+        base: &base,
+        poses: &poses,
+        animation: (keys.len() >= 2).then_some(keys.as_slice()),
+    };
+    write_gltf(path, &scene).map_err(|error| error.to_string())?;
+    let animated = if keys.len() >= 2 {
+        format!(", an animation of {} keys", keys.len())
+    } else {
+        String::new()
+    };
+    Ok(format!(
+        "exported {} ({}, {} morph target(s){animated})",
+        shown_path(path),
+        method.name(),
+        poses.len()
+    ))
+}
+
 /// Write the mesh deformed with `method`.
 pub fn export_deformed(path: &Path, current: &Document, method: Method) -> Result<String, String> {
     refuse_overwriting_open_files(path, current)?;

@@ -41,6 +41,7 @@ mod scripted_drag;
 pub mod session;
 pub mod session_checks;
 pub mod shortcuts;
+pub mod timeline;
 pub mod ui;
 mod viewport;
 pub mod views;

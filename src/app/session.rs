@@ -55,6 +55,9 @@ pub enum CageSource {
 pub struct NamedPoseEntry {
     pub name: String,
     pub positions: Vec<[f64; 3]>,
+    /// Its time on the timeline, in seconds, when it is on it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -261,6 +264,7 @@ pub fn save_session(
             .map(|named| NamedPoseEntry {
                 name: named.name.clone(),
                 positions: named.positions.iter().copied().map(to_array).collect(),
+                time: named.time,
             })
             .collect(),
         method: settings.bind_options.method,
@@ -456,9 +460,16 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         let (name, cut) = cut_text(&named.name, &format!("the name of named pose {number}"));
         cut.into_iter().for_each(&mut note);
         let what = format!("named pose {number} ({name:?})");
+        // A time out of range takes the pose off the timeline, with a note.
+        let time = named.time.and_then(|seconds| {
+            crate::app::timeline::check_key_time(seconds)
+                .map_err(|why| note(format!("{what}: {why}; it is left off the timeline")))
+                .ok()
+        });
         named_poses.push(NamedPose {
             name,
             positions: check(what, &named.positions)?,
+            time,
         });
     }
     let mut view_notes = Vec::new();

@@ -3,6 +3,7 @@
 
 #[cfg(feature = "ui-tests")]
 pub mod editor;
+pub mod gltf_reader;
 
 use pmvc::geometry::{procedural, Cage};
 use std::path::{Path, PathBuf};

@@ -149,6 +149,21 @@ impl EditorApp {
         self.files.recovery.as_ref().map(|r| r.file())
     }
 
+    /// The gesture under way, if any.
+    pub fn gesture_under_way(&self) -> Option<crate::app::model::GestureKind> {
+        self.model.gesture_under_way()
+    }
+
+    /// The timeline is playing.
+    pub fn timeline_playing(&self) -> bool {
+        self.panels.timeline.is_playing()
+    }
+
+    /// The time the timeline shows, in seconds.
+    pub fn timeline_seconds(&self) -> f64 {
+        self.panels.timeline.seconds()
+    }
+
     /// The recovery question is shown.
     pub fn is_offering_recovery(&self) -> bool {
         self.panels.recovery.is_open()
@@ -470,6 +485,12 @@ impl EditorApp {
     /// Write the mesh deformed with the active method; true when it was written.
     pub fn export_deformed(&mut self, path: &Path) -> bool {
         self.export_deformed_now(path)
+    }
+
+    /// File > Export glTF…: the deformed mesh, named poses as morph targets and
+    /// the timeline as its animation; true when it was written.
+    pub fn export_gltf(&mut self, path: &Path) -> bool {
+        self.export_gltf_now(path)
     }
 
     /// File > Export coloured mesh…: the deformed mesh as PLY in the view's colours.

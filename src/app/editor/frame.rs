@@ -58,6 +58,7 @@ impl eframe::App for EditorApp {
                     let sections = side_panel::Sections {
                         pose_tools: &mut panels.pose_tools,
                         named_poses: &mut panels.named_poses,
+                        timeline: &mut panels.timeline,
                         statistics: &panels.statistics,
                         notices: &panels.notices,
                     };
@@ -243,40 +244,4 @@ fn with_context<R>(
 ) -> R {
     let mut context = PanelContext::new(model, shown, actions);
     f(&mut context)
-}
-
-impl EditorApp {
-    /// Autosave unsaved work when it is due; let the file go once nothing is
-    /// unsaved.
-    fn autosave_when_due(&mut self, ctx: &egui::Context) {
-        let Some(recovery) = &mut self.files.recovery else {
-            return;
-        };
-        if !self.model.unsaved().any() {
-            recovery.remove();
-            return;
-        }
-        let now = ctx.input(|i| i.time);
-        match recovery.due_in(now, self.model.document()) {
-            None => {}
-            Some(wait) if wait > 0.0 => {
-                ctx.request_repaint_after(std::time::Duration::from_secs_f64(wait));
-            }
-            Some(_) => {
-                if let Err(error) = self.autosave_now() {
-                    self.error(error);
-                }
-            }
-        }
-    }
-
-    /// Write the session to the recovery file now.
-    pub(super) fn autosave_now(&mut self) -> Result<(), String> {
-        let settings = self.session_settings();
-        let Some(recovery) = &mut self.files.recovery else {
-            return Err("this run keeps no recovery file".into());
-        };
-        let now = self.run.clock;
-        recovery.write(now, self.model.document(), &settings)
-    }
 }

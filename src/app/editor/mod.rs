@@ -10,6 +10,7 @@ mod api;
 mod frame;
 mod gpu;
 mod runner;
+mod unsaved;
 
 use super::actions::Action;
 use super::bind_queue::BindQueue;
@@ -33,7 +34,8 @@ use super::ui::pose_panel::PosePanel;
 use super::ui::recovery_dialog::RecoveryDialog;
 use super::ui::shortcuts_help::ShortcutsHelp;
 use super::ui::statistics::StatisticsPanel;
-use super::ui::unsaved_dialog::{Question, UnsavedDialog};
+use super::ui::timeline::TimelinePanel;
+use super::ui::unsaved_dialog::UnsavedDialog;
 use super::views::Views;
 use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
@@ -140,6 +142,8 @@ struct Panels {
     shortcuts_help: ShortcutsHelp,
     /// Work an earlier editor autosaved and left behind, offered at start-up.
     recovery: RecoveryDialog,
+    /// The Timeline section: playing and scrubbing the keys.
+    timeline: TimelinePanel,
 }
 
 /// Where the scene's files are and go.
@@ -401,30 +405,8 @@ impl EditorApp {
 
     /// Make a scene change read from files (or an error) current, with its
     /// notices; true when it was made.
-    /// Open another scene, or edit this one: another scene waits for the
-    /// answer to "Save changes?" when work would be lost. True when the change
-    /// was read and checked (it may still wait).
-    fn change_scene(&mut self, change: Result<SceneChange, String>) -> bool {
-        let change = match change {
-            Ok(change) => change,
-            Err(error) => {
-                self.error(error);
-                return false;
-            }
-        };
-        let unsaved = self.model.unsaved();
-        if !change.same_session && unsaved.any() {
-            let what = change.replacement.document.title().to_owned();
-            self.panels.unsaved.ask(Question::Open(what), unsaved);
-            self.files.waiting = Some(Waiting::Open(Box::new(change)));
-            return true;
-        }
-        self.apply_scene_change(change);
-        true
-    }
-
     /// Replace the document by `change` and bind it.
-    fn apply_scene_change(&mut self, change: SceneChange) {
+    pub(super) fn apply_scene_change(&mut self, change: SceneChange) {
         for note in change.notes {
             self.info(note);
         }

@@ -14,9 +14,6 @@ use crate::app::recent::RecentEntry;
 use crate::app::session::SessionSettings;
 use crate::app::ui::file_dialog::{DialogAnswer, FileAction};
 use crate::app::ui::named_poses::blend_poses;
-use crate::app::ui::recovery_dialog::RecoverAnswer;
-use crate::app::ui::unsaved_dialog::Question;
-use crate::app::ui::unsaved_dialog::UnsavedAnswer;
 use crate::render::Colouring;
 use std::path::Path;
 use std::sync::Arc;
@@ -89,7 +86,14 @@ impl EditorApp {
             Action::Info(text) => self.info(text),
             Action::DismissNotice(index) => self.panels.notices.dismiss(index),
             Action::Apply(command) => {
-                self.apply(command);
+                // A preview after its gesture ended is dropped quietly; any
+                // other refusal is the user's to read (a key time in use).
+                let quiet = matches!(command, Command::PreviewGesture(_));
+                if let Outcome::Refused(why) = self.apply(command).outcome {
+                    if !quiet {
+                        self.error(why);
+                    }
+                }
             }
             Action::Undo => self.undo_step(),
             Action::Redo => self.redo_step(),
@@ -443,6 +447,11 @@ impl EditorApp {
         self.report(files::export_deformed(path, self.model.document(), method))
     }
 
+    pub(super) fn export_gltf_now(&mut self, path: &Path) -> bool {
+        let method = self.binding.active_method();
+        self.report(files::export_gltf(path, self.model.document(), method))
+    }
+
     pub(super) fn export_coloured_mesh_now(&mut self, path: &Path) -> bool {
         let wanted = self.wanted_methods_now();
         let exported = self
@@ -536,6 +545,7 @@ impl EditorApp {
             FileAction::SaveSession => self.save_session_now(path),
             FileAction::SaveImage => self.save_image_now(path),
             FileAction::ExportColouredMesh => self.export_coloured_mesh_now(path),
+            FileAction::ExportGltf => self.export_gltf_now(path),
         };
         if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
             if done {
@@ -552,91 +562,6 @@ impl EditorApp {
     fn file_action_cancelled(&mut self, action: FileAction) {
         if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
             self.files.waiting = None;
-        }
-    }
-
-    // ---- unsaved work ---------------------------------------------------------------
-
-    /// The answer to "Save changes before quitting (or opening)?".
-    fn answer_unsaved(&mut self, answer: UnsavedAnswer) {
-        match answer {
-            UnsavedAnswer::Cancel => self.files.waiting = None,
-            UnsavedAnswer::Discard => self.go_on(),
-            UnsavedAnswer::SaveSession => match self.files.session_path.clone() {
-                Some(path) => {
-                    if self.save_session_now(&path) {
-                        self.go_on_after_save();
-                    } else {
-                        self.files.waiting = None;
-                    }
-                }
-                None => self.ask_for_file_now(FileAction::SaveSession),
-            },
-            UnsavedAnswer::SavePose => self.ask_for_file_now(FileAction::SavePose),
-        }
-    }
-
-    /// A save finished: what waited goes on, unless work is still unsaved (a
-    /// pose file keeps only the pose), when the question comes back.
-    fn go_on_after_save(&mut self) {
-        let Some(waiting) = self.files.waiting.take() else {
-            return;
-        };
-        let unsaved = self.model.unsaved();
-        if unsaved.any() {
-            let question = match &waiting {
-                Waiting::Quit => Question::Quit,
-                Waiting::Open(change) => Question::Open(change.replacement.document.title().into()),
-            };
-            self.panels.unsaved.ask(question, unsaved);
-            self.files.waiting = Some(waiting);
-            return;
-        }
-        self.files.waiting = Some(waiting);
-        self.go_on();
-    }
-
-    /// The answer about a recovery file left behind.
-    fn recover(&mut self, path: &Path, answer: RecoverAnswer) {
-        match answer {
-            RecoverAnswer::Later => {}
-            RecoverAnswer::Discard => {
-                crate::app::recovery::discard(path);
-                self.info(format!(
-                    "discarded the autosaved work {}",
-                    crate::geometry::shown_path(path)
-                ));
-            }
-            RecoverAnswer::Restore => {
-                let change = files::open_session(path).map(|mut change| {
-                    // Not a session of the user's: Save session asks for a name.
-                    change.session = None;
-                    change.recent = None;
-                    change
-                });
-                if !self.change_scene(change) {
-                    return;
-                }
-                self.apply(Command::MarkRecovered);
-                self.files.session_path = None;
-                // This editor's own autosave holds it before the old file goes.
-                if self.autosave_now().is_ok() {
-                    crate::app::recovery::discard(path);
-                }
-                self.info("restored the autosaved work: File > Save session… keeps it");
-            }
-        }
-    }
-
-    /// Carry out what waited for the question: quit, or open the scene.
-    fn go_on(&mut self) {
-        match self.files.waiting.take() {
-            Some(Waiting::Quit) => {
-                self.panels.unsaved.confirm_quit();
-                self.actions.push(Action::CloseWindow);
-            }
-            Some(Waiting::Open(change)) => self.apply_scene_change(*change),
-            None => {}
         }
     }
 

@@ -43,6 +43,8 @@ pub struct Changes {
 pub struct NamedPose {
     pub name: String,
     pub positions: Vec<DVec3>,
+    /// Where the timeline plays it, in seconds; `None` when it is not on it.
+    pub time: Option<f64>,
 }
 
 /// A mesh, its cage, the pose and the weights.
@@ -203,9 +205,15 @@ impl Document {
     /// The mesh deformed with `method` on the CPU in f64 (for export), or the
     /// rest mesh before that method is bound. Displacement form: exact at rest.
     pub fn deformed_positions(&self, method: Method) -> Vec<DVec3> {
+        self.deformed_positions_at(method, &self.pose)
+    }
+
+    /// The mesh deformed by `method` with the cage posed as `pose` (one
+    /// position per cage vertex), or at rest when the method is not bound.
+    pub fn deformed_positions_at(&self, method: Method, pose: &[DVec3]) -> Vec<DVec3> {
         match self.weights(method) {
             Some(weights) => {
-                let moves = method.column_displacements(&self.cage, &self.pose);
+                let moves = method.column_displacements(&self.cage, pose);
                 weights.apply_displacements(&self.mesh.positions, &moves)
             }
             None => self.mesh.positions.clone(),
@@ -281,13 +289,14 @@ impl Document {
     /// Keep the current pose as `name` (replacing a pose of that name).
     pub(in crate::app::model) fn store_named_pose(&mut self, name: &str) {
         let mut named = (*self.named_poses).clone();
-        let pose = NamedPose {
-            name: name.to_owned(),
-            positions: self.pose.clone(),
-        };
         match named.iter_mut().find(|n| n.name == name) {
-            Some(existing) => *existing = pose,
-            None => named.push(pose),
+            // Stored again: the pose changes, its place on the timeline stays.
+            Some(existing) => existing.positions = self.pose.clone(),
+            None => named.push(NamedPose {
+                name: name.to_owned(),
+                positions: self.pose.clone(),
+                time: None,
+            }),
         }
         self.named_poses = Arc::new(named);
     }
@@ -297,6 +306,15 @@ impl Document {
         let mut named = (*self.named_poses).clone();
         if index < named.len() {
             named.remove(index);
+            self.named_poses = Arc::new(named);
+        }
+    }
+
+    /// Place the named pose at `index` on the timeline at `time`, or take it off.
+    pub(in crate::app::model) fn set_named_pose_time(&mut self, index: usize, time: Option<f64>) {
+        let mut named = (*self.named_poses).clone();
+        if let Some(pose) = named.get_mut(index) {
+            pose.time = time;
             self.named_poses = Arc::new(named);
         }
     }

@@ -29,6 +29,8 @@ pub enum GestureKind {
     Transform,
     NumericDrag,
     Blend,
+    /// The timeline playing or scrubbed.
+    Playback,
 }
 
 #[derive(Debug)]
@@ -85,6 +87,11 @@ pub enum Command {
     RenameNamedPose {
         index: usize,
         name: String,
+    },
+    /// Place a named pose on the timeline at a time (seconds), or take it off.
+    SetPoseTime {
+        index: usize,
+        time: Option<f64>,
     },
     /// A bind's weights, if they fit the document's mesh and cage.
     InstallWeights {
@@ -351,6 +358,7 @@ impl Model {
                 Applied::of(Outcome::Changed)
             }
             Command::RenameNamedPose { index, name } => Applied::of(self.rename(index, &name)),
+            Command::SetPoseTime { index, time } => Applied::of(self.set_pose_time(index, time)),
             Command::InstallWeights {
                 method,
                 set,
@@ -485,6 +493,36 @@ impl Model {
         }
         self.record_pose_step(&format!("rename pose {old} to {name}"));
         self.document.rename_named_pose(index, name);
+        Outcome::Changed
+    }
+
+    fn set_pose_time(&mut self, index: usize, time: Option<f64>) -> Outcome {
+        let named = self.document.named_poses();
+        let Some(pose) = named.get(index) else {
+            return Outcome::Refused(format!("no stored pose {}", index + 1));
+        };
+        if pose.time == time {
+            return Outcome::Unchanged;
+        }
+        let name = pose.name.clone();
+        if let Some(seconds) = time {
+            if let Err(why) = crate::app::timeline::check_key_time(seconds) {
+                return Outcome::Refused(why);
+            }
+            if let Some(other) = named
+                .iter()
+                .enumerate()
+                .find(|(i, n)| *i != index && n.time == Some(seconds))
+            {
+                return Outcome::Refused(format!("\"{}\" is already at {seconds} s", other.1.name));
+            }
+        }
+        let action = match time {
+            Some(seconds) => format!("place pose {name} at {seconds} s"),
+            None => format!("take pose {name} off the timeline"),
+        };
+        self.record_pose_step(&action);
+        self.document.set_named_pose_time(index, time);
         Outcome::Changed
     }
 

@@ -28,6 +28,9 @@ pub enum FileAction {
     SaveSession,
     SaveImage,
     ExportColouredMesh,
+    /// The deformed mesh as glTF, named poses as morph targets, the timeline
+    /// as its animation.
+    ExportGltf,
 }
 
 impl FileAction {
@@ -43,6 +46,7 @@ impl FileAction {
             FileAction::SaveSession => "Save session",
             FileAction::SaveImage => "Save image",
             FileAction::ExportColouredMesh => "Export coloured mesh",
+            FileAction::ExportGltf => "Export glTF",
         }
     }
 
@@ -55,6 +59,7 @@ impl FileAction {
                 | FileAction::SaveSession
                 | FileAction::SaveImage
                 | FileAction::ExportColouredMesh
+                | FileAction::ExportGltf
         )
     }
 
@@ -65,8 +70,11 @@ impl FileAction {
             FileAction::OpenSession | FileAction::SaveSession => &["json"],
             FileAction::SaveImage => &["png"],
             FileAction::ExportColouredMesh => &["ply"],
-            // Point sets (n × 3 arrays) open wherever a mesh does.
-            FileAction::OpenMesh | FileAction::LoadPose => &["obj", "off", "npy"],
+            FileAction::ExportGltf => &["glb", "gltf"],
+            // Point sets (n × 3 arrays) open wherever a mesh does, and glTF's
+            // first mesh.
+            FileAction::OpenMesh => &["obj", "off", "npy", "glb", "gltf"],
+            FileAction::LoadPose => &["obj", "off", "npy"],
             _ => &["obj", "off"],
         }
     }
@@ -91,6 +99,7 @@ impl FileAction {
             FileAction::SaveSession => "scene.session.json",
             FileAction::SaveImage => "view.png",
             FileAction::ExportColouredMesh => "coloured.ply",
+            FileAction::ExportGltf => "deformed.glb",
             _ => "",
         }
     }
@@ -103,7 +112,9 @@ impl FileAction {
             | FileAction::SaveCage
             | FileAction::SaveSession
             | FileAction::SaveImage => "Save",
-            FileAction::ExportMesh | FileAction::ExportColouredMesh => "Export",
+            FileAction::ExportMesh | FileAction::ExportColouredMesh | FileAction::ExportGltf => {
+                "Export"
+            }
         }
     }
 }

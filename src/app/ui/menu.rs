@@ -90,6 +90,16 @@ fn file_menu(ui: &mut egui::Ui, cx: &mut PanelContext) {
         cx.send(Action::AskForFile(FileAction::ExportMesh));
     }
     if ui
+        .button("Export glTF (poses as shape keys)…")
+        .on_hover_text(
+            "The deformed mesh as .glb or .gltf: every named pose a morph target (shape key) \
+             named after it, and the timeline's keys as its animation",
+        )
+        .clicked()
+    {
+        cx.send(Action::AskForFile(FileAction::ExportGltf));
+    }
+    if ui
         .button("Export coloured mesh (PLY)…")
         .on_hover_text(
             "The deformed mesh with each vertex in the colour the view gives it \

@@ -16,5 +16,6 @@ pub mod recovery_dialog;
 pub mod shortcuts_help;
 pub mod side_panel;
 pub mod statistics;
+pub mod timeline;
 pub mod toolbar;
 pub mod unsaved_dialog;

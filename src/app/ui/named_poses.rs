@@ -21,6 +21,8 @@ pub struct PoseBlend {
     new_name: String,
     /// The pose being renamed and the text typed so far.
     renaming: Option<(usize, String)>,
+    /// A key time being dragged or typed: sent once, when the edit ends.
+    editing_time: Option<(usize, f64)>,
 }
 
 /// `rest` moved the fraction `amount` of the way to `target`; exactly `target`
@@ -160,11 +162,69 @@ impl PoseBlend {
                     {
                         sent.push(Action::Apply(Command::DeleteNamedPose(index)));
                     }
+                    if let Some(command) = self.key_time(ui, cx.document(), index) {
+                        sent.push(Action::Apply(command));
+                    }
                 }
             });
         }
         for action in sent {
             cx.send(action);
+        }
+    }
+}
+
+impl PoseBlend {
+    /// The pose's place on the timeline: a clock toggle and its time, sent as
+    /// one command when the edit ends (not one per dragged frame).
+    fn key_time(
+        &mut self,
+        ui: &mut egui::Ui,
+        document: &Document,
+        index: usize,
+    ) -> Option<Command> {
+        let named = document.named_poses();
+        let time = named[index].time;
+        let mut on = time.is_some();
+        let toggle = ui
+            .toggle_value(&mut on, "key")
+            .on_hover_text("Place this pose on the timeline, or take it off");
+        if toggle.clicked() {
+            let after_last = crate::app::timeline::span(named).map_or(0.0, |(_, last)| last + 1.0);
+            return Some(Command::SetPoseTime {
+                index,
+                time: on.then_some(after_last),
+            });
+        }
+        let time = time?;
+        let mut seconds = match self.editing_time {
+            Some((editing, seconds)) if editing == index => seconds,
+            _ => time,
+        };
+        let field = ui
+            .add(
+                egui::DragValue::new(&mut seconds)
+                    .range(0.0..=crate::app::timeline::LONGEST_SECONDS)
+                    .speed(0.05)
+                    .max_decimals(2)
+                    .suffix(" s"),
+            )
+            .on_hover_text("Its time on the timeline");
+        if field.changed() {
+            self.editing_time = Some((index, seconds));
+        }
+        let ended = field.drag_stopped()
+            || field.lost_focus()
+            || (field.changed() && !field.dragged() && !field.has_focus());
+        match self.editing_time {
+            Some((editing, seconds)) if editing == index && ended => {
+                self.editing_time = None;
+                Some(Command::SetPoseTime {
+                    index,
+                    time: Some(seconds),
+                })
+            }
+            _ => None,
         }
     }
 }

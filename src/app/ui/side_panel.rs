@@ -9,6 +9,7 @@ use crate::app::ui::notices::Notices;
 use crate::app::ui::pose_panel::PosePanel;
 use crate::app::ui::quality_table::quality_table;
 use crate::app::ui::statistics::StatisticsPanel;
+use crate::app::ui::timeline::TimelinePanel;
 use crate::coords::Method;
 use std::time::Duration;
 
@@ -16,6 +17,7 @@ use std::time::Duration;
 pub struct Sections<'a> {
     pub pose_tools: &'a mut PosePanel,
     pub named_poses: &'a mut PoseBlend,
+    pub timeline: &'a mut TimelinePanel,
     pub statistics: &'a StatisticsPanel,
     pub notices: &'a Notices,
 }
@@ -38,6 +40,8 @@ pub fn side_panel(ui: &mut egui::Ui, cx: &mut PanelContext, sections: Sections) 
     sections.pose_tools.ui(ui, cx);
     ui.separator();
     sections.named_poses.ui(ui, cx);
+    ui.separator();
+    sections.timeline.ui(ui, cx);
     ui.separator();
     ui.small("Left-drag: orbit / move handles · Right-drag or Shift+middle: pan · Wheel: zoom · Ctrl+drag: box select · Shift+click: toggle · X/Y/Z: axis · G/R/S: move/rotate/scale · O: soft selection · Shift+right click: 3D cursor · F: frame selection · Home: frame all · H: cage · M: next method · Esc: deselect");
     if sections.statistics.is_shown() {
