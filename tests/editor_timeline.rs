@@ -13,10 +13,12 @@ use pmvc::app::timeline::pose_at;
 use pmvc::app::EditorApp;
 
 /// The editor in a window tall enough that the side panel shows the timeline
-/// without scrolling (a click lands where the button is drawn).
+/// without scrolling (a click lands where the button is drawn), at 60 frames
+/// a second, so that playback reaches times of more than two decimals.
 fn tall_editor() -> Option<Harness<'static, EditorApp>> {
     let state = render_state()?;
-    let mut harness = editor_sized(state, Default::default(), egui::vec2(1100.0, 1500.0));
+    let size = egui::vec2(1100.0, 1500.0);
+    let mut harness = editor_sized(state, Default::default(), size, 1.0 / 60.0);
     run_until_bound(&mut harness);
     Some(harness)
 }
@@ -59,6 +61,11 @@ fn keys_placed_with_the_clock_play_as_linear_blends_and_stop_restores_the_pose()
     harness.get_by_label("Play").click();
     harness.run_steps(20);
     assert!(harness.state().timeline_playing());
+    assert_eq!(
+        harness.state().undo_label().as_deref(),
+        Some("place pose far at 2 s"),
+        "playing makes no undo step"
+    );
     let seconds = harness.state().timeline_seconds();
     assert!(seconds > 0.0, "time moves while playing: {seconds}");
     let expected = pose_at(&named, seconds).unwrap();

@@ -10,7 +10,12 @@ use pmvc::app::EditorOptions;
 #[test]
 fn an_error_from_a_dropped_file_shows_over_the_viewport_at_1280_by_800() {
     let Some(state) = render_state() else { return };
-    let mut harness = editor_sized(state, EditorOptions::default(), egui::vec2(1280.0, 800.0));
+    let mut harness = editor_sized(
+        state,
+        EditorOptions::default(),
+        egui::vec2(1280.0, 800.0),
+        0.25,
+    );
     run_until_bound(&mut harness);
     let dir = tempfile::tempdir().unwrap();
     let notes = dir.path().join("notes.txt");

@@ -537,3 +537,24 @@ fn normals_beyond_the_storage_bindings_light_each_face_and_the_menu_says_why() {
     harness.run_steps(2);
     harness.get_by_label("Smooth shading (unavailable)");
 }
+
+#[test]
+fn the_first_runs_line_about_the_comb_goes_when_another_scene_opens() {
+    use egui_kittest::kittest::Queryable;
+    let Some(mut harness) = editor_with(EditorOptions::first_run()) else {
+        return;
+    };
+    run_until_bound(&mut harness);
+    harness.get_by_label(pmvc::app::ui::toolbar::FIRST_RUN_LINE);
+    harness
+        .state_mut()
+        .open_bundled(pmvc::app::scenes::BundledScene::Scan);
+    harness.run_steps(2);
+    assert_eq!(
+        harness.state().document().bundled(),
+        Some(pmvc::app::scenes::BundledScene::Scan)
+    );
+    assert!(harness
+        .query_by_label(pmvc::app::ui::toolbar::FIRST_RUN_LINE)
+        .is_none());
+}

@@ -108,17 +108,20 @@ pub fn editor_on(
     state: eframe::egui_wgpu::RenderState,
     options: EditorOptions,
 ) -> Harness<'static, EditorApp> {
-    editor_sized(state, options, egui::vec2(1100.0, 700.0))
+    editor_sized(state, options, egui::vec2(1100.0, 700.0), 0.25)
 }
 
-/// The editor with `options` in a window of `size` points.
+/// The editor with `options` in a window of `size` points, each frame
+/// `step_dt` seconds after the last (egui_kittest's default is 0.25).
 pub fn editor_sized(
     state: eframe::egui_wgpu::RenderState,
     options: EditorOptions,
     size: egui::Vec2,
+    step_dt: f32,
 ) -> Harness<'static, EditorApp> {
     let harness = Harness::builder()
         .with_size(size)
+        .with_step_dt(step_dt)
         .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
             state,
         ))

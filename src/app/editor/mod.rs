@@ -428,9 +428,11 @@ impl EditorApp {
             let vertices = self.model.document().cage().vertex_count();
             self.panels.cage_window.open_window(vertices);
         }
-        // Another scene's files are on disk: nothing of it is unsaved yet.
+        // Another scene's files are on disk: nothing of it is unsaved yet; and
+        // the first run's line about the comb no longer describes it.
         if !change.same_session {
             self.apply(Command::MarkSessionSaved);
+            self.panels.first_run_hint = false;
         }
     }
 

@@ -206,7 +206,7 @@ impl PoseBlend {
                 egui::DragValue::new(&mut seconds)
                     .range(0.0..=crate::app::timeline::LONGEST_SECONDS)
                     .speed(0.05)
-                    .max_decimals(2)
+                    .custom_formatter(|seconds, _| format!("{seconds:.2}"))
                     .suffix(" s"),
             )
             .on_hover_text("Its time on the timeline");

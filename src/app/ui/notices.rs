@@ -138,7 +138,8 @@ impl Notices {
         egui::Area::new(egui::Id::unique("toasts"))
             .order(egui::Order::Foreground)
             .pivot(egui::Align2::CENTER_BOTTOM)
-            .fixed_pos(egui::pos2(viewport.center().x, viewport.bottom() - 12.0))
+            // Above the line a transform under way writes at the foot.
+            .fixed_pos(egui::pos2(viewport.center().x, viewport.bottom() - 36.0))
             .interactable(true)
             .show(ctx, |ui| {
                 ui.set_max_width(width);

@@ -22,6 +22,8 @@ pub enum RecoverAnswer {
 pub struct RecoveryDialog {
     /// The newest file left behind, and how many there are in all.
     offered: Option<(LeftBehind, usize)>,
+    /// Its first frame was drawn.
+    drawn: bool,
 }
 
 impl RecoveryDialog {
@@ -43,6 +45,12 @@ impl RecoveryDialog {
             .written
             .elapsed()
             .map_or_else(|_| "just now".to_owned(), |d| ago(d.as_secs()));
+        // A window's first frame only sizes it: at start-up no input brings
+        // the next, so ask for it.
+        if !self.drawn {
+            self.drawn = true;
+            ctx.request_repaint();
+        }
         let mut answer = None;
         egui::Window::new("Recover unsaved work?")
             .collapsible(false)

@@ -67,9 +67,11 @@ impl TimelinePanel {
             let slider = ui
                 .add_enabled(
                     self.playing.is_none() && last > first,
+                    // Shown to 2 decimals, not rounded: a slider that rounds
+                    // its value reports a change each frame the value has more.
                     egui::Slider::new(&mut self.seconds, first..=last)
                         .suffix(" s")
-                        .max_decimals(2)
+                        .custom_formatter(|seconds, _| format!("{seconds:.2}"))
                         .text("time"),
                 )
                 .on_hover_text("Scrub: releasing keeps the pose shown (Ctrl+Z undoes it)");
@@ -77,7 +79,9 @@ impl TimelinePanel {
                 sent.push(Action::Apply(Command::BeginGesture(GestureKind::Playback)));
             }
             let dragging = slider.dragged() || slider.drag_started() || slider.drag_stopped();
-            if slider.changed() && !dragging {
+            // Only the user's changes: playback moves the value too.
+            let changed = slider.changed() && self.playing.is_none();
+            if changed && !dragging {
                 // A click or a typed time: that pose, as one undo step.
                 if let Some(pose) = pose_at(named, self.seconds) {
                     sent.push(Action::Apply(Command::EditPose {
@@ -85,7 +89,7 @@ impl TimelinePanel {
                         action: format!("pose at {:.2} s", self.seconds),
                     }));
                 }
-            } else if slider.changed() {
+            } else if changed {
                 preview = true;
             }
             if slider.drag_stopped() {

@@ -404,7 +404,11 @@ impl Views {
         }
         let transform = self.modal_transform(modal);
         let amount = match transform {
-            Transform::Translate(offset) => format!("by {:.4}", offset.length()),
+            // Along an axis the sign says which way; free, the distance.
+            Transform::Translate(offset) => match modal.axis {
+                Some(axis) => format!("by {:+.4}", offset[axis]),
+                None => format!("by {:.4}", offset.length()),
+            },
             Transform::Rotate { angle, .. } => format!("{:.1}°", angle.to_degrees()),
             Transform::Scale(factors) => {
                 format!("× {:.3}", modal.axis.map_or(factors.x, |a| factors[a]))
