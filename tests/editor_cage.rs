@@ -354,3 +354,42 @@ fn a_mesh_inside_the_cages_box_but_outside_the_cage_gets_a_box_and_the_window() 
         .outside
         .is_empty());
 }
+
+#[test]
+fn a_generated_cage_is_unsaved_work_that_quitting_and_opening_ask_about() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().open_cage_generation();
+    harness.state_mut().cage_generation_mut().target_vertices = 24;
+    harness.state_mut().start_cage_generation();
+    run_until_generated(&mut harness);
+    assert!(harness.state_mut().use_generated_cage());
+    run_until_bound(&mut harness);
+    let unsaved = harness.state().unsaved();
+    assert!(unsaved.cage && !unsaved.pose, "{unsaved:?}");
+
+    // Opening another scene asks, and Cancel keeps the generated cage.
+    let cage = cage_positions(harness.state());
+    harness
+        .state_mut()
+        .open_bundled(pmvc::app::scenes::BundledScene::Scan);
+    harness.run_steps(2);
+    harness.get_by_label_contains("the edited or generated cage");
+    harness.get_by_label("Cancel").click();
+    harness.run_steps(2);
+    assert_eq!(cage_positions(harness.state()), cage);
+
+    // Quitting asks too; a saved session holds the cage, and then nothing is
+    // unsaved.
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Q);
+    harness.run_steps(2);
+    assert!(harness.state().is_asking_to_quit());
+    harness.get_by_label("Cancel").click();
+    harness.run_steps(2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("generated.session.json");
+    assert!(harness.state_mut().save_session(&path));
+    assert!(!harness.state().unsaved().any());
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("\"inline\""), "the cage is in the session");
+}
