@@ -388,4 +388,21 @@ fn the_mirror_plane_picked_at_the_3d_cursor_pairs_a_cage_whose_extent_is_not_sym
     harness.run_steps(2);
     use egui_kittest::kittest::Queryable;
     harness.get_by_label(&format!("Mirror plane: z = {plane:.4}"));
+
+    // Fitted instead, from the box centre: the same plane, found by the editor.
+    harness.state_mut().pose_tool_settings_mut().mirror_plane =
+        pmvc::app::pose_tools::MirrorPlane::CageCentre;
+    harness.run_steps(2);
+    harness.get_by_label("fitted").scroll_to_me();
+    harness.run_steps(2);
+    harness.get_by_label("fitted").click_accesskit();
+    harness.run_steps(2);
+    assert_eq!(harness.state().handles_without_partner(), 2);
+    match harness.state().pose_tool_settings().mirror_plane {
+        pmvc::app::pose_tools::MirrorPlane::Fitted(offset) => {
+            assert!((offset - plane).abs() < 1e-9, "{offset} against {plane}")
+        }
+        other => panic!("not fitted: {other:?}"),
+    }
+    harness.get_by_label_contains(&format!("{} of {handles} handles paired", handles - 2));
 }

@@ -42,7 +42,7 @@ pub enum Pivot {
 }
 
 /// Where the symmetry's mirror plane passes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum MirrorPlane {
     /// Through the rest cage's bounding-box centre.
     #[default]
@@ -50,6 +50,9 @@ pub enum MirrorPlane {
     /// Through the 3D cursor (Shift+right-click picks it on the mesh or cage),
     /// for a cage whose extent is not symmetric (a tail, a raised arm).
     Cursor,
+    /// At this coordinate along the axis: the plane that pairs the most
+    /// handles, found by [`fitted_mirror_offset`] when it was asked for.
+    Fitted(f64),
 }
 
 /// The posing tools' settings.
@@ -121,6 +124,70 @@ pub fn mirror_partners(
         .collect()
 }
 
+/// The most cage vertices a mirror plane is fitted to, and the most candidate
+/// planes it weighs (8 MiB of them): beyond either, fitting is refused.
+pub const FIT_VERTEX_LIMIT: usize = 8192;
+pub const FIT_CANDIDATE_LIMIT: usize = 1 << 20;
+
+/// The plane `axis = offset` that pairs the most handles of `rest` within
+/// `tolerance`, and how many it pairs. Every two handles whose other two
+/// coordinates agree within `tolerance` vote for the plane midway between them
+/// with the two handles it would pair, and each handle for the plane through
+/// it with one; of the planes within `tolerance` of one another, the run with
+/// the most handles gives its median. An artist's
+/// posed cage is symmetric only in parts, and its box centre then misses them.
+pub fn fitted_mirror_offset(
+    rest: &[DVec3],
+    axis: usize,
+    tolerance: f64,
+) -> Result<Option<(f64, usize)>, String> {
+    if rest.len() > FIT_VERTEX_LIMIT {
+        return Err(format!(
+            "a mirror plane is fitted to at most {FIT_VERTEX_LIMIT} cage vertices, not {}",
+            rest.len()
+        ));
+    }
+    let [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+    // (plane, handles it would pair): 2 for two handles, 1 for one on it.
+    let mut votes: Vec<(f64, usize)> = Vec::new();
+    for (i, p) in rest.iter().enumerate() {
+        for (k, q) in rest[i..].iter().enumerate() {
+            if (p[u] - q[u]).hypot(p[v] - q[v]) <= tolerance {
+                if votes.len() == FIT_CANDIDATE_LIMIT {
+                    return Err(format!(
+                        "more than {FIT_CANDIDATE_LIMIT} candidate planes: the tolerance is too wide \
+                         for a fit"
+                    ));
+                }
+                votes.push(((p[axis] + q[axis]) / 2.0, if k == 0 { 1 } else { 2 }));
+            }
+        }
+    }
+    votes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // The run of planes within one tolerance of each other that would pair
+    // the most handles.
+    let (mut best, mut best_weight, mut start, mut weight) = ((0, 0), 0, 0, 0);
+    for end in 0..votes.len() {
+        weight += votes[end].1;
+        while votes[end].0 - votes[start].0 > tolerance {
+            weight -= votes[start].1;
+            start += 1;
+        }
+        if weight > best_weight {
+            (best, best_weight) = ((start, end + 1), weight);
+        }
+    }
+    let run = &votes[best.0..best.1];
+    let Some(&(offset, _)) = run.get(run.len() / 2) else {
+        return Ok(None);
+    };
+    let paired = mirror_partners(rest, axis, offset, tolerance)
+        .iter()
+        .filter(|p| p.is_some())
+        .count();
+    Ok(Some((offset, paired)))
+}
+
 /// The mean length of the edges of `triangles` over `positions`, each edge
 /// counted once.
 pub fn mean_edge_length(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
@@ -147,6 +214,7 @@ impl PoseToolSettings {
         match self.mirror_plane {
             MirrorPlane::CageCentre => mid_plane(rest, axis),
             MirrorPlane::Cursor => self.cursor[axis],
+            MirrorPlane::Fitted(offset) => offset,
         }
     }
 }
@@ -347,5 +415,47 @@ mod tests {
         );
         assert!(close(moved[0], DVec3::Y));
         assert!(close(moved[1], DVec3::new(1.0, 0.5, 0.0)));
+    }
+
+    #[test]
+    fn a_fitted_plane_finds_the_symmetry_the_box_centre_misses() {
+        // Symmetric about x = 0.37 to within 1e-3, plus an arm reaching far
+        // out on one side only.
+        let plane = 0.37;
+        let mut rest = Vec::new();
+        for k in 0..12 {
+            let k = f64::from(k);
+            let (y, z, d) = ((k * 0.7).sin(), (k * 1.3).cos(), 0.2 + 0.1 * k);
+            let wobble = 1e-3 * (k * 2.1).sin();
+            rest.push(DVec3::new(plane - d, y, z));
+            rest.push(DVec3::new(plane + d + wobble, y, z));
+        }
+        rest.push(DVec3::new(plane + 9.0, 0.5, 0.5));
+        let tolerance = 0.01;
+        let centre = mid_plane(&rest, 0);
+        let at_centre = mirror_partners(&rest, 0, centre, tolerance);
+        assert!(
+            at_centre.iter().all(Option::is_none),
+            "the box centre pairs nothing"
+        );
+        let (offset, paired) = fitted_mirror_offset(&rest, 0, tolerance).unwrap().unwrap();
+        assert!((offset - plane).abs() < 1e-3, "{offset}");
+        assert_eq!(paired, 24, "every handle but the arm's");
+    }
+
+    #[test]
+    fn fitting_is_refused_with_sizes_beyond_its_limits() {
+        let many = vec![DVec3::ZERO; FIT_VERTEX_LIMIT + 1];
+        let error = fitted_mirror_offset(&many, 0, 0.1).unwrap_err();
+        assert!(
+            error.contains(&format!("{}", FIT_VERTEX_LIMIT + 1)),
+            "{error}"
+        );
+        // Two thousand handles in one column: every pair votes.
+        let column: Vec<DVec3> = (0..2000)
+            .map(|i| DVec3::new(f64::from(i), 0.0, 0.0))
+            .collect();
+        let error = fitted_mirror_offset(&column, 0, 0.1).unwrap_err();
+        assert!(error.contains("candidate planes"), "{error}");
     }
 }

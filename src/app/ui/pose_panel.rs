@@ -3,7 +3,10 @@
 
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
-use crate::app::pose_tools::{MirrorPlane, Pivot, PoseToolSettings, AXIS_NAMES, MIRROR_TOLERANCES};
+use crate::app::pose_tools::{
+    fitted_mirror_offset, mean_edge_length, MirrorPlane, Pivot, PoseToolSettings, AXIS_NAMES,
+    MIRROR_TOLERANCES,
+};
 use crate::app::viewport::handles_without_partner;
 
 /// The section and the settings it owns, which the viewport's edits read.
@@ -13,6 +16,27 @@ pub struct PosePanel {
 }
 
 impl PosePanel {
+    /// Fit the mirror plane along `axis` to the rest cage, and say how it went.
+    fn fit_mirror_plane(&mut self, cx: &mut PanelContext, axis: usize) {
+        let cage = cx.document().cage();
+        let rest = cage.positions();
+        let tolerance = self.tools.mirror_tolerance * mean_edge_length(rest, cage.triangles());
+        let name = AXIS_NAMES[axis].to_lowercase();
+        match fitted_mirror_offset(rest, axis, tolerance) {
+            Ok(Some((offset, paired))) => {
+                self.tools.mirror_plane = MirrorPlane::Fitted(offset);
+                cx.send(Action::Info(format!(
+                    "mirror plane fitted at {name} = {offset:.4}: {paired} of {} handles paired",
+                    rest.len()
+                )));
+            }
+            Ok(None) => cx.send(Action::Error(
+                "no mirror plane pairs any handles within the tolerance".into(),
+            )),
+            Err(why) => cx.send(Action::Error(why)),
+        }
+    }
+
     pub fn ui(&mut self, ui: &mut egui::Ui, cx: &mut PanelContext) {
         ui.label("Posing tools (G move, R rotate, S scale)");
         ui.horizontal(|ui| {
@@ -51,6 +75,17 @@ impl PosePanel {
                     "The 3D cursor: Shift+right click on the mesh or a handle picks it, \
                          for a cage whose extent is not symmetric",
                 );
+                let fitted = matches!(self.tools.mirror_plane, MirrorPlane::Fitted(_));
+                if ui
+                    .selectable_label(fitted, "fitted")
+                    .on_hover_text(
+                        "The plane that pairs the most handles within the tolerance, found \
+                         now (press again after changing the tolerance or the cage)",
+                    )
+                    .clicked()
+                {
+                    self.fit_mirror_plane(cx, axis);
+                }
             });
             let offset = self
                 .tools
