@@ -41,7 +41,7 @@ pub use output::{
 };
 pub use ply::{colour_byte, write_coloured_ply};
 pub use points_npy::write_points_npy;
-pub use polygons::{polygons_of, triangulate_faces};
+pub use polygons::{polygon_edges, polygons_of, triangulate_faces};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;

@@ -169,7 +169,12 @@ impl ViewportRenderer {
         let cage_rest: Vec<Vec3> = (scene.cage.positions().iter())
             .map(|&p| scene.origin.to_scene(p))
             .collect();
-        let edges = super::cage::feature_edges(&cage_rest, scene.cage.triangles());
+        // The artist's polygons where the cage has them (quads' diagonals are
+        // never drawn); for a cage of triangles, the edges between triangles
+        // that are not coplanar.
+        let cage = scene.cage;
+        let edges = crate::geometry::polygon_edges(cage.triangles(), cage.triangle_faces())
+            .unwrap_or_else(|| super::cage::feature_edges(&cage_rest, cage.triangles()));
         self.scene = Some(SceneGpu::new(
             device,
             scene.rest_positions,
