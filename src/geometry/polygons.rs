@@ -109,17 +109,10 @@ mod tests {
             .collect();
         // One corner pulled out: its three quads are no longer planar.
         positions[7] += DVec3::splat(0.3);
-        let quads: Vec<Vec<u32>> = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ]
-        .iter()
-        .map(|q| q.to_vec())
-        .collect();
+        let quads: Vec<Vec<u32>> = crate::geometry::procedural::CUBE_QUADS
+            .iter()
+            .map(|q| q.to_vec())
+            .collect();
         let mesh = triangulate_faces(&quads, &positions);
         assert_eq!(mesh.triangles.len(), 12);
         let edges = polygon_edges(&mesh.triangles, &mesh.triangle_faces).unwrap();

@@ -5,6 +5,17 @@
 use super::{Cage, TriMesh};
 use glam::{DVec2, DVec3};
 
+/// A cube's six outward quads over corners numbered by bits (x = 1, y = 2,
+/// z = 4).
+pub const CUBE_QUADS: [[u32; 4]; 6] = [
+    [0, 2, 3, 1],
+    [4, 5, 7, 6],
+    [0, 1, 5, 4],
+    [2, 6, 7, 3],
+    [0, 4, 6, 2],
+    [1, 3, 7, 5],
+];
+
 /// An axis-aligned cube cage of half-size `half`, centred at the origin, 8 vertices.
 pub fn cube_cage(half: f64) -> Cage {
     let positions: Vec<DVec3> = (0..8)
@@ -16,17 +27,8 @@ pub fn cube_cage(half: f64) -> Cage {
             )
         })
         .collect();
-    // Outward quads (corner bits: x=1, y=2, z=4), split into triangles.
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
     let mut triangles = Vec::new();
-    for [a, b, c, d] in quads {
+    for [a, b, c, d] in CUBE_QUADS {
         triangles.push([a, b, c]);
         triangles.push([a, c, d]);
     }
