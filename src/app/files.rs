@@ -417,3 +417,35 @@ pub fn export_deformed(path: &Path, current: &Document, method: Method) -> Resul
     .map_err(|error| error.to_string())?;
     Ok(format!("exported {}", shown_path(path)))
 }
+
+/// The name a new session file is offered: the mesh's, as
+/// "hydrant.session.json" for hydrant.obj.
+pub fn session_name(document: &Document) -> String {
+    let title = match document.mesh_file() {
+        Some(file) => file
+            .path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned()),
+        None => Path::new(document.title())
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned()),
+    };
+    let stem = title
+        .filter(|t| !t.trim().is_empty())
+        .unwrap_or_else(|| "scene".into());
+    format!("{stem}.session.json")
+}
+
+/// The name a saved cage is offered: the cage file's with "-edited" (the
+/// file itself is an input, never overwritten), or the mesh's with "_cage"
+/// for a cage that came from no file (generated, a box, bundled).
+pub fn cage_name(document: &Document) -> String {
+    let stem = |path: &Path| path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    match document.cage_path().and_then(stem) {
+        Some(cage) => format!("{cage}-edited.obj"),
+        None => {
+            let mesh = session_name(document);
+            format!("{}_cage.obj", mesh.trim_end_matches(".session.json"))
+        }
+    }
+}

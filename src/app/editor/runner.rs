@@ -477,8 +477,8 @@ impl EditorApp {
     /// works, else the in-window one (which answers in a later frame).
     pub(super) fn ask_for_file_now(&mut self, action: FileAction) {
         let name = match action {
-            FileAction::SaveSession => Some(self.session_name()),
-            FileAction::SaveCage => Some(self.cage_name()),
+            FileAction::SaveSession => Some(files::session_name(self.model.document())),
+            FileAction::SaveCage => Some(files::cage_name(self.model.document())),
             _ => None,
         };
         match self.panels.file_dialogs.ask(action, name) {
@@ -493,40 +493,6 @@ impl EditorApp {
                          in-window dialog (File > In-window file dialog)",
                     );
                 }
-            }
-        }
-    }
-
-    /// The name a new session file is offered: the mesh's, as
-    /// "hydrant.session.json" for hydrant.obj.
-    fn session_name(&self) -> String {
-        let document = self.model.document();
-        let title = match document.mesh_file() {
-            Some(file) => file
-                .path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned()),
-            None => Path::new(document.title())
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned()),
-        };
-        let stem = title
-            .filter(|t| !t.trim().is_empty())
-            .unwrap_or_else(|| "scene".into());
-        format!("{stem}.session.json")
-    }
-
-    /// The name a saved cage is offered: the cage file's with "-edited" (the
-    /// file itself is an input, never overwritten), or the mesh's with "_cage"
-    /// for a cage that came from no file (generated, a box, bundled).
-    fn cage_name(&self) -> String {
-        let document = self.model.document();
-        let stem = |path: &Path| path.file_stem().map(|s| s.to_string_lossy().into_owned());
-        match document.cage_path().and_then(stem) {
-            Some(cage) => format!("{cage}-edited.obj"),
-            None => {
-                let mesh = self.session_name();
-                format!("{}_cage.obj", mesh.trim_end_matches(".session.json"))
             }
         }
     }
