@@ -23,8 +23,11 @@ impl eframe::App for EditorApp {
             .statistics
             .frames_mut()
             .record_frame(ctx.input(|i| i.time));
-        let (scripted, unsaved) = (self.run.screenshot.is_some(), self.model.unsaved());
-        if panels.unsaved.intercept_close(&ctx, scripted, unsaved) {
+        let (scripted, model) = (self.run.screenshot.is_some(), &self.model);
+        if panels
+            .unsaved
+            .intercept_close(&ctx, scripted, || model.unsaved())
+        {
             self.files.waiting = Some(super::Waiting::Quit);
         }
         self.run.focus.ask(&ctx, frame);

@@ -78,22 +78,22 @@ impl UnsavedDialog {
 
     /// A close asked for by the window system waits for the answer; true when
     /// it was held. A scripted run (`--screenshot`) ends on its own; its pose
-    /// (`--drag`) is not work to keep.
+    /// (`--drag`) is not work to keep. `unsaved` is asked only for a close.
     pub fn intercept_close(
         &mut self,
         ctx: &egui::Context,
         scripted: bool,
-        unsaved: Unsaved,
+        unsaved: impl FnOnce() -> Unsaved,
     ) -> bool {
-        let held = ctx.input(|i| i.viewport().close_requested())
-            && !scripted
-            && !self.confirmed
-            && unsaved.any();
-        if held {
+        if !ctx.input(|i| i.viewport().close_requested()) || scripted || self.confirmed {
+            return false;
+        }
+        let unsaved = unsaved();
+        if unsaved.any() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.ask(Question::Quit, unsaved);
         }
-        held
+        unsaved.any()
     }
 
     /// The question, while it is shown. Every button sends
