@@ -4,6 +4,7 @@
 //! cages are flipped.
 
 use super::intersect::ShellProblem;
+use super::quads::{check_quad, find_quads, CageQuad, QuadSplit};
 use super::{CageError, TriMesh};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -17,7 +18,14 @@ pub struct Cage {
     triangles: Vec<[u32; 3]>,
     /// For each triangle, the face of the file it came from.
     triangle_faces: Vec<u32>,
+    /// The file's quads, as bilinear patches; each also has two of `triangles`.
+    quads: Vec<CageQuad>,
+    /// For each triangle, the index in `quads` of the quad it halves, or `NO_QUAD`.
+    quad_of_triangle: Vec<u32>,
 }
+
+/// [`Cage::quad_of_triangle`]'s value for a triangle that is a face of its own.
+const NO_QUAD: u32 = u32::MAX;
 
 impl Cage {
     /// Validate `mesh` as a cage and return it outward-facing, with what validation
@@ -43,6 +51,58 @@ impl Cage {
     /// For each triangle, the face of the file it came from (0-based).
     pub fn triangle_faces(&self) -> &[u32] {
         &self.triangle_faces
+    }
+
+    /// The file's quads, as bilinear patches (empty for a cage of triangles, and
+    /// after [`Cage::split_quads`]).
+    pub fn quads(&self) -> &[CageQuad] {
+        &self.quads
+    }
+
+    pub fn has_quads(&self) -> bool {
+        !self.quads.is_empty()
+    }
+
+    /// The quad (index into [`Cage::quads`]) that triangle `t` is half of, if any.
+    #[inline]
+    pub fn quad_of_triangle(&self, t: usize) -> Option<usize> {
+        let quad = self.quad_of_triangle[t];
+        (quad != NO_QUAD).then_some(quad as usize)
+    }
+
+    /// The triangles that are faces of their own, not halves of a quad: with
+    /// [`Cage::quads`], the surface as the file drew it.
+    pub fn lone_triangles(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.triangles.len()).filter(|&t| self.quad_of_triangle[t] == NO_QUAD)
+    }
+
+    /// Corner positions of quad `k`.
+    #[inline]
+    pub fn quad(&self, k: usize) -> [DVec3; 4] {
+        self.quads[k].corners.map(|i| self.positions[i as usize])
+    }
+
+    /// This cage with its quads split into triangles along `split`'s diagonal, and
+    /// no quads: for families bound on triangles as they were before quads were
+    /// patches. `QuadSplit::None` gives the cage as it is.
+    pub fn split_quads(&self, split: QuadSplit) -> Cage {
+        if split == QuadSplit::None || self.quads.is_empty() {
+            return self.clone();
+        }
+        let mut triangles = self.triangles.clone();
+        for quad in &self.quads {
+            let halves = super::quads::split_quad(quad.corners, &self.positions, split);
+            for (half, &t) in halves.into_iter().zip(&quad.triangles) {
+                triangles[t as usize] = half;
+            }
+        }
+        Cage {
+            positions: self.positions.clone(),
+            quad_of_triangle: vec![NO_QUAD; triangles.len()],
+            triangles,
+            triangle_faces: self.triangle_faces.clone(),
+            quads: Vec::new(),
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -87,6 +147,9 @@ pub struct CageReport {
     pub unreferenced: Vec<u32>,
     /// Enclosed volume after any flip (positive).
     pub volume: f64,
+    /// Faces of more than four corners, split into triangles (a fan from their
+    /// first corner); quads stay bilinear patches.
+    pub split_polygons: usize,
 }
 
 impl CageReport {
@@ -98,6 +161,12 @@ impl CageReport {
                 "notice: the cage's faces pointed inward; they were flipped to face outward"
                     .to_owned(),
             );
+        }
+        if self.split_polygons > 0 {
+            messages.push(format!(
+                "notice: {} faces have more than four corners; each was split into a fan of triangles from its first corner",
+                self.split_polygons
+            ));
         }
         if !self.unreferenced.is_empty() {
             let shown: Vec<String> = self
@@ -164,6 +233,11 @@ fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
         let (lo, hi) = mesh.bounds();
         (hi - lo).length()
     };
+    let (mut quads, split_polygons) = find_quads(&mesh);
+    for quad in &quads {
+        let corners = quad.corners.map(|i| mesh.positions[i as usize]);
+        check_quad(&corners, quad.corners, quad.face as usize, diagonal)?;
+    }
     for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         let [pa, pb, pc] = [a, b, c].map(|i| mesh.positions[i as usize]);
         let doubled_area = (pb - pa).cross(pc - pa).length();
@@ -239,13 +313,18 @@ fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
         for triangle in &mut triangles {
             triangle.reverse();
         }
+        for quad in &mut quads {
+            quad.corners.reverse();
+        }
         volume = -volume;
     }
 
-    if let Some(crossing) = super::intersect::find_crossing(&mesh.positions, &triangles, diagonal) {
+    if let Some([first, second]) =
+        super::quads::find_patch_crossing(&mesh.positions, &triangles, &quads, diagonal)
+    {
         return Err(CageError::SelfIntersecting {
-            first: face_of(crossing.first),
-            second: face_of(crossing.second),
+            first: face_of(first),
+            second: face_of(second),
         });
     }
     match super::intersect::check_shells(&mesh.positions, &triangles) {
@@ -277,16 +356,25 @@ fn validate(mesh: TriMesh) -> Result<(Cage, CageReport), CageError> {
     } else {
         (0..triangles.len() as u32).collect()
     };
+    let mut quad_of_triangle = vec![NO_QUAD; triangles.len()];
+    for (k, quad) in quads.iter().enumerate() {
+        for &t in &quad.triangles {
+            quad_of_triangle[t as usize] = k as u32;
+        }
+    }
     Ok((
         Cage {
             positions: mesh.positions,
             triangles,
             triangle_faces,
+            quads,
+            quad_of_triangle,
         },
         CageReport {
             flipped,
             unreferenced,
             volume,
+            split_polygons,
         },
     ))
 }

@@ -71,6 +71,10 @@ pub enum CageError {
     TooFewVertices { count: usize },
     #[error("the cage has no faces")]
     NoFaces,
+    #[error("face {} is a degenerate quad: corners {}, {}, {} are collinear (a quad needs four corners in general position)", .face + 1, .corners[0] + 1, .corners[1] + 1, .corners[2] + 1)]
+    DegenerateQuad { face: usize, corners: [u32; 3] },
+    #[error("face {} is a quad that folds over itself at corner {}: its bilinear patch turns its back on itself there (a bow tie, or a corner pushed through the opposite side)", .face + 1, .corner + 1)]
+    FoldedQuad { face: usize, corner: u32 },
     #[error("vertex {} has a non-finite coordinate", .vertex + 1)]
     NonFinite { vertex: usize },
     #[error("face {} refers to vertex {}, but the cage has {count} vertices", .face + 1, *.index as u64 + 1)]

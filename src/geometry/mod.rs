@@ -20,6 +20,8 @@ mod ply;
 mod points_npy;
 mod polygons;
 pub mod procedural;
+pub mod procedural_quads;
+pub mod quads;
 pub mod subdivide;
 pub mod twisted_bar;
 
@@ -41,6 +43,7 @@ pub use output::{
 };
 pub use ply::{colour_byte, write_coloured_ply};
 pub use points_npy::write_points_npy;
+pub use quads::{CageQuad, QuadSplit};
 pub use polygons::{polygon_edges, polygons_of, triangulate_faces};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
