@@ -19,25 +19,32 @@
 // would keep one invocation busy while the others wait at the barrier.
 // Finally each cage vertex gathers its incident triangles' sums and the row is
 // normalised by its total (Σ_k E_k/det · Ω/|d| = w, so the row sum is Σ w).
+// On a cage with quads a second pipeline (CORNERS = 4) takes bilinear patches
+// among the primitives, in the same passes (shared/pmvc_patches.wgsl); on a cage
+// of triangles every patch branch folds away.
 
 #import bind_params
 #import bind_constants
+#import pmvc_patches
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const FAR: f32 = 1e30;
+// Corner slots per primitive: 3 on a cage of triangles, 4 on a cage with quads
+// (set per pipeline; the layout `topology` and `triangle_sums` follow).
+override CORNERS: u32 = 3u;
 
 @group(0) @binding(0) var<uniform> params: Params;
 // Cage vertices relative to the cage centre, xyz.
 @group(0) @binding(1) var<storage, read> cage_positions: array<vec4<f32>>;
-// 3 corners per triangle, then incidence offsets (vertex_count + 1), then incident
-// corners as triangle * 3 + corner.
+// CORNERS corners per primitive (NO_CORNER fills a triangle's fourth), then
+// incidence offsets (vertex_count + 1), then incident corners as t * CORNERS + corner.
 @group(0) @binding(2) var<storage, read> topology: array<u32>;
 // Ω/|d| per texel of one face (row-major, j is the row).
 @group(0) @binding(3) var<storage, read> texels: array<f32>;
 // xyz relative to the cage centre; w = output row within the batch.
 @group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
-// Per point: the three corner sums of every triangle, then their sums for the
-// current band (6 floats per triangle).
+// Per point: the CORNERS corner sums of every primitive, then their sums for the
+// current band.
 @group(0) @binding(5) var<storage, read_write> triangle_sums: array<f32>;
 @group(0) @binding(6) var<storage, read_write> weights: array<f32>;
 // Per point: 0, or FALLBACK when too many rays escaped (the CPU redoes the row).
@@ -53,7 +60,7 @@ var<workgroup> partial_totals: array<f32, WORKGROUP_SIZE>;
 // invocations' sums over one of them.
 var<workgroup> shared_count: atomic<u32>;
 var<workgroup> shared_triangles: array<u32, MAX_SHARED>;
-var<workgroup> partial_sums: array<vec3<f32>, WORKGROUP_SIZE>;
+var<workgroup> partial_sums: array<vec4<f32>, WORKGROUP_SIZE>;
 
 // Above this many texels in a band, a triangle is rasterised by the whole workgroup.
 const SHARED_TEXELS: u32 = 128u;
@@ -82,24 +89,24 @@ struct FaceSetup {
 }
 
 fn triangle_at(t: u32, x: vec3<f32>) -> Triangle {
-    let a = cage_positions[topology[3u * t]].xyz - x;
-    let b = cage_positions[topology[3u * t + 1u]].xyz - x;
-    let c = cage_positions[topology[3u * t + 2u]].xyz - x;
+    let a = cage_positions[topology[CORNERS * t]].xyz - x;
+    let b = cage_positions[topology[CORNERS * t + 1u]].xyz - x;
+    let c = cage_positions[topology[CORNERS * t + 2u]].xyz - x;
     let e0 = cross(b, c);
     return Triangle(a, b, c, e0, cross(c, a), cross(a, b), dot(a, e0));
 }
 
 #import cube_faces
 
-// False only when no ray through the face can reach triangle t: all three corners
+// False only when no ray through the face can reach primitive t: all its corners
 // lie outside one of the four planes that bound the face's pyramid (n·p ≥ |r·p|,
-// n·p ≥ |u·p|). Texel centres lie strictly inside, so rounding here cannot drop a
-// hit. A few loads and multiplies instead of a full set-up: most triangles of a
-// large cage miss most faces.
-fn may_reach_face(t: u32, x: vec3<f32>, axes: mat3x3<f32>) -> bool {
+// n·p ≥ |u·p|); a patch lies in its corners' hull. Texel centres lie strictly
+// inside, so rounding here cannot drop a hit. A few loads and multiplies instead
+// of a full set-up: most primitives of a large cage miss most faces.
+fn may_reach_face(t: u32, x: vec3<f32>, axes: mat3x3<f32>, corners: u32) -> bool {
     var outside = 15u;
-    for (var k = 0u; k < 3u; k++) {
-        let p = cage_positions[topology[3u * t + k]].xyz - x;
+    for (var k = 0u; k < corners; k++) {
+        let p = cage_positions[topology[CORNERS * t + k]].xyz - x;
         let r = dot(p, axes[0]);
         let u = dot(p, axes[1]);
         let n = dot(p, axes[2]);
@@ -137,6 +144,11 @@ fn texel_range(tri: Triangle, axes: mat3x3<f32>) -> vec4<u32> {
             if crossing.y <= 0.0 { lo.y = -FAR; }
         }
     }
+    return texels_within(lo, hi, any_in_front);
+}
+
+// The texel ranges covering face bounds [lo, hi], widened by a texel.
+fn texels_within(lo: vec2<f32>, hi: vec2<f32>, any_in_front: bool) -> vec4<u32> {
     if !any_in_front || lo.x > 1.0 || hi.x < -1.0 || lo.y > 1.0 || hi.y < -1.0 {
         return vec4<u32>(0u, 0u, 0u, 0u);
     }
@@ -227,6 +239,30 @@ fn claim(setup: FaceSetup, t: u32, i: u32, j: u32, band_start: u32) -> vec3<f32>
     return vec3<f32>(0.0);
 }
 
+// Step 1: t's part of the band is large, and it joins the band's shared list.
+fn share(t: u32) -> bool {
+    let slot = atomicAdd(&shared_count, 1u);
+    if slot < MAX_SHARED {
+        shared_triangles[slot] = t;
+        return true;
+    }
+    return false;
+}
+
+fn band_sums(base: u32, t: u32) -> vec4<f32> {
+    var sums = vec4<f32>(0.0);
+    for (var k = 0u; k < CORNERS; k++) {
+        sums[k] = triangle_sums[base + CORNERS * t + k];
+    }
+    return sums;
+}
+
+fn store_band_sums(base: u32, t: u32, sums: vec4<f32>) {
+    for (var k = 0u; k < CORNERS; k++) {
+        triangle_sums[base + CORNERS * t + k] = sums[k];
+    }
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let point = group.x;
@@ -236,12 +272,10 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let x = points[point].xyz;
     let row = u32(points[point].w);
     let resolution = params.resolution;
-    let sums_base = point * params.triangle_count * 6u;
-    let band_base = sums_base + 3u * params.triangle_count;
-    for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
-        triangle_sums[sums_base + 3u * t] = 0.0;
-        triangle_sums[sums_base + 3u * t + 1u] = 0.0;
-        triangle_sums[sums_base + 3u * t + 2u] = 0.0;
+    let sums_base = point * params.triangle_count * 2u * CORNERS;
+    let band_base = sums_base + CORNERS * params.triangle_count;
+    for (var n = lane; n < CORNERS * params.triangle_count; n += WORKGROUP_SIZE) {
+        triangle_sums[sums_base + n] = 0.0;
     }
     if lane == 0u {
         atomicStore(&missed, 0u);
@@ -272,21 +306,32 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             for (var t = lane; t < params.triangle_count; t += WORKGROUP_SIZE) {
                 let owned = k;
                 k++;
+                let on_patch = is_patch(t);
                 if owned < 64u {
-                    if !may_reach_face(t, x, axes) {
+                    if !may_reach_face(t, x, axes, select(3u, 4u, on_patch)) {
                         continue;
                     }
                     reaching[owned / 32u] |= 1u << (owned % 32u);
                 }
-                let setup = face_setup(triangle_at(t, x), axes);
-                let part = band_part(setup, band_start, band_end);
-                if owned < 32u && texel_count(part) > SHARED_TEXELS {
-                    let slot = atomicAdd(&shared_count, 1u);
-                    if slot < MAX_SHARED {
-                        shared_triangles[slot] = t;
+                if on_patch {
+                    let setup = patch_setup(t, x, axes);
+                    let part = band_part(setup.face, band_start, band_end);
+                    if owned < 32u && texel_count(part) > SHARED_TEXELS && share(t) {
                         shared_mask |= 1u << owned;
                         continue;
                     }
+                    for (var j = part.z; j < part.w; j++) {
+                        for (var i = part.x; i < part.y; i++) {
+                            raster_patch(setup, i, j, band_start);
+                        }
+                    }
+                    continue;
+                }
+                let setup = face_setup(triangle_at(t, x), axes);
+                let part = band_part(setup, band_start, band_end);
+                if owned < 32u && texel_count(part) > SHARED_TEXELS && share(t) {
+                    shared_mask |= 1u << owned;
+                    continue;
                 }
                 for (var j = part.z; j < part.w; j++) {
                     for (var i = part.x; i < part.y; i++) {
@@ -299,7 +344,19 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             }
             let shared_total = min(workgroupUniformLoad(&shared_count), MAX_SHARED);
             for (var s = 0u; s < shared_total; s++) {
-                let setup = face_setup(triangle_at(shared_triangles[s], x), axes);
+                let t = shared_triangles[s];
+                if is_patch(t) {
+                    let setup = patch_setup(t, x, axes);
+                    let part = band_part(setup.face, band_start, band_end);
+                    let step = texel_step(part);
+                    var at = first_texel(part, lane);
+                    while at.y < part.w {
+                        raster_patch(setup, at.x, at.y, band_start);
+                        at = next_texel(part, at, step);
+                    }
+                    continue;
+                }
+                let setup = face_setup(triangle_at(t, x), axes);
                 let part = band_part(setup, band_start, band_end);
                 let step = texel_step(part);
                 var at = first_texel(part, lane);
@@ -324,6 +381,18 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 if owned < 32u && (shared_mask & (1u << owned)) != 0u {
                     continue;
                 }
+                if is_patch(t) {
+                    let setup = patch_setup(t, x, axes);
+                    let part = band_part(setup.face, band_start, band_end);
+                    var sums = vec4<f32>(0.0);
+                    for (var j = part.z; j < part.w; j++) {
+                        for (var i = part.x; i < part.y; i++) {
+                            sums += claim_patch(setup, t, i, j, band_start);
+                        }
+                    }
+                    store_band_sums(band_base, t, sums);
+                    continue;
+                }
                 let setup = face_setup(triangle_at(t, x), axes);
                 let part = band_part(setup, band_start, band_end);
                 var sums = vec3<f32>(0.0);
@@ -332,32 +401,39 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                         sums += claim(setup, t, i, j, band_start);
                     }
                 }
-                triangle_sums[band_base + 3u * t] = sums.x;
-                triangle_sums[band_base + 3u * t + 1u] = sums.y;
-                triangle_sums[band_base + 3u * t + 2u] = sums.z;
+                store_band_sums(band_base, t, vec4<f32>(sums, 0.0));
             }
             for (var s = 0u; s < shared_total; s++) {
                 let t = shared_triangles[s];
-                let setup = face_setup(triangle_at(t, x), axes);
-                let part = band_part(setup, band_start, band_end);
-                var sums = vec3<f32>(0.0);
-                let step = texel_step(part);
-                var at = first_texel(part, lane);
-                while at.y < part.w {
-                    sums += claim(setup, t, at.x, at.y, band_start);
-                    at = next_texel(part, at, step);
+                var sums = vec4<f32>(0.0);
+                if is_patch(t) {
+                    let setup = patch_setup(t, x, axes);
+                    let part = band_part(setup.face, band_start, band_end);
+                    let step = texel_step(part);
+                    var at = first_texel(part, lane);
+                    while at.y < part.w {
+                        sums += claim_patch(setup, t, at.x, at.y, band_start);
+                        at = next_texel(part, at, step);
+                    }
+                } else {
+                    let setup = face_setup(triangle_at(t, x), axes);
+                    let part = band_part(setup, band_start, band_end);
+                    let step = texel_step(part);
+                    var at = first_texel(part, lane);
+                    while at.y < part.w {
+                        sums += vec4<f32>(claim(setup, t, at.x, at.y, band_start), 0.0);
+                        at = next_texel(part, at, step);
+                    }
                 }
                 partial_sums[lane] = sums;
                 workgroupBarrier();
                 // The owner of t, which adds the band's sums to its totals in step 3.
                 if lane == t % WORKGROUP_SIZE {
-                    var total = vec3<f32>(0.0);
+                    var total = vec4<f32>(0.0);
                     for (var q = 0u; q < WORKGROUP_SIZE; q++) {
                         total += partial_sums[q];
                     }
-                    triangle_sums[band_base + 3u * t] = total.x;
-                    triangle_sums[band_base + 3u * t + 1u] = total.y;
-                    triangle_sums[band_base + 3u * t + 2u] = total.z;
+                    store_band_sums(band_base, t, total);
                 }
                 workgroupBarrier();
             }
@@ -371,27 +447,25 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 if !reaches(reaching, owned) {
                     continue;
                 }
-                var sums = vec3<f32>(
-                    triangle_sums[band_base + 3u * t],
-                    triangle_sums[band_base + 3u * t + 1u],
-                    triangle_sums[band_base + 3u * t + 2u],
-                );
-                if any_tie {
+                var sums = band_sums(band_base, t);
+                if any_tie && is_patch(t) {
+                    sums = claimed_patch_sums(patch_setup(t, x, axes), t, band_start, band_end);
+                } else if any_tie {
                     let setup = face_setup(triangle_at(t, x), axes);
-                    sums = vec3<f32>(0.0);
+                    sums = vec4<f32>(0.0);
                     for (var j = max(setup.range.z, band_start); j < min(setup.range.w, band_end); j++) {
                         for (var i = setup.range.x; i < setup.range.y; i++) {
                             if atomicLoad(&nearest_triangle[(j - band_start) * resolution + i]) == t {
                                 let h = hit(setup, i, j);
-                                sums += (texels[j * resolution + i] * setup.inverse_det) * h.xyz;
+                                sums += vec4<f32>((texels[j * resolution + i] * setup.inverse_det) * h.xyz, 0.0);
                             }
                         }
                     }
                 }
-                if any(sums != vec3<f32>(0.0)) {
-                    triangle_sums[sums_base + 3u * t] += sums.x;
-                    triangle_sums[sums_base + 3u * t + 1u] += sums.y;
-                    triangle_sums[sums_base + 3u * t + 2u] += sums.z;
+                if any(sums != vec4<f32>(0.0)) {
+                    for (var c = 0u; c < CORNERS; c++) {
+                        triangle_sums[sums_base + CORNERS * t + c] += sums[c];
+                    }
                 }
             }
             for (var texel = lane; texel < band_texels; texel += WORKGROUP_SIZE) {

@@ -299,6 +299,7 @@ fn the_library_refuses_a_parameter_outside_its_range() {
             method,
             resolution,
             grid,
+            quads: pmvc::coords::QuadSplit::None,
         };
         let error = bind_cpu(
             &points,

@@ -89,7 +89,7 @@ fn chunked_weights_deform_and_colour_the_mesh_as_the_cpu_does() {
         app,
         Shading {
             method: Method::Pmvc,
-            against: Some(Method::Mvc),
+            against: Some(Method::Mvc.into()),
             colouring: Colouring::MethodDistance,
             cage_size: diagonal as f32,
             ..Default::default()

@@ -259,12 +259,12 @@ fn the_difference_view_shows_the_distance_between_the_deformations() {
     assert_eq!(
         app.pane_rects()[0].0,
         Pane::Difference {
-            against: Method::Mvc,
+            against: Method::Mvc.into(),
             shown: Method::Pmvc
         }
     );
     let shading = app.shading_of(Pane::Difference {
-        against: Method::Mvc,
+        against: Method::Mvc.into(),
         shown: Method::Pmvc,
     });
     assert_eq!(shading.colouring, Colouring::MethodDistance);

@@ -11,7 +11,7 @@ use pmvc::app::{EditorApp, EditorOptions};
 use pmvc::coords::Method;
 
 const DIFFERENCE: Pane = Pane::Difference {
-    against: Method::Mvc,
+    against: pmvc::coords::WeightsId::of(Method::Mvc),
     shown: Method::Pmvc,
 };
 

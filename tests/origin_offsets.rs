@@ -62,6 +62,7 @@ fn options(method: Method) -> BindOptions {
         method,
         resolution: 32,
         grid: 32,
+        quads: pmvc::coords::QuadSplit::None,
     }
 }
 

@@ -89,6 +89,8 @@ pub enum Action {
     NextMethod,
     /// A family parameter, checked by its spec.
     SetParameter(Parameter, u32),
+    /// Bind quads as bilinear patches, or split along a diagonal (`--triangulate`).
+    SetQuadSplit(crate::coords::QuadSplit),
     /// Bind the methods the views show, replacing a running bind.
     StartBind,
     /// Cancel the running bind; views stop asking until the user binds again.

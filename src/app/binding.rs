@@ -6,7 +6,7 @@
 use super::bind_queue::BindQueue;
 use super::compare::ViewSettings;
 use super::document::Document;
-use crate::coords::{BindOptions, Method, Parameter};
+use crate::coords::{BindOptions, Method, Parameter, QuadSplit, QuadSupport};
 
 /// `options` with the parameters `pmvc edit` was given put over them, each
 /// checked by its spec; a refused value leaves the option as it was and is
@@ -16,6 +16,9 @@ pub(super) fn with_asked_parameters(
     asked: &super::EditorOptions,
 ) -> Vec<String> {
     let mut refused = Vec::new();
+    if let Some(split) = asked.triangulate {
+        options.quads = split;
+    }
     for (parameter, value) in [
         (Parameter::Resolution, asked.resolution),
         (Parameter::Grid, asked.grid),
@@ -68,12 +71,37 @@ impl Binding {
         self.options.method
     }
 
-    /// The options `method` is bound with: its family's current parameters.
+    /// The options `method` is bound with: its family's current parameters, and
+    /// the quads as the setting says. A family that takes only triangles (Green)
+    /// is bound on the cage's own triangles, split along the shorter diagonal,
+    /// whatever the setting: its ψ columns follow those triangles everywhere
+    /// the editor moves them.
     pub fn options_for(&self, method: Method) -> BindOptions {
+        let quads = match method.spec().quads {
+            QuadSupport::Patches { .. } => self.options.quads,
+            QuadSupport::Triangles => QuadSplit::None,
+        };
         BindOptions {
             method,
+            quads,
             ..self.options
         }
+    }
+
+    /// Bind the cage's quads as bilinear patches or split along a diagonal;
+    /// every family that takes patches is bound again. False when already so.
+    pub fn set_quad_split(&mut self, split: QuadSplit) -> bool {
+        if self.options.quads == split {
+            return false;
+        }
+        self.options.quads = split;
+        for method in Method::ALL {
+            if matches!(method.spec().quads, QuadSupport::Patches { .. }) {
+                self.queue.drop_method(method);
+            }
+        }
+        self.paused = false;
+        true
     }
 
     /// Bind the methods `view` shows, the active one first, replacing any
@@ -85,6 +113,34 @@ impl Binding {
         for method in wanted_methods(self.active_method(), view) {
             self.queue.request(self.options_for(method));
         }
+        for options in self.wanted_twins(view) {
+            self.queue.request(options);
+        }
+    }
+
+    /// The triangulated twins the views compare with, as bind options.
+    fn wanted_twins(&self, view: &ViewSettings) -> Vec<BindOptions> {
+        let panes = view.panes(self.active_method(), crate::render::MAX_VIEWS);
+        panes
+            .iter()
+            .filter_map(|pane| match pane {
+                super::compare::Pane::Difference { against, .. } => {
+                    let split = against.split_twin?;
+                    // A twin bound as the family itself is not a twin; one of a
+                    // family that takes only triangles would change nothing.
+                    let takes_patches =
+                        matches!(against.method.spec().quads, QuadSupport::Patches { .. });
+                    if !takes_patches || split == self.options_for(against.method).quads {
+                        return None;
+                    }
+                    Some(BindOptions {
+                        quads: split,
+                        ..self.options_for(against.method)
+                    })
+                }
+                super::compare::Pane::Method(_) => None,
+            })
+            .collect()
     }
 
     /// Queue binds for the wanted methods that have no weights at the current
@@ -97,6 +153,15 @@ impl Binding {
             let options = self.options_for(method);
             let current = document
                 .bound(method)
+                .is_some_and(|set| set.options.same_weights_as(&options));
+            if !current {
+                self.queue.request(options);
+            }
+        }
+        for options in self.wanted_twins(view) {
+            let id = crate::coords::WeightsId::twin(options.method, options.quads);
+            let current = document
+                .bound_id(id)
                 .is_some_and(|set| set.options.same_weights_as(&options));
             if !current {
                 self.queue.request(options);

@@ -5,7 +5,7 @@
 //! Methods are data here: nothing below names a coordinate family except the
 //! defaults.
 
-use crate::coords::{quality, Method, Weights};
+use crate::coords::{quality, Method, QuadSplit, Weights, WeightsId};
 use crate::render::colormap::Scale;
 use crate::render::Colouring;
 use glam::{DVec3, Mat4, Vec3};
@@ -45,8 +45,8 @@ pub enum Pane {
     /// The mesh deformed (and coloured) with one method's weights.
     Method(Method),
     /// The mesh deformed with `shown`, coloured by its distance to the mesh
-    /// deformed with `against`.
-    Difference { against: Method, shown: Method },
+    /// deformed with `against`: another family, or `shown`'s triangulated twin.
+    Difference { against: WeightsId, shown: Method },
 }
 
 impl Pane {
@@ -62,7 +62,7 @@ impl Pane {
     pub fn methods(self) -> Vec<Method> {
         match self {
             Pane::Method(method) => vec![method],
-            Pane::Difference { against, shown } => vec![against, shown],
+            Pane::Difference { against, shown } => vec![against.method, shown],
         }
     }
 }
@@ -143,6 +143,10 @@ pub struct ViewSettings {
     /// The two methods the difference compares: the mesh is deformed with the
     /// second and coloured by its distance to the first.
     pub difference: [Method; 2],
+    /// When set, the difference compares the shown family (the second of
+    /// `difference`) with its triangulated twin, bound with the cage's quads split
+    /// along this diagonal, instead of with the first family.
+    pub difference_split: Option<QuadSplit>,
     /// In the side-by-side layout, one more view of the difference.
     pub difference_pane: bool,
     /// The difference view's colour scale ends here (a fraction of the cage
@@ -209,6 +213,7 @@ impl Default for ViewSettings {
             negativity_scale: Scale::LogMagnitude,
             compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
             difference: [Method::Mvc, Method::Pmvc],
+            difference_split: None,
             difference_pane: false,
             difference_limit: None,
             cameras_locked: true,
@@ -225,6 +230,10 @@ impl ViewSettings {
     /// The difference pane of [`Self::difference`].
     pub fn difference_pane_kind(&self) -> Pane {
         let [against, shown] = self.difference;
+        let against = match self.difference_split {
+            Some(split) => WeightsId::twin(shown, split),
+            None => WeightsId::of(against),
+        };
         Pane::Difference { against, shown }
     }
 
@@ -460,7 +469,7 @@ mod tests {
         );
         settings.difference_pane = true;
         let difference = Pane::Difference {
-            against: Method::Mvc,
+            against: WeightsId::of(Method::Mvc),
             shown: Method::Pmvc,
         };
         assert_eq!(settings.panes(Method::Pmvc, 3)[2], difference);

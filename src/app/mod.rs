@@ -69,6 +69,9 @@ pub struct EditorOptions {
     pub resolution: Option<u32>,
     /// Harmonic grid (cells along the cage's longest side); `None` for the default.
     pub grid: Option<u32>,
+    /// Split the cage's quads along a diagonal (`--triangulate`); `None` keeps
+    /// the session's setting, or bilinear patches.
+    pub triangulate: Option<crate::coords::QuadSplit>,
     /// Coordinates to bind with; `None` for PMVC.
     pub method: Option<crate::coords::Method>,
     /// Save a PNG of the window once the first bind finishes, then quit.

@@ -6,19 +6,19 @@
 use super::compare::{self, Pane, ValueRange};
 use super::document::{Changes, Document};
 use super::views::Views;
-use crate::coords::Method;
+use crate::coords::{Method, WeightsId};
 use crate::render::{Colouring, Shading};
 use glam::Vec3;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
 /// A range is keyed by what it shows and the methods it reads.
-type RangeKey = (Colouring, Method, Option<Method>);
+type RangeKey = (Colouring, Method, Option<WeightsId>);
 
 #[derive(Default)]
 pub struct ReadoutCache {
     /// The mesh deformed per method, with the pose revision it was made for.
-    deformed: BTreeMap<Method, (u64, Arc<Vec<Vec3>>)>,
+    deformed: BTreeMap<WeightsId, (u64, Arc<Vec<Vec3>>)>,
     /// Colour-bar ranges (a row-minimum scan of a large matrix is too slow to
     /// repeat every frame).
     ranges: Vec<(RangeKey, Option<ValueRange>)>,
@@ -40,7 +40,8 @@ impl ReadoutCache {
             self.deformed.remove(method);
         }
         let weights_changed = |key: &RangeKey| {
-            changes.weights.contains(&key.1) || key.2.is_some_and(|m| changes.weights.contains(&m))
+            changes.weights.contains(&WeightsId::of(key.1))
+                || key.2.is_some_and(|id| changes.weights.contains(&id))
         };
         // Distances depend on the pose; weights and their ranges do not.
         self.ranges.retain(|(key, _)| {
@@ -55,16 +56,19 @@ impl Views {
     pub(super) fn deformed_on_cpu(
         &mut self,
         document: &Document,
-        method: Method,
+        id: impl Into<WeightsId>,
     ) -> Option<Arc<Vec<Vec3>>> {
+        let id = id.into();
         let revision = document.pose_revision();
-        if let Some((made_for, positions)) = self.readouts.deformed.get(&method) {
+        if let Some((made_for, positions)) = self.readouts.deformed.get(&id) {
             if *made_for == revision {
                 return Some(Arc::clone(positions));
             }
         }
-        let weights = document.weights(method)?;
-        let moves = method.column_displacements(document.cage(), document.pose());
+        let weights = &document.bound_id(id)?.weights;
+        let moves = id
+            .method
+            .column_displacements(document.cage(), document.pose());
         let positions = Arc::new(compare::deform(
             weights,
             &document.mesh().positions,
@@ -73,7 +77,7 @@ impl Views {
         ));
         self.readouts
             .deformed
-            .insert(method, (revision, Arc::clone(&positions)));
+            .insert(id, (revision, Arc::clone(&positions)));
         Some(positions)
     }
 

@@ -13,7 +13,7 @@ use super::session_checks::{
     camera_in_range, checked_pose, cut_text, inline_cage_defect, view_in_range, Reach,
     SESSION_SIZE_LIMIT,
 };
-use crate::coords::{BindOptions, Method, Parameter, ParameterError};
+use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
 use crate::geometry::budget::read_limited;
 use crate::geometry::{
     load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
@@ -48,6 +48,10 @@ pub enum CageSource {
     Inline {
         positions: Vec<[f64; 3]>,
         triangles: Vec<[u32; 3]>,
+        /// The faces as polygons, when the cage has quads: they are read
+        /// instead of `triangles`, so the quads stay bilinear patches.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        faces: Option<Vec<Vec<u32>>>,
     },
 }
 
@@ -89,6 +93,10 @@ pub struct SessionFile {
     /// Each family's parameter by name ("resolution": 32).
     #[serde(default)]
     pub parameters: BTreeMap<String, u64>,
+    /// How the cage's quads are bound: "none" (bilinear patches, the default and
+    /// what sessions from before this setting get), "shorter" or "longer".
+    #[serde(default, skip_serializing_if = "is_no_split")]
+    pub triangulate: QuadSplit,
     #[serde(default)]
     pub view: ViewSettings,
     /// One camera per view (the first is every view's while they are locked).
@@ -166,6 +174,10 @@ pub struct OpenedSession {
     pub settings: SessionSettings,
     /// Things worth saying that did not stop the session from opening.
     pub notes: Vec<String>,
+}
+
+fn is_no_split(split: &QuadSplit) -> bool {
+    *split == QuadSplit::None
 }
 
 fn to_array(p: DVec3) -> [f64; 3] {
@@ -272,6 +284,7 @@ pub fn save_session(
             .into_iter()
             .map(|p| (p.id().to_owned(), settings.bind_options.get(p).into()))
             .collect(),
+        triangulate: settings.bind_options.quads,
         view: settings.view,
         cameras: settings
             .cameras
@@ -342,6 +355,7 @@ fn cage_source(folder: &Path, document: &Document) -> CageSource {
     CageSource::Inline {
         positions: cage.positions().iter().copied().map(to_array).collect(),
         triangles: cage.triangles().to_vec(),
+        faces: cage.has_quads().then(|| cage.polygons()),
     }
 }
 
@@ -394,6 +408,7 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
     let (title, cut) = cut_text(&session.title, "the title");
     cut.into_iter().for_each(&mut note);
     let mut bind_options = BindOptions::for_method(session.method);
+    bind_options.quads = session.triangulate;
     for (name, &value) in &session.parameters {
         match Parameter::ALL.into_iter().find(|p| p.id() == name) {
             Some(parameter) => {
@@ -434,11 +449,15 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         CageSource::Inline {
             positions,
             triangles,
+            faces,
         } => {
-            let mesh = TriMesh {
-                positions: to_points(positions),
-                triangle_faces: (0..triangles.len() as u32).collect(),
-                triangles: triangles.clone(),
+            let mesh = match faces {
+                Some(faces) => crate::geometry::triangulate_faces(faces, &to_points(positions)),
+                None => TriMesh {
+                    positions: to_points(positions),
+                    triangle_faces: (0..triangles.len() as u32).collect(),
+                    triangles: triangles.clone(),
+                },
             };
             let (cage, report) = Cage::new(mesh).map_err(|error| SessionError::InlineCage {
                 path: path.to_owned(),

@@ -2,7 +2,7 @@
 //! and on the shared evaluation data, on the CPU and on a GPU adapter. Reports medians over repeated runs, as markdown on
 //! stdout and optionally as JSON.
 
-use crate::coords::{BindOptions, BindProgress, Method};
+use crate::coords::{BindOptions, BindProgress, Method, QuadSplit};
 use crate::geometry::{self, classify_points, procedural, shown_path, Cage};
 use crate::gpu::{Backend, BindInput, Binder, GpuContext};
 use anyhow::{bail, Result};
@@ -244,17 +244,36 @@ fn bench_scene(
     backends: &[Timed],
     runs: usize,
 ) -> Result<Vec<BenchRow>> {
+    let as_patches: Vec<_> = configurations
+        .iter()
+        .map(|&(method, value)| (method, value, QuadSplit::None))
+        .collect();
+    bench_scene_split(name, cage, points, &as_patches, backends, runs)
+}
+
+/// [`bench_scene`] with each configuration's quads bound as patches or split.
+fn bench_scene_split(
+    name: &str,
+    cage: &Cage,
+    points: &[DVec3],
+    configurations: &[(Method, u32, QuadSplit)],
+    backends: &[Timed],
+    runs: usize,
+) -> Result<Vec<BenchRow>> {
     let classes = classify_points(cage, points);
     let mut rows = Vec::new();
     for timed in backends {
-        for &(method, resolution) in configurations {
+        for &(method, resolution, quads) in configurations {
             // A family without a GPU kernel binds on the CPU on every backend: its
             // CPU row says all there is.
             let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
             if gpu_backend && crate::gpu::kernels::Kernel::of(method).is_none() {
                 continue;
             }
-            let mut options = BindOptions::for_method(method);
+            let mut options = BindOptions {
+                quads,
+                ..BindOptions::for_method(method)
+            };
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
             }
@@ -277,9 +296,10 @@ fn bench_scene(
                 last = Some(output.stats);
             }
             let last = last.unwrap_or_default();
+            let name_on_cage = options.family_name(cage);
             let label = match options.parameter() {
-                Some((spec, value)) => format!("{} {}", method.name(), (spec.format)(value)),
-                None => method.name().to_owned(),
+                Some((spec, value)) => format!("{name_on_cage} {}", (spec.format)(value)),
+                None => name_on_cage,
             };
             let row = BenchRow {
                 scene: name.to_owned(),
@@ -322,8 +342,18 @@ fn bench_shared_data(
     for name in names {
         let mesh = geometry::load_mesh(&args.data.join(format!("{name}.obj")))?;
         let (cage, _) = geometry::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
-        let configurations = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)];
-        rows.extend(bench_scene(
+        // On a cage with quads, each family as patches and split along the
+        // shorter diagonal (as files were bound before quads were patches).
+        let splits: &[QuadSplit] = if cage.has_quads() {
+            &[QuadSplit::None, QuadSplit::Shorter]
+        } else {
+            &[QuadSplit::None]
+        };
+        let configurations: Vec<_> = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)]
+            .into_iter()
+            .flat_map(|(method, value)| splits.iter().map(move |&split| (method, value, split)))
+            .collect();
+        rows.extend(bench_scene_split(
             name,
             &cage,
             &mesh.mesh.positions,

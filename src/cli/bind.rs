@@ -148,7 +148,7 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     summary(format_args!(
         "wrote {}{beside}: {shape} ({}, {}) bound in {:.2} s; {}",
         shown_path(&args.out),
-        method_label(args.method.options()),
+        method_label(args.method.options(), &input.cage),
         done.device,
         done.seconds,
         outside_note(&input)

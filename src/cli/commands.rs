@@ -144,6 +144,11 @@ pub(super) fn bind_rows(
     if choice.verbose && range.start == 0 {
         warn_line!("pmvc: {}", decision.explain());
     }
+    if range.start == 0 {
+        if let Some(notice) = choice.options().quad_notice(&input.cage) {
+            warn_line!("pmvc: {notice}");
+        }
+    }
     let on_gpu = decision.on_gpu(choice.method);
     let backend = &decision.backend;
     let bind_input = BindInput {
@@ -180,9 +185,10 @@ pub(super) fn bind_rows(
     })
 }
 
-/// What a bind used, for the summary line: "PMVC 32²", "HC grid 64", "MVC".
-pub(super) fn method_label(options: BindOptions) -> String {
-    let name = options.method.name();
+/// What a bind used, for the summary line: "PMVC 32²", "HC grid 64", "MVC",
+/// "QMVC" (MVC on a cage's bilinear quads), "PMVC (shorter split) 32²".
+pub(super) fn method_label(options: BindOptions, cage: &Cage) -> String {
+    let name = options.family_name(cage);
     match options.parameter() {
         Some((spec, value)) => format!("{name} {}", (spec.format)(value)),
         None => name.to_owned(),
@@ -313,11 +319,19 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         }
     );
     let (cage, report) = geometry::load_cage(&args.input.cage)?;
+    let faces = if cage.has_quads() {
+        format!(
+            "{} quads (bilinear patches) and {} triangles",
+            cage.quads().len(),
+            cage.lone_triangles().count()
+        )
+    } else {
+        format!("{} triangles", cage.triangles().len())
+    };
     say!(
-        "cage  {}: {} vertices, {} triangles, closed, edge-manifold, consistently oriented",
+        "cage  {}: {} vertices, {faces}, closed, edge-manifold, consistently oriented",
         shown_path(&args.input.cage),
         cage.vertex_count(),
-        cage.triangles().len()
     );
     say!(
         "      volume {:.6}, faces point {}, diagonal {:.6}",
@@ -389,11 +403,13 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         .filter(|&r| weights.row(r).iter().any(|&w| w < 0.0))
         .count();
     say!(
-        "MVC on {} sampled inside vertices: {:.1}% have a negative weight, most negative {:.4}",
+        "{} on {} sampled inside vertices: {:.1}% have a negative weight, most negative {:.4}",
+        options.family_name(&cage),
         weights.rows,
         100.0 * negative_rows as f64 / weights.rows.max(1) as f64,
         weights.min().min(0.0)
     );
+    super::quad_report::report_split_effect(args, &cage, &points, &sample_classes)?;
     Ok(())
 }
 

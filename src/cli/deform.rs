@@ -144,8 +144,10 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     // Σλc̃ carries each weight's rounding times the cage's distance from the
     // origin, this form only times how far the cage moved. Rows were checked to
     // sum to 1 when read, so a translation of the cage moves every vertex with it.
+    // Green's ψ columns follow the triangles the weights were bound on.
+    let bound_cage = options.cage_to_bind(&input.cage);
     let deform = |pose: &[DVec3]| -> Vec<DVec3> {
-        let moves = method.column_displacements(&input.cage, pose);
+        let moves = method.column_displacements(&bound_cage, pose);
         weights.apply_displacements(&input.mesh.mesh.positions, &moves)
     };
     let deformed = deform(&pose);
@@ -180,11 +182,11 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     let source = match (&args.weights, &stored) {
         (Some(path), Some(stored)) if stored.metadata.is_some() => format!(
             "{} weights from {}",
-            method_label(stored.options),
+            method_label(stored.options, &input.cage),
             shown_path(path)
         ),
         (Some(path), _) => format!("weights from {}", shown_path(path)),
-        (None, _) => format!("{} weights", method_label(options)),
+        (None, _) => format!("{} weights", method_label(options, &input.cage)),
     };
     let extra = match (args.poses.len(), args.animate) {
         (0, _) => String::new(),
@@ -205,7 +207,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
 
 /// A pose of the cage read from `path`: its vertices, which must be as many as
 /// the cage's, in order. A pose that crosses itself gets a warning.
-fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Vec<DVec3>> {
+pub(super) fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Vec<DVec3>> {
     let pose = geometry::load_mesh(path)?;
     let (expected, found) = (cage.vertex_count(), pose.mesh.positions.len());
     if found != expected {

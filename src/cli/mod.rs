@@ -29,6 +29,7 @@ mod commands;
 mod deform;
 mod environment;
 mod parse;
+mod quad_report;
 mod weights_format;
 
 /// Standard output could not be written.
@@ -37,7 +38,9 @@ mod weights_format;
 pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
-use parse::{parse_grid, parse_percent, parse_resolution, parse_seconds, parse_view};
+use parse::{
+    parse_grid, parse_percent, parse_resolution, parse_seconds, parse_view, TriangulateArg,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -118,6 +121,13 @@ pub struct MethodChoice {
     /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
     #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = parse_grid)]
     pub grid: u32,
+    /// Split the cage's quads into triangles along their shorter or longer diagonal
+    /// before binding, as before quads were bilinear patches, to reproduce earlier
+    /// results or see how much the split moves the mesh. Without it, quads stay
+    /// bilinear patches (MVC on quads is then QMVC); Green coordinates, which take
+    /// only triangles, split along the shorter diagonal.
+    #[arg(long, value_enum, value_name = "DIAGONAL")]
+    pub triangulate: Option<TriangulateArg>,
     /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
@@ -140,6 +150,9 @@ impl MethodChoice {
             method: self.method,
             resolution: self.resolution,
             grid: self.grid,
+            quads: self
+                .triangulate
+                .map_or(crate::coords::QuadSplit::None, TriangulateArg::split),
         }
     }
 }
@@ -194,6 +207,14 @@ pub struct CheckArgs {
     /// The harmonic grid to report on: cells along the cage's longest side (4–2048).
     #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = parse_grid)]
     pub grid: u32,
+    /// On a cage with quads, the pose at which to measure how far the choice of
+    /// diagonal moves the mesh (default: the cage twisted by 45° about its
+    /// longest axis).
+    #[arg(long, value_name = "POSE.obj")]
+    pub deformed_cage: Option<PathBuf>,
+    /// PMVC cube-map resolution for that measurement (1–1024).
+    #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
+    pub resolution: u32,
 }
 
 #[derive(Debug, clap::Args)]
@@ -216,6 +237,10 @@ pub struct EditArgs {
     /// Harmonic grid: cells along the cage's longest side (4–2048).
     #[arg(long, value_parser = parse_grid)]
     pub grid: Option<u32>,
+    /// Bind the cage's quads split along their shorter or longer diagonal
+    /// instead of as bilinear patches (the Quads setting in the side panel).
+    #[arg(long, value_enum, value_name = "DIAGONAL")]
+    pub triangulate: Option<TriangulateArg>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
     pub method: Option<crate::coords::Method>,
@@ -328,6 +353,7 @@ impl EditArgs {
             pose: self.pose,
             resolution: self.resolution,
             grid: self.grid,
+            triangulate: self.triangulate.map(TriangulateArg::split),
             method,
             screenshot: self.screenshot,
             drag_handle: self.drag,

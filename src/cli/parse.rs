@@ -56,3 +56,21 @@ pub(super) fn parse_view(value: &str) -> Result<ViewArg, String> {
             }),
     }
 }
+
+/// `--triangulate`'s values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TriangulateArg {
+    /// Along each quad's shorter diagonal.
+    Shorter,
+    /// Along each quad's longer diagonal.
+    Longer,
+}
+
+impl TriangulateArg {
+    pub(super) fn split(self) -> crate::coords::QuadSplit {
+        match self {
+            TriangulateArg::Shorter => crate::coords::QuadSplit::Shorter,
+            TriangulateArg::Longer => crate::coords::QuadSplit::Longer,
+        }
+    }
+}

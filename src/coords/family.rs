@@ -14,7 +14,8 @@ use glam::DVec3;
 /// A family of generalised barycentric coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Method {
-    /// Mean value coordinates (Ju, Schaefer, Warren 2005), closed form.
+    /// Mean value coordinates (Ju, Schaefer, Warren 2005), closed form; on bilinear
+    /// quads, QMVC (Thiery, Memari, Boubekeur 2018).
     Mvc,
     /// Positive mean value coordinates (Lipman et al. 2007), by cube-map integration.
     Pmvc,
@@ -23,6 +24,49 @@ pub enum Method {
     /// Green coordinates (Lipman, Levin, Cohen-Or 2008), closed form: one column per
     /// cage vertex (φ) and one per cage triangle (ψ).
     Green,
+}
+
+/// One set of weights a viewer holds: a family as bound with the viewer's
+/// setting for quads, or its triangulated twin, the same family bound with the
+/// cage's quads split along a diagonal, to show what the split does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct WeightsId {
+    pub method: Method,
+    pub split_twin: Option<crate::geometry::QuadSplit>,
+}
+
+impl WeightsId {
+    /// `method` as the viewer binds it.
+    pub const fn of(method: Method) -> Self {
+        Self {
+            method,
+            split_twin: None,
+        }
+    }
+
+    /// `method` with the quads split along `split`'s diagonal.
+    pub fn twin(method: Method, split: crate::geometry::QuadSplit) -> Self {
+        Self {
+            method,
+            split_twin: Some(split),
+        }
+    }
+}
+
+impl From<Method> for WeightsId {
+    fn from(method: Method) -> Self {
+        Self::of(method)
+    }
+}
+
+impl std::fmt::Display for WeightsId {
+    /// "PMVC", or "PMVC (shorter split)" for a twin.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.split_twin {
+            None => write!(f, "{}", self.method.name()),
+            Some(split) => write!(f, "{} ({} split)", self.method.name(), split.id()),
+        }
+    }
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -117,6 +161,15 @@ pub enum ColumnLayout {
     CageVerticesThenTriangles,
 }
 
+/// What a family does with a cage's quads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QuadSupport {
+    /// Quads are bilinear patches; on a cage with quads the family is called `name`.
+    Patches { name: &'static str },
+    /// Only triangles: quads are split along a diagonal, with a notice saying so.
+    Triangles,
+}
+
 /// Everything the product needs to know about a family to offer it.
 #[derive(Clone, Copy, Debug)]
 pub struct FamilySpec {
@@ -137,6 +190,9 @@ pub struct FamilySpec {
     /// bind can be computed and written in blocks of rows. False for a family
     /// that solves once for the whole cage (harmonic coordinates' grid).
     pub rows_independent: bool,
+    pub quads: QuadSupport,
+    /// Why a family of [`QuadSupport::Triangles`] cannot take quads, for its notice.
+    pub quads_reason: &'static str,
 }
 
 /// PMVC's default cube-map resolution (texels along one face edge).
@@ -149,12 +205,14 @@ const OUTSIDE_BY_MVC: &str = "vertices outside the cage get MVC weights (their a
 const MVC: FamilySpec = FamilySpec {
     id: "mvc",
     name: "MVC",
-    summary: "mean value coordinates, closed form; negative in non-convex cages",
+    summary: "mean value coordinates, closed form (QMVC on quads); negative in non-convex cages",
     parameter: None,
     columns: ColumnLayout::CageVertices,
     positive_inside: false,
     outside_policy: OUTSIDE_BY_MVC,
     rows_independent: true,
+    quads: QuadSupport::Patches { name: "QMVC" },
+    quads_reason: "",
 };
 
 /// PMVC's cube-map resolution. Past 1024 the six faces of one point's cube map
@@ -192,6 +250,8 @@ const PMVC: FamilySpec = FamilySpec {
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
     rows_independent: true,
+    quads: QuadSupport::Patches { name: "PMVC" },
+    quads_reason: "",
 };
 
 const HARMONIC: FamilySpec = FamilySpec {
@@ -203,6 +263,8 @@ const HARMONIC: FamilySpec = FamilySpec {
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
     rows_independent: false,
+    quads: QuadSupport::Patches { name: "HC" },
+    quads_reason: "",
 };
 
 const GREEN: FamilySpec = FamilySpec {
@@ -215,6 +277,8 @@ const GREEN: FamilySpec = FamilySpec {
     outside_policy: "vertices outside the cage get Green's exterior extension: the inside \
          coordinates continued through the nearest cage triangle, exact at rest and continuous across it",
     rows_independent: true,
+    quads: QuadSupport::Triangles,
+    quads_reason: "Green coordinates for quad cages are another method, Thiery and Boubekeur 2022, not yet offered",
 };
 
 impl Method {

@@ -29,11 +29,15 @@ pub mod npy;
 pub use crate::geometry::npy_header;
 pub mod npz;
 pub mod pmvc;
+pub mod qmvc;
 pub mod quality;
+pub mod split_effect;
 
+pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass};
 pub use family::{
-    FamilySpec, Method, Parameter, ParameterError, ParameterSpec, DEFAULT_RESOLUTION,
+    FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
+    DEFAULT_RESOLUTION,
 };
 use glam::DVec3;
 pub use quality::WeightQuality;
@@ -49,6 +53,10 @@ pub struct BindOptions {
     /// Grid cells along the cage's longest side for harmonic coordinates; ignored
     /// by the others.
     pub grid: u32,
+    /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
+    /// split into triangles along a diagonal first (`--triangulate`). Families that
+    /// only take triangles (Green) split along the shorter one when this is `None`.
+    pub quads: QuadSplit,
 }
 
 impl BindOptions {
@@ -95,7 +103,63 @@ impl BindOptions {
     pub fn same_weights_as(&self, other: &BindOptions) -> bool {
         let key =
             |options: &BindOptions| options.parameter().map(|(spec, value)| (spec.key, value));
-        self.method == other.method && key(self) == key(other)
+        self.method == other.method && key(self) == key(other) && self.quads == other.quads
+    }
+
+    /// The cage the family binds: `cage` itself, or a copy with its quads split
+    /// into triangles when `--triangulate` asks for it or the family takes only
+    /// triangles. Borrowed when nothing is split.
+    pub fn cage_to_bind<'a>(&self, cage: &'a Cage) -> std::borrow::Cow<'a, Cage> {
+        match self.split_applied(cage) {
+            None => std::borrow::Cow::Borrowed(cage),
+            Some(split) => std::borrow::Cow::Owned(cage.split_quads(split)),
+        }
+    }
+
+    /// How the cage's quads are split for this bind, if they are.
+    pub fn split_applied(&self, cage: &Cage) -> Option<QuadSplit> {
+        if !cage.has_quads() {
+            return None;
+        }
+        match (self.quads, self.method.spec().quads) {
+            (QuadSplit::None, QuadSupport::Patches { .. }) => None,
+            (QuadSplit::None, QuadSupport::Triangles) => Some(QuadSplit::Shorter),
+            (split, _) => Some(split),
+        }
+    }
+
+    /// The family's name for this cage: QMVC for MVC on bilinear quads, and
+    /// "(shorter split)" or "(longer split)" after a family whose quads were split.
+    pub fn family_name(&self, cage: &Cage) -> String {
+        let spec = self.method.spec();
+        match (self.split_applied(cage), spec.quads) {
+            (None, QuadSupport::Patches { name }) if cage.has_quads() => name.to_owned(),
+            (Some(split), QuadSupport::Patches { .. }) => {
+                format!("{} ({} split)", spec.name, split.id())
+            }
+            _ => spec.name.to_owned(),
+        }
+    }
+
+    /// What a user should know about the cage's quads in this bind, in one line:
+    /// that they were split, and how, for a family that cannot take patches.
+    pub fn quad_notice(&self, cage: &Cage) -> Option<String> {
+        let split = self.split_applied(cage)?;
+        let count = cage.quads().len();
+        let spec = self.method.spec();
+        Some(match spec.quads {
+            QuadSupport::Triangles => format!(
+                "notice: {} are bound on triangles: the cage's {count} quads were split along the {} diagonal ({})",
+                spec.name,
+                if split == QuadSplit::Longer { "longer" } else { "shorter" },
+                spec.quads_reason
+            ),
+            QuadSupport::Patches { .. } => format!(
+                "notice: the cage's {count} quads were split along the {} diagonal, as asked (--triangulate {})",
+                split.id(),
+                split.id()
+            ),
+        })
     }
 }
 
@@ -105,6 +169,7 @@ impl Default for BindOptions {
             method: Method::Pmvc,
             resolution: DEFAULT_RESOLUTION,
             grid: harmonic::DEFAULT_GRID,
+            quads: QuadSplit::None,
         }
     }
 }
@@ -280,6 +345,7 @@ pub fn bind_cpu(
     progress: &BindProgress,
 ) -> Result<Weights, BindFailure> {
     options.validate()?;
+    let cage = &*options.cage_to_bind(cage);
     if options.method == Method::Harmonic {
         let (weights, _stats) =
             harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
@@ -317,6 +383,7 @@ pub fn bind_rows(
     progress: &BindProgress,
 ) -> Result<(), Cancelled> {
     assert_eq!(points.len(), classes.len(), "one class per point");
+    let cage = &*options.cage_to_bind(cage);
     let cols = options.method.columns(cage);
     assert_eq!(
         out.len(),
@@ -401,6 +468,21 @@ pub fn weights_at(
             barycentric,
         } => {
             out.fill(0.0);
+            if let Some(quad) = cage.quad_of_triangle(triangle as usize) {
+                // On a patch: its bilinear basis, the limit of every family there.
+                let uv = crate::geometry::quads::patch_uv_from_triangle(
+                    cage,
+                    quad,
+                    triangle as usize,
+                    barycentric,
+                    x,
+                );
+                let basis = crate::geometry::quads::bilinear_basis(uv[0], uv[1]);
+                for (&corner, value) in cage.quads()[quad].corners.iter().zip(basis) {
+                    out[corner as usize] += value;
+                }
+                return;
+            }
             let corners = cage.triangles()[triangle as usize];
             for (k, &corner) in corners.iter().enumerate() {
                 out[corner as usize] += barycentric[k];

@@ -76,6 +76,23 @@ impl Cage {
         (0..self.triangles.len()).filter(|&t| self.quad_of_triangle[t] == NO_QUAD)
     }
 
+    /// The faces as polygons, in file order: each quad's four corners, and every
+    /// other triangle on its own (a polygon of more than four corners comes back
+    /// as its triangles). For writing the cage as the artist made it.
+    pub fn polygons(&self) -> Vec<Vec<u32>> {
+        let mut polygons = Vec::with_capacity(self.triangles.len());
+        for (t, triangle) in self.triangles.iter().enumerate() {
+            match self.quad_of_triangle(t) {
+                Some(k) if self.quads[k].triangles[0] as usize == t => {
+                    polygons.push(self.quads[k].corners.to_vec())
+                }
+                Some(_) => {}
+                None => polygons.push(triangle.to_vec()),
+            }
+        }
+        polygons
+    }
+
     /// Corner positions of quad `k`.
     #[inline]
     pub fn quad(&self, k: usize) -> [DVec3; 4] {

@@ -2,7 +2,9 @@
 //!
 //! Inside/outside is decided by the generalized winding number (the solid angle the
 //! cage subtends, over 4π), which stays correct for points near the surface and for
-//! cages with small defects, where ray-parity tests flip.
+//! cages with small defects, where ray-parity tests flip. A cage's bent quads are
+//! bilinear patches, not their triangles: points between the two are corrected by
+//! [`super::classify_patches`].
 
 use super::Cage;
 use glam::DVec3;
@@ -44,10 +46,17 @@ pub fn classify_points(cage: &Cage, points: &[DVec3]) -> PointClasses {
             ((b - a).cross(c - a).normalize_or_zero(), a)
         })
         .collect();
+    let bent = super::classify_patches::bent_quads(cage, tolerance);
+    let pillow = super::classify_patches::pillow_triangles();
     let classes: Vec<PointClass> = points
         .par_iter()
         .map_init(Vec::new, |corners, &x| {
-            classify_point(cage, &planes, x, tolerance, corners)
+            let class = classify_point(cage, &planes, x, tolerance, corners);
+            if bent.is_empty() {
+                class
+            } else {
+                super::classify_patches::correct_class(cage, &bent, &pillow, x, class, tolerance)
+            }
         })
         .collect();
     let outside = classes

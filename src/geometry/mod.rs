@@ -7,6 +7,7 @@ pub mod autocage;
 pub mod budget;
 mod cage;
 mod classify;
+mod classify_patches;
 mod error;
 pub mod gltf;
 mod intersect;
@@ -43,8 +44,8 @@ pub use output::{
 };
 pub use ply::{colour_byte, write_coloured_ply};
 pub use points_npy::write_points_npy;
-pub use quads::{CageQuad, QuadSplit};
 pub use polygons::{polygon_edges, polygons_of, triangulate_faces};
+pub use quads::{CageQuad, QuadSplit};
 pub use subdivide::{subdivide_midpoint, SubdivideError, Subdivided};
 
 use glam::DVec3;

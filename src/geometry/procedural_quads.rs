@@ -51,7 +51,10 @@ pub fn quad_comb(prongs: usize, width: f64, gap: f64, length: f64, depth: f64, b
     let at = |row: usize, column: usize| (row * columns.len() + column) as u32;
     let near = positions.len() as u32;
     let far = |i: u32| i + near;
-    let mut far_positions: Vec<DVec3> = positions.iter().map(|p| DVec3::new(p.x, p.y, depth)).collect();
+    let mut far_positions: Vec<DVec3> = positions
+        .iter()
+        .map(|p| DVec3::new(p.x, p.y, depth))
+        .collect();
     if let Some(last) = far_positions.last_mut() {
         last.z += bend;
     }
@@ -60,7 +63,14 @@ pub fn quad_comb(prongs: usize, width: f64, gap: f64, length: f64, depth: f64, b
     let mut caps: Vec<[u32; 4]> = (0..columns.len() - 1)
         .map(|k| [at(0, k), at(0, k + 1), at(1, k + 1), at(1, k)])
         .collect();
-    caps.extend((0..prongs).map(|p| [at(1, 2 * p), at(1, 2 * p + 1), at(2, 2 * p + 1), at(2, 2 * p)]));
+    caps.extend((0..prongs).map(|p| {
+        [
+            at(1, 2 * p),
+            at(1, 2 * p + 1),
+            at(2, 2 * p + 1),
+            at(2, 2 * p),
+        ]
+    }));
     let mut polygons: Vec<Vec<u32>> = Vec::new();
     for [a, b, c, d] in caps {
         polygons.push(vec![d, c, b, a]);
@@ -70,7 +80,12 @@ pub fn quad_comb(prongs: usize, width: f64, gap: f64, length: f64, depth: f64, b
     // prongs from the right.
     let mut outline: Vec<u32> = (0..columns.len()).map(|k| at(0, k)).collect();
     for p in (0..prongs).rev() {
-        outline.extend([at(1, 2 * p + 1), at(2, 2 * p + 1), at(2, 2 * p), at(1, 2 * p)]);
+        outline.extend([
+            at(1, 2 * p + 1),
+            at(2, 2 * p + 1),
+            at(2, 2 * p),
+            at(1, 2 * p),
+        ]);
     }
     outline.pop(); // at(1, 0) closes onto at(0, 0) below
     outline.push(at(1, 0));
@@ -98,7 +113,9 @@ mod tests {
         let cage = twisted_box(2.0, 0.6);
         assert_eq!(cage.quads().len(), 6);
         assert_eq!(cage.lone_triangles().count(), 0);
-        let bent = (0..6).filter(|&k| out_of_plane(&cage.quad(k)) > 1e-6).count();
+        let bent = (0..6)
+            .filter(|&k| out_of_plane(&cage.quad(k)) > 1e-6)
+            .count();
         assert_eq!(bent, 4);
         assert!(cage.signed_volume() > 0.0);
     }

@@ -23,7 +23,19 @@ pub struct CageQuad {
 /// How a cage's quads are split into triangles when a family is asked to bind
 /// them as triangles (`--triangulate`), to reproduce results from before quads
 /// were patches or to see how much the split matters.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum QuadSplit {
     /// Quads stay bilinear patches (no split).
@@ -210,7 +222,12 @@ pub fn patch_grid_triangles(n: usize) -> Vec<[u32; 3]> {
     let mut triangles = Vec::with_capacity(2 * n * n);
     for j in 0..n {
         for i in 0..n {
-            let [a, b, c, d] = [index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)];
+            let [a, b, c, d] = [
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            ];
             triangles.push([a, b, c]);
             triangles.push([a, c, d]);
         }
@@ -243,7 +260,8 @@ pub(crate) fn find_patch_crossing(
         return Some([crossing.first, crossing.second]);
     }
     let mut fine_positions = positions.to_vec();
-    let mut fine_triangles = Vec::with_capacity(triangles.len() + bent.len() * 2 * CHECK_STEPS.pow(2));
+    let mut fine_triangles =
+        Vec::with_capacity(triangles.len() + bent.len() * 2 * CHECK_STEPS.pow(2));
     let mut parent = Vec::with_capacity(fine_triangles.capacity());
     let mut replaced = vec![false; triangles.len()];
     for quad in &bent {
@@ -308,5 +326,55 @@ pub(crate) fn find_patch_crossing(
         }
     }
     let crossing = super::find_crossing(&fine_positions, &fine_triangles, diagonal)?;
-    Some([parent[crossing.first], parent[crossing.second]])
+    let (first, second) = (parent[crossing.first], parent[crossing.second]);
+    Some([first.min(second), first.max(second)])
+}
+
+/// The (u, v) on quad `quad` of `cage` nearest `x`, a point found on the
+/// quad's triangle `triangle` at `barycentric`: the triangle's (u, v) as a
+/// start, then Gauss–Newton steps on `|P(u, v) − x|²`, kept in the square.
+pub fn patch_uv_from_triangle(
+    cage: &super::Cage,
+    quad: usize,
+    triangle: usize,
+    barycentric: DVec3,
+    x: DVec3,
+) -> [f64; 2] {
+    const CORNER_UV: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let corners = cage.quads()[quad].corners;
+    let mut uv = [0.0, 0.0];
+    for (k, vertex) in cage.triangles()[triangle].iter().enumerate() {
+        let at = corners.iter().position(|c| c == vertex).unwrap_or(0);
+        uv[0] += barycentric[k] * CORNER_UV[at][0];
+        uv[1] += barycentric[k] * CORNER_UV[at][1];
+    }
+    nearest_uv(&cage.quad(quad), x, uv)
+}
+
+/// Gauss–Newton for the patch point nearest `x`, from `start`, in `[0, 1]²`.
+pub fn nearest_uv(q: &[DVec3; 4], x: DVec3, start: [f64; 2]) -> [f64; 2] {
+    let [mut u, mut v] = start;
+    for _ in 0..8 {
+        let residual = bilinear_point(q, u, v) - x;
+        let along_u = (1.0 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
+        let along_v = (1.0 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
+        let (a, b, c) = (
+            along_u.dot(along_u),
+            along_u.dot(along_v),
+            along_v.dot(along_v),
+        );
+        let (r_u, r_v) = (along_u.dot(residual), along_v.dot(residual));
+        let det = a * c - b * b;
+        if det.abs() <= f64::MIN_POSITIVE {
+            break;
+        }
+        let du = (c * r_u - b * r_v) / det;
+        let dv = (a * r_v - b * r_u) / det;
+        u = (u - du).clamp(0.0, 1.0);
+        v = (v - dv).clamp(0.0, 1.0);
+        if du.abs().max(dv.abs()) < 1e-15 {
+            break;
+        }
+    }
+    [u, v]
 }

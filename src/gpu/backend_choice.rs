@@ -87,6 +87,8 @@ pub struct Work {
     pub texels: usize,
     pub cage_triangles: usize,
     pub cage_vertices: usize,
+    /// Quads the family binds as bilinear patches (0 when they are split).
+    pub cage_quads: usize,
     pub cpu_threads: usize,
 }
 
@@ -105,7 +107,25 @@ impl Work {
             texels,
             cage_triangles: cage.triangles().len(),
             cage_vertices: cage.vertex_count(),
+            cage_quads: match options.split_applied(cage) {
+                None => cage.quads().len(),
+                Some(_) => 0,
+            },
             cpu_threads: rayon::current_num_threads(),
+        }
+    }
+
+    /// The GPU kernel for this work, if any ([`Kernel::for_cage`]).
+    pub fn kernel(&self) -> Option<Kernel> {
+        Kernel::of_work(self.method, self.cage_quads > 0)
+    }
+
+    /// Why this work has no GPU kernel, when it has none.
+    pub fn no_kernel_reason(&self) -> Option<&'static str> {
+        match (self.kernel(), Kernel::of(self.method)) {
+            (Some(_), _) => None,
+            (None, Some(_)) => Some("MVC on a cage with quads is QMVC, which has no GPU kernel"),
+            (None, None) => Some("this family has no GPU kernel"),
         }
     }
 }
@@ -277,7 +297,10 @@ impl Prediction {
     /// One line: both predictions and what they rest on.
     pub fn explain(&self) -> String {
         if self.gpu_s.is_none() {
-            return format!("{} has no GPU kernel", self.work.method.name());
+            return match self.work.no_kernel_reason() {
+                Some(reason) if Kernel::of(self.work.method).is_some() => reason.to_owned(),
+                _ => format!("{} has no GPU kernel", self.work.method.name()),
+            };
         }
         let seconds =
             |s: Option<f64>| s.map_or_else(|| "not modelled".into(), |s| format!("{s:.3} s"));
@@ -306,7 +329,8 @@ impl Prediction {
 
 /// The model: the CPU's and the GPU's time for `work` on a device in `gpu`'s state.
 pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
-    let costs = Kernel::of(work.method)
+    let costs = work
+        .kernel()
         .and_then(|kernel| COSTS.iter().find(|costs| costs.kernel == kernel));
     let Some(costs) = costs else {
         return Prediction {
@@ -348,27 +372,32 @@ pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
 pub struct Decision {
     pub backend: Backend,
     pub prediction: Option<Prediction>,
-    /// Why `auto` binds on the CPU when no prediction says so.
+    /// Why the bind runs on the CPU when no prediction says so.
     pub reason: Option<&'static str>,
+    /// The GPU kernel for the work decided on ([`Work::kernel`]); without one
+    /// the bind runs on the CPU whatever the backend.
+    pub kernel: Option<Kernel>,
 }
 
 impl Decision {
-    /// Whether GPU kernels compute the weights (a family without one binds on
-    /// the CPU on every backend).
+    /// Whether GPU kernels compute the weights (a family without one, or MVC on
+    /// a cage with quads, binds on the CPU on every backend).
     pub fn on_gpu(&self, method: Method) -> bool {
-        matches!(self.backend, Backend::Gpu(_)) && Kernel::of(method).is_some()
+        matches!(self.backend, Backend::Gpu(_))
+            && self.kernel.is_some()
+            && Kernel::of(method).is_some()
     }
 
     /// One line for the user: where and, for `auto`, why.
     pub fn explain(&self) -> String {
         let place = match &self.backend {
-            Backend::Gpu(context) => format!(
+            Backend::Gpu(context) if self.kernel.is_some() => format!(
                 "GPU {} (device opened in {:.3} s; pipeline cache: {})",
                 context.info.name,
                 context.opened_in().as_secs_f64(),
                 context.pipeline_cache().describe()
             ),
-            Backend::Cpu => "CPU".to_owned(),
+            _ => "CPU".to_owned(),
         };
         match (&self.prediction, self.reason) {
             (Some(prediction), _) => format!("binding on the {place}: {}", prediction.explain()),
@@ -408,6 +437,7 @@ pub fn decide_and_open(request: BackendRequest, work: &Work) -> Result<Decision,
                 backend: Backend::Cpu,
                 prediction: Some(best),
                 reason: None,
+                kernel: work.kernel(),
             });
         }
     }
@@ -423,13 +453,17 @@ pub fn decide(request: BackendRequest, device: Option<&Arc<GpuContext>>, work: &
             backend: Backend::Cpu,
             prediction: None,
             reason: (request == BackendRequest::Auto).then_some("no hardware GPU adapter"),
+            kernel: work.kernel(),
         };
     };
     if request == BackendRequest::Gpu {
+        // Kept on a kernel-less family too: the binder then runs on the CPU, and
+        // the line says why.
         return Decision {
             backend: Backend::Gpu(Arc::clone(context)),
             prediction: None,
-            reason: None,
+            reason: work.no_kernel_reason(),
+            kernel: work.kernel(),
         };
     }
     let prediction = predict(work, &GpuState::of(context));
@@ -441,6 +475,7 @@ pub fn decide(request: BackendRequest, device: Option<&Arc<GpuContext>>, work: &
         },
         prediction: Some(prediction),
         reason: None,
+        kernel: work.kernel(),
     }
 }
 

@@ -13,6 +13,7 @@ fn work(method: Method, points: usize, cage_vertices: usize, cpu_threads: usize)
         },
         cage_triangles: 2 * cage_vertices - 4,
         cage_vertices,
+        cage_quads: 0,
         cpu_threads,
     }
 }
@@ -145,4 +146,42 @@ fn auto_without_a_hardware_adapter_says_so() {
     );
     let asked_for_cpu = decide(BackendRequest::Cpu, None, &large);
     assert_eq!(asked_for_cpu.explain(), "binding on the CPU");
+}
+
+#[test]
+fn mvc_on_a_cage_with_quads_is_qmvc_and_binds_on_the_cpu_saying_why() {
+    let quads = Work {
+        cage_quads: 6,
+        ..work(Method::Mvc, 10_000_000, 8, 1)
+    };
+    assert_eq!(quads.kernel(), None);
+    let prediction = predict(&quads, &device(AdapterClass::Discrete, Pipelines::Ready));
+    assert!(!prediction.gpu_wins());
+    assert!(
+        prediction.explain().contains("QMVC"),
+        "{}",
+        prediction.explain()
+    );
+    let decision = decide(BackendRequest::Cpu, None, &quads);
+    assert!(!decision.on_gpu(Method::Mvc));
+    // PMVC and Green keep their kernels on the same cage.
+    for method in [Method::Pmvc, Method::Green] {
+        let other = Work { method, ..quads };
+        assert!(other.kernel().is_some(), "{method:?}");
+        assert_eq!(other.no_kernel_reason(), None);
+    }
+}
+
+#[test]
+fn work_counts_the_quads_a_family_binds_as_patches() {
+    let cage = crate::geometry::procedural_quads::twisted_box(2.0, 0.6);
+    let mvc = Work::of(BindOptions::for_method(Method::Mvc), 10, &cage);
+    assert_eq!((mvc.cage_quads, mvc.kernel()), (6, None));
+    let split = BindOptions {
+        quads: crate::geometry::QuadSplit::Shorter,
+        ..BindOptions::for_method(Method::Mvc)
+    };
+    assert_eq!(Work::of(split, 10, &cage).kernel(), Some(Kernel::Mvc));
+    let green = Work::of(BindOptions::for_method(Method::Green), 10, &cage);
+    assert_eq!((green.cage_quads, green.kernel()), (0, Some(Kernel::Green)));
 }

@@ -4,6 +4,7 @@ use super::GpuError;
 
 use super::shader_source::compose;
 use crate::coords::Method;
+use crate::geometry::Cage;
 
 /// The families that have a GPU kernel. The rest bind on the CPU whatever the
 /// backend, so a new family needs no change here until it gets a kernel.
@@ -21,6 +22,21 @@ impl Kernel {
             Method::Pmvc => Some(Kernel::Pmvc),
             Method::Green => Some(Kernel::Green),
             _ => None,
+        }
+    }
+
+    /// The kernel that binds `method` on `cage` (the cage the family binds, see
+    /// `BindOptions::cage_to_bind`). MVC on a cage with quads is QMVC, which has
+    /// none: those binds run on the CPU.
+    pub fn for_cage(method: Method, cage: &Cage) -> Option<Kernel> {
+        Self::of_work(method, cage.has_quads())
+    }
+
+    /// [`Kernel::for_cage`] from the method and whether the cage keeps patches.
+    pub fn of_work(method: Method, patches: bool) -> Option<Kernel> {
+        match Self::of(method) {
+            Some(Kernel::Mvc) if patches => None,
+            kernel => kernel,
         }
     }
 }
@@ -66,6 +82,8 @@ pub struct Params {
 pub(crate) struct Kernels {
     pub layout: wgpu::BindGroupLayout,
     pub pmvc: wgpu::ComputePipeline,
+    /// PMVC on a cage with quads: primitives of four corner slots, patches among them.
+    pub pmvc_quads: wgpu::ComputePipeline,
     pub mvc: wgpu::ComputePipeline,
     pub green: wgpu::ComputePipeline,
 }
@@ -119,23 +137,31 @@ impl Kernels {
             immediate_size: 0,
         });
         let [(_, pmvc_source), (_, mvc_source), (_, green_source)] = kernel_sources();
-        let pipeline = |label: &str, source: String| {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let module = |label: &str, source: String| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(label),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
+            })
+        };
+        // `constants`: the pipeline's override values (bind_pmvc's CORNERS).
+        let pipeline = |label: &str, module: &wgpu::ShaderModule, constants: &[(&str, f64)]| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(&pipeline_layout),
-                module: &module,
+                module,
                 entry_point: Some("main"),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
                 cache,
             })
         };
-        let pmvc = pipeline("bind_pmvc", pmvc_source);
-        let mvc = pipeline("bind_mvc", mvc_source);
-        let green = pipeline("bind_green", green_source);
+        let pmvc_module = module("bind_pmvc", pmvc_source);
+        let pmvc = pipeline("bind_pmvc", &pmvc_module, &[]);
+        let pmvc_quads = pipeline("bind_pmvc quads", &pmvc_module, &[("CORNERS", 4.0)]);
+        let mvc = pipeline("bind_mvc", &module("bind_mvc", mvc_source), &[]);
+        let green = pipeline("bind_green", &module("bind_green", green_source), &[]);
         if let Some(error) = pollster::block_on(memory.pop()) {
             return Err(error.into());
         }
@@ -145,6 +171,7 @@ impl Kernels {
         Ok(Self {
             layout,
             pmvc,
+            pmvc_quads,
             mvc,
             green,
         })

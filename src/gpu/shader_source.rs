@@ -17,7 +17,7 @@ enum Shared {
 }
 
 /// Every importable name and its text.
-const SHARED: [(&str, Shared); 6] = [
+const SHARED: [(&str, Shared); 7] = [
     (
         "frame",
         Shared::File(include_str!("../../shaders/shared/frame.wgsl")),
@@ -35,6 +35,10 @@ const SHARED: [(&str, Shared); 6] = [
         Shared::File(include_str!(
             "../../shaders/shared/closed_form_bindings.wgsl"
         )),
+    ),
+    (
+        "pmvc_patches",
+        Shared::File(include_str!("../../shaders/shared/pmvc_patches.wgsl")),
     ),
     ("cube_faces", Shared::Generated(cube_faces_wgsl)),
     ("bind_constants", Shared::Generated(bind_constants_wgsl)),

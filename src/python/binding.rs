@@ -9,7 +9,7 @@ use super::errors::{error, Kind};
 use super::scene::PyCage;
 use super::weights::PyWeights;
 use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
-use crate::coords::{BindOptions, BindProgress, Method, Parameter};
+use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
 use crate::geometry::classify_points;
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindError, BindInput, Binder};
@@ -124,6 +124,21 @@ fn choose_backend(
         .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))
 }
 
+/// `triangulate`: "shorter" or "longer" (None keeps quads as bilinear patches).
+fn quad_split_from(value: &Bound<'_, PyAny>) -> PyResult<QuadSplit> {
+    let bad = || {
+        error(
+            Kind::Parameter,
+            format!("triangulate must be None, \"shorter\" or \"longer\", not {value}"),
+        )
+    };
+    let id: String = value.extract().map_err(|_| bad())?;
+    match QuadSplit::from_id(&id) {
+        Some(split) if split != QuadSplit::None => Ok(split),
+        _ => Err(bad()),
+    }
+}
+
 /// The family named `id`, or an error listing the known ones.
 pub(super) fn method_from(id: &str) -> PyResult<Method> {
     Method::from_id(id).ok_or_else(|| {
@@ -165,8 +180,12 @@ fn bind_options(
     method: Method,
     resolution: Option<&Bound<'_, PyAny>>,
     grid: Option<&Bound<'_, PyAny>>,
+    triangulate: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<BindOptions> {
     let mut options = BindOptions::for_method(method);
+    if let Some(given) = triangulate.filter(|value| !value.is_none()) {
+        options.quads = quad_split_from(given)?;
+    }
     if let Some(spec) = method.spec().parameter {
         let given = match spec.key {
             Parameter::Resolution => resolution,
@@ -187,7 +206,10 @@ fn bind_options(
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
 /// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
-/// its family). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
+/// its family). A cage's quads are bilinear patches (MVC on them is QMVC);
+/// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
+/// first, as before quads were patches (Green coordinates always bind on
+/// triangles, split along the shorter diagonal unless told otherwise). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
 /// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
 /// a GPU kernel bind on the CPU.
 /// ``progress``, if given, is called with ``(done, total)`` rows, from
@@ -195,8 +217,8 @@ fn bind_options(
 /// Ctrl-C cancels within about a second.
 #[pyfunction]
 #[pyo3(
-    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None)"
+    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None, triangulate=None),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None)"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(
@@ -208,9 +230,15 @@ pub(super) fn bind<'py>(
     grid: Option<Bound<'py, PyAny>>,
     backend: &str,
     progress: Option<Bound<'py, PyAny>>,
+    triangulate: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyWeights> {
     let method = method_from(method)?;
-    let options = bind_options(method, resolution.as_ref(), grid.as_ref())?;
+    let options = bind_options(
+        method,
+        resolution.as_ref(),
+        grid.as_ref(),
+        triangulate.as_ref(),
+    )?;
     let points = positions(points, "points")?;
     bind_points(py, points, &cage, options, backend, progress.as_ref())
 }
@@ -347,10 +375,11 @@ pub(super) fn deform<'py>(
     if let Some(given) = parameters {
         for key in given.keys() {
             let key: String = key.extract()?;
-            if !["resolution", "grid", "backend", "progress"].contains(&key.as_str()) {
+            if !["resolution", "grid", "backend", "progress", "triangulate"].contains(&key.as_str())
+            {
                 return Err(error(
                     Kind::Parameter,
-                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress)"),
+                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress, triangulate)"),
                 ));
             }
             if weights.is_some() {
@@ -385,6 +414,7 @@ pub(super) fn deform<'py>(
                 method,
                 parameter("resolution")?.as_ref(),
                 parameter("grid")?.as_ref(),
+                parameter("triangulate")?.as_ref(),
             )?;
             let backend: String = match parameter("backend")? {
                 Some(value) => value.extract()?,

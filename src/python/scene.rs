@@ -20,9 +20,10 @@ use std::sync::Arc;
 /// triangles, not crossing itself (the checks of the command line).
 ///
 /// ``Cage(vertices, faces)`` takes an (m, 3) array-like of positions and a
-/// sequence of faces, each a sequence of 0-based vertex indices (polygons are
-/// cut into triangles as the files are: quads along their shorter diagonal,
-/// larger polygons fanned from their first corner). An inward-facing cage is
+/// sequence of faces, each a sequence of 0-based vertex indices. Quads stay
+/// bilinear patches (``quads``) for the families that take them, and are also
+/// cut along their shorter diagonal into ``triangles``; larger polygons are
+/// fanned from their first corner. An inward-facing cage is
 /// flipped (``flipped`` says so). ``Cage.load(path)`` reads an OBJ or OFF file.
 #[pyclass(name = "Cage", module = "pmvc", frozen)]
 pub(super) struct PyCage {
@@ -100,6 +101,19 @@ impl PyCage {
     #[getter]
     fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
         triangles_array(py, self.cage.triangles())
+    }
+
+    /// The quads, as bilinear patches, int64, shape (q, 4): corners q0..q3 of
+    /// P(u, v) = (1−u)(1−v)q0 + u(1−v)q1 + uv·q2 + (1−u)v·q3, outward.
+    #[getter]
+    fn quads<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let quads = self.cage.quads();
+        let flat: Vec<i64> = quads
+            .iter()
+            .flat_map(|q| q.corners)
+            .map(i64::from)
+            .collect();
+        super::arrays::matrix(py, flat, quads.len(), 4)
     }
 
     /// For each triangle, the face (0-based) it was cut from.

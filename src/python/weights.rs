@@ -138,7 +138,9 @@ impl PyWeights {
             .check_inputs(&self.shown(), points, &cage.cage)
             .map_err(|cause| metadata_error(&cause))?;
         let weights = self.checked_matrix(py)?;
-        let moves = self.method().column_displacements(&cage.cage, pose);
+        // Green's ψ columns follow the triangles the weights were bound on.
+        let bound = self.options.cage_to_bind(&cage.cage);
+        let moves = self.method().column_displacements(&bound, pose);
         Ok(py.detach(|| weights.apply_displacements(points, &moves)))
     }
 }

@@ -9,7 +9,7 @@ use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use super::weight_chunks::{
     ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
 };
-use crate::coords::Method;
+use crate::coords::{Method, WeightsId};
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
 use glam::DVec3;
@@ -211,6 +211,9 @@ pub struct SceneGpu {
     /// The same for the uniform copy of the displacements.
     pub uniform_placeholder: wgpu::Buffer,
     pub slots: BTreeMap<Method, WeightSlot>,
+    /// Each family's triangulated twin, where one is bound (the difference view's
+    /// quads-split comparison).
+    pub twin_slots: BTreeMap<Method, WeightSlot>,
     /// The rest cage and the current pose, in f64: displacements are taken in f64
     /// and only then rounded.
     pub rest_cage: Cage,
@@ -218,7 +221,7 @@ pub struct SceneGpu {
     /// How weights are split on this device.
     pub chunk_limits: ChunkLimits,
     /// Per (family shown, family compared): its bind group, made on first use.
-    bind_groups: HashMap<(Method, Option<Method>), wgpu::BindGroup>,
+    bind_groups: HashMap<(Method, Option<WeightsId>), wgpu::BindGroup>,
 }
 
 impl SceneGpu {
@@ -274,6 +277,7 @@ impl SceneGpu {
             placeholder: buffer_with(device, "no weights", &[0f32; 4], storage),
             uniform_placeholder: uniform_displacements_buffer(device, &[]),
             slots: BTreeMap::new(),
+            twin_slots: BTreeMap::new(),
             rest_cage: rest_cage.clone(),
             pose,
             chunk_limits,
@@ -300,14 +304,28 @@ impl SceneGpu {
         )
     }
 
-    /// Install or remove `method`'s weights; bind groups that used the old ones go.
-    pub fn set_slot(&mut self, method: Method, slot: Option<WeightSlot>) {
-        match slot {
-            Some(slot) => self.slots.insert(method, slot),
-            None => self.slots.remove(&method),
+    /// The slot of weights `id`, if bound.
+    pub fn slot(&self, id: WeightsId) -> Option<&WeightSlot> {
+        match id.split_twin {
+            None => self.slots.get(&id.method),
+            Some(_) => self.twin_slots.get(&id.method),
+        }
+    }
+
+    /// Install or remove the weights `id`; bind groups that used the old ones go.
+    pub fn set_slot(&mut self, id: WeightsId, slot: Option<WeightSlot>) {
+        let slots = match id.split_twin {
+            None => &mut self.slots,
+            Some(_) => &mut self.twin_slots,
         };
-        self.bind_groups
-            .retain(|(shown, against), _| *shown != method && *against != Some(method));
+        match slot {
+            Some(slot) => slots.insert(id.method, slot),
+            None => slots.remove(&id.method),
+        };
+        let primary = id.split_twin.is_none();
+        self.bind_groups.retain(|(shown, against), _| {
+            !(primary && *shown == id.method) && against.is_none_or(|a| a.method != id.method)
+        });
     }
 
     /// The bind group showing `shown` (and `against` for the difference view).
@@ -317,7 +335,7 @@ impl SceneGpu {
         layout: &wgpu::BindGroupLayout,
         frame: &wgpu::Buffer,
         shown: Method,
-        against: Option<Method>,
+        against: Option<WeightsId>,
     ) -> &wgpu::BindGroup {
         if !self.bind_groups.contains_key(&(shown, against)) {
             let group = self.make_bind_group(device, layout, frame, shown, against);
@@ -332,9 +350,10 @@ impl SceneGpu {
         layout: &wgpu::BindGroupLayout,
         frame: &wgpu::Buffer,
         shown: Method,
-        against: Option<Method>,
+        against: Option<WeightsId>,
     ) -> wgpu::BindGroup {
-        let slot = |method: Option<Method>| method.and_then(|m| self.slots.get(&m));
+        let slot = |id: Option<WeightsId>| id.and_then(|id| self.slot(id));
+        let shown = WeightsId::of(shown);
         let moves = |method| slot(method).map_or(&self.placeholder, |s| &s.displacements);
         let uniform_moves =
             |method| slot(method).map_or(&self.uniform_placeholder, |s| &s.uniform_displacements);
@@ -346,12 +365,10 @@ impl SceneGpu {
             moves(against),
         ];
         // The pool: the shown family's chunks, then the compared family's.
-        let chunks = [shown].into_iter().chain(against).flat_map(|method| {
-            self.slots
-                .get(&method)
-                .into_iter()
-                .flat_map(|slot| &slot.chunks)
-        });
+        let chunks = [shown]
+            .into_iter()
+            .chain(against)
+            .flat_map(|id| self.slot(id).into_iter().flat_map(|slot| &slot.chunks));
         let pool = chunks
             .chain(std::iter::repeat(&self.placeholder))
             .take(self.chunk_limits.slots as usize);

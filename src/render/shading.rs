@@ -3,7 +3,7 @@
 //! ([`super::viewport`]) turns into the frame uniform.
 
 use super::colormap::Scale;
-use crate::coords::Method;
+use crate::coords::{Method, WeightsId};
 use glam::{Mat4, Vec3};
 
 /// What the mesh is coloured by.
@@ -45,8 +45,9 @@ impl Colouring {
 pub struct Shading {
     /// The weights the mesh is deformed (and coloured) with.
     pub method: Method,
-    /// The family compared with in the difference view ([`Colouring::MethodDistance`]).
-    pub against: Option<Method>,
+    /// The weights compared with in the difference view ([`Colouring::MethodDistance`]):
+    /// another family, or the shown family's triangulated twin.
+    pub against: Option<WeightsId>,
     pub colouring: Colouring,
     pub scale: Scale,
     /// Magnitude at which the colour map saturates.

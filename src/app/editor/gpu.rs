@@ -5,7 +5,7 @@
 //! coordinates (the GPU works relative to the scene origin), for tests and checks.
 
 use super::EditorApp;
-use crate::coords::Method;
+use crate::coords::{Method, WeightsId};
 use crate::render::{ReadBack, RenderError, SceneOrigin, SceneUpload, Shading, ViewportRenderer};
 use glam::{DVec3, Vec3};
 use std::collections::BTreeSet;
@@ -53,7 +53,7 @@ impl EditorApp {
 
     /// Upload the weights of `methods` and the outside flags beside them; a
     /// bind's copy already on the device is used where there is one.
-    fn upload_weights(&mut self, methods: &BTreeSet<Method>) {
+    fn upload_weights(&mut self, methods: &BTreeSet<WeightsId>) {
         let resident = self
             .gpu
             .as_mut()
@@ -63,7 +63,11 @@ impl EditorApp {
         let outside = document.outside();
         let sets: Vec<_> = methods
             .iter()
-            .filter_map(|&m| document.bound(m).map(|set| (m, Arc::clone(&set.weights))))
+            .filter_map(|&id| {
+                document
+                    .bound_id(id)
+                    .map(|set| (id, Arc::clone(&set.weights)))
+            })
             .collect();
         let uploaded = self.with_renderer(|renderer, device, queue| {
             renderer.set_outside(queue, rest, outside);

@@ -6,7 +6,6 @@
 use super::{EditorApp, FileRole, Waiting};
 use crate::app::actions::{Action, BlendStep, CageRequest};
 use crate::app::bind_queue::{Finished, JobError};
-use crate::app::compare::Pane;
 use crate::app::document::WeightSet;
 use crate::app::files;
 use crate::app::model::{Command, GestureKind, Outcome, Selection};
@@ -134,6 +133,11 @@ impl EditorApp {
                     Err(error) => self.error(error),
                 }
             }
+            Action::SetQuadSplit(split) => {
+                if self.binding.set_quad_split(split) {
+                    self.request_wanted_binds();
+                }
+            }
             Action::StartBind => self.bind_wanted(),
             Action::CancelBind => self.binding.cancel(self.model.document()),
             Action::SetHighlightOutside(on) => self.views.highlight_outside = on,
@@ -198,13 +202,13 @@ impl EditorApp {
     /// follow the largest distance again.
     fn fix_difference_scale(&mut self, fixed: bool) {
         self.views.settings.difference_limit = if fixed {
-            let [against, shown] = self.views.settings.difference;
+            let pane = self.views.settings.difference_pane_kind();
             let wanted = self.wanted_methods_now();
             Some(self.views.colour_limit(
                 self.model.document(),
                 &wanted,
                 Colouring::MethodDistance,
-                Pane::Difference { against, shown },
+                pane,
             ))
         } else {
             None
@@ -259,10 +263,18 @@ impl EditorApp {
                 "pmvc editor: bound {} vertices × {} columns ({}, {}) in {:.2} s",
                 outcome.weights.rows,
                 outcome.weights.cols,
-                method.name(),
+                options.family_name(self.model.document().cage()),
                 outcome.device,
                 outcome.elapsed.as_secs_f64()
             );
+        }
+        if let Some(notice) = options.quad_notice(self.model.document().cage()) {
+            if !matches!(
+                options.method.spec().quads,
+                crate::coords::QuadSupport::Patches { .. }
+            ) {
+                self.info(notice.trim_start_matches("notice: ").to_owned());
+            }
         }
         let weights = Arc::clone(&outcome.weights);
         let set = WeightSet {
@@ -272,8 +284,14 @@ impl EditorApp {
             device: outcome.device,
             quality: outcome.quality,
         };
+        // A bind with other quads than the setting's is a triangulated twin.
+        let id = if options.quads == self.binding.options_for(method).quads {
+            crate::coords::WeightsId::of(method)
+        } else {
+            crate::coords::WeightsId::twin(method, options.quads)
+        };
         let installed = self.apply(Command::InstallWeights {
-            method,
+            id,
             set,
             outside: outcome.outside,
         });

@@ -8,7 +8,7 @@
 //! pose or the weights without the GPU copy and the caches learning about it.
 
 use crate::app::scenes::BundledScene;
-use crate::coords::{BindOptions, Method, WeightQuality, Weights};
+use crate::coords::{BindOptions, Method, WeightQuality, Weights, WeightsId};
 use crate::geometry::{Cage, MeshFile, TriMesh};
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
@@ -35,7 +35,7 @@ pub struct Changes {
     pub pose: bool,
     pub selection: bool,
     /// Methods whose weights arrived.
-    pub weights: BTreeSet<Method>,
+    pub weights: BTreeSet<WeightsId>,
 }
 
 /// A pose kept under a name, to come back to or to blend towards.
@@ -61,6 +61,9 @@ pub struct Document {
     pose: Vec<DVec3>,
     selection: BTreeSet<usize>,
     weight_sets: BTreeMap<Method, WeightSet>,
+    /// Each family's triangulated twin, for the difference view that shows what
+    /// splitting the quads does; its options say along which diagonal.
+    twin_sets: BTreeMap<Method, WeightSet>,
     /// Mesh vertices outside the cage, ascending; known once classified.
     outside: Arc<[u32]>,
     changes: Changes,
@@ -85,6 +88,7 @@ impl Document {
             cage_path: None,
             selection: BTreeSet::new(),
             weight_sets: BTreeMap::new(),
+            twin_sets: BTreeMap::new(),
             outside: Arc::from([]),
             changes: Changes {
                 scene: true,
@@ -192,6 +196,16 @@ impl Document {
         self.weight_sets.get(&method)
     }
 
+    /// The weights `id`: a family's, or its twin's when bound along that split.
+    pub fn bound_id(&self, id: WeightsId) -> Option<&WeightSet> {
+        match id.split_twin {
+            None => self.weight_sets.get(&id.method),
+            Some(split) => {
+                (self.twin_sets.get(&id.method)).filter(|set| set.options.quads == split)
+            }
+        }
+    }
+
     /// `method`'s weights, once bound.
     pub fn weights(&self, method: Method) -> Option<&Arc<Weights>> {
         self.bound(method).map(|set| &set.weights)
@@ -245,7 +259,13 @@ impl Document {
             scene: true,
             pose: true,
             selection: true,
-            weights: self.weight_sets.keys().copied().collect(),
+            weights: (self.weight_sets.keys().map(|&m| WeightsId::of(m)))
+                .chain(
+                    self.twin_sets
+                        .iter()
+                        .map(|(&m, set)| WeightsId::twin(m, set.options.quads)),
+                )
+                .collect(),
         };
     }
 
@@ -366,16 +386,20 @@ impl Document {
     /// (a bind for a scene that has since been replaced does not).
     pub(in crate::app::model) fn install_weights(
         &mut self,
-        method: Method,
+        id: WeightsId,
         set: WeightSet,
         outside: Arc<[u32]>,
     ) -> bool {
         let fits = set.weights.rows == self.mesh.positions.len()
-            && set.weights.cols == method.columns(&self.cage);
+            && set.weights.cols == id.method.columns(&self.cage)
+            && id.split_twin.is_none_or(|split| split == set.options.quads);
         if fits {
-            self.weight_sets.insert(method, set);
+            match id.split_twin {
+                None => self.weight_sets.insert(id.method, set),
+                Some(_) => self.twin_sets.insert(id.method, set),
+            };
             self.outside = outside;
-            self.changes.weights.insert(method);
+            self.changes.weights.insert(id);
         }
         fits
     }
@@ -406,10 +430,11 @@ mod tests {
             device: "CPU".into(),
             quality: WeightQuality::default(),
         };
-        assert!(!document.install_weights(Method::Pmvc, set(2, 8), Arc::from([])));
+        let pmvc = WeightsId::of(Method::Pmvc);
+        assert!(!document.install_weights(pmvc, set(2, 8), Arc::from([])));
         assert!(document.bound(Method::Pmvc).is_none());
-        assert!(document.install_weights(Method::Pmvc, set(1, 8), Arc::from([])));
-        assert!(document.take_changes().weights.contains(&Method::Pmvc));
+        assert!(document.install_weights(pmvc, set(1, 8), Arc::from([])));
+        assert!(document.take_changes().weights.contains(&pmvc));
     }
 
     #[test]

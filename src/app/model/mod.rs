@@ -10,7 +10,7 @@ mod undo_log;
 
 use super::compare::ViewSettings;
 use super::viewport::ViewCameras;
-use crate::coords::{BindOptions, Method};
+use crate::coords::BindOptions;
 use document::{Changes, Document, WeightSet};
 use glam::DVec3;
 use save_point::SessionMark;
@@ -97,7 +97,7 @@ pub enum Command {
     },
     /// A bind's weights, if they fit the document's mesh and cage.
     InstallWeights {
-        method: Method,
+        id: crate::coords::WeightsId,
         set: WeightSet,
         outside: Arc<[u32]>,
     },
@@ -285,15 +285,13 @@ impl Model {
             }
             Command::RenameNamedPose { index, name } => Applied::of(self.rename(index, &name)),
             Command::SetPoseTime { index, time } => Applied::of(self.set_pose_time(index, time)),
-            Command::InstallWeights {
-                method,
-                set,
-                outside,
-            } => Applied::of(if self.document.install_weights(method, set, outside) {
-                Outcome::Changed
-            } else {
-                Outcome::Unchanged
-            }),
+            Command::InstallWeights { id, set, outside } => {
+                Applied::of(if self.document.install_weights(id, set, outside) {
+                    Outcome::Changed
+                } else {
+                    Outcome::Unchanged
+                })
+            }
             Command::ReplaceDocument {
                 document,
                 action,

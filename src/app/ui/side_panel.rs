@@ -10,7 +10,7 @@ use crate::app::ui::pose_panel::PosePanel;
 use crate::app::ui::quality_table::quality_table;
 use crate::app::ui::statistics::StatisticsPanel;
 use crate::app::ui::timeline::TimelinePanel;
-use crate::coords::Method;
+use crate::coords::{Method, QuadSplit};
 use std::time::Duration;
 
 /// The panels the side panel shows below its own sections.
@@ -71,6 +71,7 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
             cx.send(Action::SetParameter(spec.key, value));
         }
     }
+    quads_choice(ui, cx);
     if ui
             .button("Subdivide cage")
             .on_hover_text(
@@ -103,7 +104,7 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
             } else {
                 "Binding"
             },
-            status.options.method.name(),
+            status.options.family_name(cx.document().cage()),
         ));
         if ui.button("Cancel").clicked() {
             cx.send(Action::CancelBind);
@@ -126,6 +127,40 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
         if outside > 0 && ui.checkbox(&mut highlight, "Highlight them").changed() {
             cx.send(Action::SetHighlightOutside(highlight));
         }
+    }
+}
+
+/// On a cage with quads: bind them as bilinear patches, or split along a
+/// diagonal as before, to reproduce earlier results or see what the split does.
+fn quads_choice(ui: &mut egui::Ui, cx: &mut PanelContext) {
+    let cage = cx.document().cage();
+    if !cage.has_quads() {
+        return;
+    }
+    let quads = cage.quads().len();
+    let current = cx.shown().bind_options.quads;
+    let mut chosen = current;
+    egui::ComboBox::from_label("Quads")
+        .selected_text(quad_split_label(current))
+        .show_ui(ui, |ui| {
+            for split in QuadSplit::ALL {
+                ui.selectable_value(&mut chosen, split, quad_split_label(split));
+            }
+        })
+        .response
+        .on_hover_text(format!(
+            "The cage has {quads} quads. As bilinear patches the weights do not depend on how a quad is indexed or split (MVC on them is QMVC); split, they depend on the diagonal. Green coordinates always use the shorter diagonal's triangles."
+        ));
+    if chosen != current {
+        cx.send(Action::SetQuadSplit(chosen));
+    }
+}
+
+fn quad_split_label(split: QuadSplit) -> &'static str {
+    match split {
+        QuadSplit::None => "bilinear patches",
+        QuadSplit::Shorter => "split: shorter diagonal",
+        QuadSplit::Longer => "split: longer diagonal",
     }
 }
 

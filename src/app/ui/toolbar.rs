@@ -5,7 +5,7 @@
 use crate::app::actions::Action;
 use crate::app::compare::{Layout, Overlay, ViewSettings, DIFFERENCE_LIMITS};
 use crate::app::ctx::PanelContext;
-use crate::coords::Method;
+use crate::coords::{Method, QuadSplit, QuadSupport};
 use crate::render::colormap::Scale;
 
 /// What the first run shows, in one line.
@@ -46,7 +46,11 @@ pub fn toolbar(ui: &mut egui::Ui, cx: &mut PanelContext) {
         ui.selectable_value(layout, Layout::Difference, "Difference");
         match view.layout {
             Layout::SideBySide => comparison_controls(ui, &mut view, &mut later),
-            Layout::Difference => difference_controls(ui, &mut view, &mut later),
+            Layout::Difference => {
+                let quads =
+                    (cx.document().cage().has_quads()).then_some(cx.shown().bind_options.quads);
+                difference_controls(ui, &mut view, &mut later, quads)
+            }
             Layout::Single => {}
         }
         ui.separator();
@@ -131,19 +135,64 @@ fn comparison_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut V
     }
 }
 
-/// Which two methods the difference compares: "[MVC] vs [PMVC] shown".
-fn difference_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut Vec<Action>) {
-    for (index, label) in ["vs", "shown"].into_iter().enumerate() {
-        let mut chosen = view.difference[index];
-        egui::ComboBox::from_label(label)
-            .selected_text(chosen.name())
-            .show_ui(ui, |ui| {
-                for family in Method::ALL {
-                    ui.selectable_value(&mut chosen, family, family.name());
-                }
-            });
-        view.difference[index] = chosen;
+/// Which two methods the difference compares: "[MVC] vs [PMVC] shown", or on a
+/// cage with quads a family against its triangulated twin: "[split: shorter] vs
+/// [PMVC] shown".
+fn difference_controls(
+    ui: &mut egui::Ui,
+    view: &mut ViewSettings,
+    later: &mut Vec<Action>,
+    quads: Option<QuadSplit>,
+) {
+    let shown = view.difference[1];
+    // The twins on offer: the shown family with its quads split another way
+    // than the setting binds them (`quads`), for a family that takes patches.
+    let twins: Vec<QuadSplit> = match quads {
+        Some(setting) if matches!(shown.spec().quads, QuadSupport::Patches { .. }) => {
+            [QuadSplit::Shorter, QuadSplit::Longer]
+                .into_iter()
+                .filter(|&split| split != setting)
+                .collect()
+        }
+        _ => Vec::new(),
+    };
+    if view
+        .difference_split
+        .is_some_and(|split| !twins.contains(&split))
+    {
+        view.difference_split = None;
     }
+    let twin_label = |split: QuadSplit| format!("itself, split: {} diagonal", split.id());
+    let mut against = (view.difference[0], view.difference_split);
+    let selected = match against.1 {
+        Some(split) => twin_label(split),
+        None => against.0.name().to_owned(),
+    };
+    egui::ComboBox::from_label("vs")
+        .selected_text(selected)
+        .show_ui(ui, |ui| {
+            for family in Method::ALL {
+                ui.selectable_value(&mut against, (family, None), family.name());
+            }
+            let family = against.0;
+            for &split in &twins {
+                ui.selectable_value(&mut against, (family, Some(split)), twin_label(split))
+                    .on_hover_text(
+                        "The shown family bound with the cage's quads split along this diagonal: \
+                         how far the invisible split moves the mesh",
+                    );
+            }
+        });
+    (view.difference[0], view.difference_split) = against;
+    let mut chosen = shown;
+    egui::ComboBox::from_label("shown")
+        .selected_text(chosen.name())
+        .show_ui(ui, |ui| {
+            for family in Method::ALL {
+                ui.selectable_value(&mut chosen, family, family.name());
+            }
+        });
+    view.difference[1] = chosen;
     difference_scale_controls(ui, view, later);
 }
 

@@ -459,7 +459,8 @@ impl Views {
                     } else {
                         format!(" · bound in {:.2} s", set.bind_time.as_secs_f32())
                     };
-                    format!("{}{parameter}{seconds}", method.name())
+                    let name = set.options.family_name(cx.model.document().cage());
+                    format!("{name}{parameter}{seconds}")
                 }
                 None => format!("{} · not bound", method.name()),
             },

@@ -4,27 +4,31 @@
 //! The stencil is the symmetric cut-cell discretisation of Gibou, Fedkiw, Cheng and
 //! Kang (2002): along each axis an arm to an inside neighbour has coefficient 1/h²;
 //! an arm that the cage cuts at θh (0 < θ ≤ 1) ends at the crossing, where the value
-//! is known (the hat functions of the crossed triangle), with coefficient 1/(θh²).
+//! is known (the boundary data of the crossed face), with coefficient 1/(θh²).
 //! The matrix is symmetric and an M-matrix (so the discrete maximum principle holds:
 //! weights are non-negative and sum to one), and a linear function is reproduced
 //! exactly at every node: its two arms' terms cancel whatever θ is.
+//!
+//! The cage's surface is that of [`super::patches`]: on a cage with quads, its
+//! lone triangles and its quads as bilinear patches, whose crossings decide
+//! which nodes are inside as well as where arms are cut.
 
-use crate::geometry::{closest_offset_on_triangle, Cage};
-use glam::DVec3;
+use super::patches::{closest_boundary_value, patch_line_crossings, BoundaryValue};
+use crate::geometry::Cage;
+use glam::{DVec2, DVec3};
 
 /// No unknown here: the node is outside the cage, or the arm is cut.
 pub(super) const NONE: u32 = u32::MAX;
 /// Arms shorter than this share of a cell are lengthened to it, bounding the
 /// diagonal; the boundary then moves by at most this share of a cell.
-const THETA_MIN: f64 = 1e-3;
+pub(super) const THETA_MIN: f64 = 1e-3;
 
 /// Where a grid line crosses the cage: `s` along the line in cells from its first
-/// node, and the hat values there (the barycentrics of the crossed triangle).
+/// node, and the boundary data there.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Crossing {
     pub s: f64,
-    pub triangle: u32,
-    pub barycentric: [f64; 3],
+    pub value: BoundaryValue,
 }
 
 /// A cut arm: the unknown it belongs to, its coefficient `1/θ`, and the values at
@@ -33,8 +37,8 @@ pub(super) struct Crossing {
 pub(super) struct CutArm {
     pub unknown: u32,
     pub coefficient: f32,
-    pub corners: [u32; 3],
-    pub barycentric: [f32; 3],
+    pub corners: [u32; 4],
+    pub values: [f32; 4],
 }
 
 /// The grid's placement, shared by all levels (a level doubles `h`).
@@ -96,23 +100,18 @@ fn line_crossings(cage: &Cage, frame: &Frame, axis: usize) -> Vec<Vec<Crossing>>
     let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
     let (nb, nc) = (frame.dims[b], frame.dims[c]);
     let mut lines = vec![Vec::new(); nb * nc];
-    for (t, corners) in cage.triangles().iter().enumerate() {
-        let q = corners.map(|k| (cage.positions()[k as usize] - frame.origin) / frame.h);
-        let lo = |axis: usize| q.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
-        let hi = |axis: usize| q.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
-        let range = |axis: usize, n: usize| {
-            let first = lo(axis).ceil().max(0.0) as usize;
-            let last = (hi(axis).floor().max(-1.0) + 1.0).min(n as f64) as usize;
-            first..last.max(first)
-        };
+    let to_grid = |k: u32| (cage.positions()[k as usize] - frame.origin) / frame.h;
+    for t in cage.lone_triangles() {
+        let corners = cage.triangles()[t];
+        let q = corners.map(to_grid);
         // Twice the projected signed area; zero for a triangle along the axis.
         let area =
             (q[1][b] - q[0][b]) * (q[2][c] - q[0][c]) - (q[2][b] - q[0][b]) * (q[1][c] - q[0][c]);
         if area == 0.0 {
             continue;
         }
-        for jc in range(c, nc) {
-            for jb in range(b, nb) {
+        for jc in line_range(&q, c, nc) {
+            for jb in line_range(&q, b, nb) {
                 let (u, v) = (jb as f64, jc as f64);
                 // Barycentrics of (u, v) in the projected triangle.
                 let edge = |i: usize, k: usize| {
@@ -125,9 +124,22 @@ fn line_crossings(cage: &Cage, frame: &Frame, axis: usize) -> Vec<Vec<Crossing>>
                 let s = weights[0] * q[0][axis] + weights[1] * q[1][axis] + weights[2] * q[2][axis];
                 lines[jb + nb * jc].push(Crossing {
                     s,
-                    triangle: t as u32,
-                    barycentric: weights,
+                    value: BoundaryValue::triangle(corners, weights),
                 });
+            }
+        }
+    }
+    for quad in cage.quads() {
+        let q = quad.corners.map(to_grid);
+        for jc in line_range(&q, c, nc) {
+            for jb in line_range(&q, b, nb) {
+                let point = DVec2::new(jb as f64, jc as f64);
+                for [s, u, v] in patch_line_crossings(&q, axis, point).into_iter().flatten() {
+                    lines[jb + nb * jc].push(Crossing {
+                        s,
+                        value: BoundaryValue::quad(quad.corners, u, v),
+                    });
+                }
             }
         }
     }
@@ -135,6 +147,16 @@ fn line_crossings(cage: &Cage, frame: &Frame, axis: usize) -> Vec<Vec<Crossing>>
         line.sort_by(|a, b| a.s.total_cmp(&b.s));
     }
     lines
+}
+
+/// Grid lines (indices along `axis`, of `n`) within the span of the points `q`:
+/// a triangle or a patch lies in its corners' box.
+fn line_range(q: &[DVec3], axis: usize, n: usize) -> std::ops::Range<usize> {
+    let lo = q.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+    let hi = q.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+    let first = lo.ceil().max(0.0) as usize;
+    let last = (hi.floor().max(-1.0) + 1.0).min(n as f64) as usize;
+    first..last.max(first)
 }
 
 /// The line along `axis` through node `[x, y, z]`, and the node's place on it.
@@ -210,8 +232,8 @@ impl Level {
                             cut_arms.push(CutArm {
                                 unknown: unknown as u32,
                                 coefficient,
-                                corners: cage.triangles()[crossing.triangle as usize],
-                                barycentric: crossing.barycentric.map(|w| w as f32),
+                                corners: crossing.value.corners,
+                                values: crossing.value.values.map(|w| w as f32),
                             });
                         }
                     }
@@ -252,25 +274,8 @@ fn nearest_crossing(
             ..*nearest
         };
     }
-    let (triangle, barycentric) = closest_hat_values(cage, frame.position(node));
     Crossing {
         s: at + 1.0,
-        triangle,
-        barycentric,
+        value: closest_boundary_value(cage, frame.position(node)),
     }
-}
-
-/// The triangle nearest to `x` and the barycentrics of the nearest point on it: the
-/// hat functions' values there.
-pub(super) fn closest_hat_values(cage: &Cage, x: DVec3) -> (u32, [f64; 3]) {
-    let mut best = (f64::INFINITY, 0, [1.0, 0.0, 0.0]);
-    for t in 0..cage.triangle_count() {
-        let [a, b, c] = cage.triangle(t);
-        let (offset, barycentric) = closest_offset_on_triangle(x, a, b, c);
-        let distance = offset.length_squared();
-        if distance < best.0 {
-            best = (distance, t as u32, barycentric.to_array());
-        }
-    }
-    (best.1, best.2)
 }

@@ -1,7 +1,8 @@
 //! Harmonic coordinates (Joshi, Meyer, DeRose, Green, Sanocki 2007), the paper's
 //! third method. For every cage vertex i, hᵢ is harmonic inside the cage and equals
-//! on the cage the piecewise-linear hat function of vertex i; the weights are the
-//! hᵢ at the mesh vertices.
+//! on the cage the piecewise-linear hat function of vertex i on triangles and its
+//! bilinear basis function on quads, which are bilinear patches (see [`patches`]);
+//! the weights are the hᵢ at the mesh vertices.
 //!
 //! Discretisation ([`grid`]): a regular grid over the cage's bounding box with
 //! `grid` cells along its longest side, and the symmetric cut-cell stencil at the
@@ -10,13 +11,14 @@
 //! Solver ([`solve`]): conjugate gradients preconditioned by a multigrid V-cycle,
 //! for blocks of cage vertices at once, in f32 with f64 dot products. Mesh
 //! vertices take the trilinear interpolation of their cell's corners; a corner
-//! outside the cage takes the hat values at its closest point on the cage, so
+//! outside the cage takes the boundary data at its closest point on the cage, so
 //! every inside vertex gets non-negative weights summing to one.
 //!
 //! Vertices on the cage get the barycentrics of their triangle and vertices outside
 //! get MVC, as for the other families (see [`super`]).
 
 mod grid;
+mod patches;
 mod sample;
 mod solve;
 
@@ -195,18 +197,7 @@ pub fn bind_harmonic(
 ) -> Result<(Weights, SolveStats), HarmonicError> {
     let plan = plan(cage, grid, points.len())?;
     check_memory(cage, &plan, points.len())?;
-    let (frame, level_count) = frame_for(cage, grid)?;
-    let mut levels = vec![Level::new(cage, frame, true)];
-    for _ in 1..level_count {
-        let coarser = levels.last().map(|level| level.frame.coarser());
-        match coarser {
-            Some(frame) if frame.dims.iter().all(|&n| n >= 3) => {
-                levels.push(Level::new(cage, frame, false))
-            }
-            _ => break,
-        }
-    }
-    let multigrid = Multigrid::new(levels);
+    let multigrid = multigrid(cage, grid)?;
     let columns = cage.vertex_count();
     let mut weights = Weights::zeros(points.len(), columns);
     let blocks = columns.div_ceil(COLUMNS_PER_BLOCK).max(1);
@@ -254,13 +245,33 @@ pub fn bind_harmonic(
     Ok((weights, stats))
 }
 
+/// The levels of a solve at `grid`, finest first, and their transfers.
+fn multigrid(cage: &Cage, grid: u32) -> Result<Multigrid, HarmonicError> {
+    let (frame, level_count) = frame_for(cage, grid)?;
+    let mut levels = vec![Level::new(cage, frame, true)];
+    for _ in 1..level_count {
+        let coarser = levels.last().map(|level| level.frame.coarser());
+        match coarser {
+            Some(frame) if frame.dims.iter().all(|&n| n >= 3) => {
+                levels.push(Level::new(cage, frame, false))
+            }
+            _ => break,
+        }
+    }
+    Ok(Multigrid::new(levels))
+}
+
 /// Right-hand sides of columns `first..first + width`: each cut arm's coefficient
-/// times the hat values at its crossing.
+/// times the boundary data at its crossing.
 fn right_hand_sides(level: &Level, first: usize, width: usize) -> Vec<f32> {
     let mut b = vec![0.0f32; level.unknowns() * width];
     for arm in &level.cut_arms {
-        for (&corner, &value) in arm.corners.iter().zip(&arm.barycentric) {
+        for (&corner, &value) in arm.corners.iter().zip(&arm.values) {
             let column = corner as usize;
+            // A triangle's fourth value is zero: adding it would change nothing.
+            if value == 0.0 {
+                continue;
+            }
             if (first..first + width).contains(&column) {
                 b[arm.unknown as usize * width + column - first] += arm.coefficient * value;
             }
@@ -344,3 +355,6 @@ impl<'a> RowsProgress<'a> {
         self.reach(self.units);
     }
 }
+
+#[cfg(test)]
+mod quad_tests;

@@ -1,9 +1,11 @@
 //! Harmonic coordinates at the mesh vertices: trilinear interpolation of the
-//! vertex's grid cell. A corner outside the cage has no unknown; it takes the hat
-//! values at its closest point on the cage (the boundary data, carried outwards),
+//! vertex's grid cell. A corner outside the cage has no unknown; it takes the
+//! boundary data at its closest point on the cage (hat values on a triangle, the
+//! bilinear basis on a quad's patch: the boundary data, carried outwards),
 //! which keeps every row non-negative and summing to one.
 
-use super::grid::{closest_hat_values, Level, NONE};
+use super::grid::{Level, NONE};
+use super::patches::closest_boundary_value;
 use crate::coords::Weights;
 use crate::geometry::{Cage, PointClass};
 use glam::DVec3;
@@ -18,15 +20,15 @@ const SOLVER_ROUNDING: f32 = 1e-6;
 enum Corner {
     /// An unknown of the finest level.
     Unknown(u32),
-    /// Hat values at a cage point: an index into [`Sampler::hats`].
+    /// Boundary data at a cage point: an index into [`Sampler::hats`].
     Hat(u32),
 }
 
 /// Per inside point, its eight corners and their trilinear weights.
 pub(super) struct Sampler {
     rows: Vec<(usize, [(Corner, f32); 8])>,
-    /// Cage vertices and their hat values, per outside corner used.
-    hats: Vec<([u32; 3], [f32; 3])>,
+    /// Cage vertices and their boundary values, per outside corner used.
+    hats: Vec<([u32; 4], [f32; 4])>,
 }
 
 impl Sampler {
@@ -73,15 +75,12 @@ impl Sampler {
             .collect();
         outside.sort_unstable();
         outside.dedup();
-        let hats: Vec<([u32; 3], [f32; 3])> = outside
+        let hats: Vec<([u32; 4], [f32; 4])> = outside
             .par_iter()
             .map(|&node| {
                 let position = frame.position(frame.coordinates(node));
-                let (triangle, barycentric) = closest_hat_values(cage, position);
-                (
-                    cage.triangles()[triangle as usize],
-                    barycentric.map(|w| w as f32),
-                )
+                let value = closest_boundary_value(cage, position);
+                (value.corners, value.values.map(|w| w as f32))
             })
             .collect();
         let hat_of: HashMap<usize, u32> = outside
@@ -144,7 +143,7 @@ impl Sampler {
                             let (corners, values) = self.hats[index as usize];
                             for (&corner, &value) in corners.iter().zip(&values) {
                                 let corner = corner as usize;
-                                if columns_of_block.contains(&corner) {
+                                if value != 0.0 && columns_of_block.contains(&corner) {
                                     out[corner - first] += weight * value;
                                 }
                             }

@@ -9,7 +9,7 @@ use super::family::ColumnLayout;
 use super::npy::{npy_preamble, read_npy, write_f32_values, ExpectedArray, NpyError};
 use super::npz::{read_npz, write_npz};
 use super::{BindOptions, Method, ParameterError, Weights};
-use crate::geometry::{shown_path, Cage, OutputSet, PointClass, WriteError};
+use crate::geometry::{shown_path, Cage, OutputSet, PointClass, QuadSplit, WriteError};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -96,6 +96,9 @@ pub struct CageRecord {
     pub vertices: usize,
     /// Triangles after quads and polygons were split ([`Cage::triangles`]).
     pub triangles: usize,
+    /// The file's quads, bilinear patches unless `quad_split` split them.
+    #[serde(default)]
+    pub quads: usize,
     /// [`cage_digest`] of the cage.
     pub digest: String,
 }
@@ -112,6 +115,15 @@ pub struct WeightsMetadata {
     pub method_name: String,
     /// The family's own parameters and their values (none for MVC and Green).
     pub parameters: BTreeMap<String, u32>,
+    /// `--triangulate` as asked: "none" (quads stay bilinear patches), "shorter"
+    /// or "longer". Files from before quads were patches have none and read as
+    /// "none"; their cages' quads were split along the shorter diagonal.
+    #[serde(default = "no_split")]
+    pub quad_split: String,
+    /// What the family bound the quads as, in words: "bilinear quads", or the
+    /// diagonal they were split along (Green coordinates always split them).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub quads_bound_as: String,
     /// "cpu" or "gpu".
     pub backend: String,
     /// Where they were computed, in words (the adapter, or the CPU threads).
@@ -152,9 +164,22 @@ pub struct BindRecord<'a> {
     pub weights_file: &'a Path,
 }
 
+fn no_split() -> String {
+    QuadSplit::None.id().to_owned()
+}
+
 impl WeightsMetadata {
     pub fn new(record: &BindRecord) -> Self {
         let method = record.options.method;
+        let bound = record.options.cage_to_bind(record.cage);
+        let quads_bound_as = match (
+            record.cage.has_quads(),
+            record.options.split_applied(record.cage),
+        ) {
+            (false, _) => String::new(),
+            (true, None) => QuadSplit::None.describe().to_owned(),
+            (true, Some(split)) => split.describe().to_owned(),
+        };
         let spec = method.spec();
         let count = |code| {
             record
@@ -169,7 +194,9 @@ impl WeightsMetadata {
             format_version: FORMAT_VERSION,
             program: format!("pmvc {}", env!("CARGO_PKG_VERSION")),
             method: spec.id.to_owned(),
-            method_name: spec.name.to_owned(),
+            method_name: record.options.family_name(record.cage),
+            quad_split: record.options.quads.id().to_owned(),
+            quads_bound_as,
             parameters: record
                 .options
                 .parameter()
@@ -183,7 +210,7 @@ impl WeightsMetadata {
             columns: method.columns(record.cage),
             columns_layout: layout_id(layout).to_owned(),
             triangles: (layout == ColumnLayout::CageVerticesThenTriangles)
-                .then(|| record.cage.triangles().to_vec()),
+                .then(|| bound.triangles().to_vec()),
             positive_inside: spec.positive_inside,
             outside_policy: spec.outside_policy.to_owned(),
             classes: ClassesRecord {
@@ -209,6 +236,7 @@ impl WeightsMetadata {
                 file: record.cage_file.to_owned(),
                 vertices: record.cage.vertex_count(),
                 triangles: record.cage.triangle_count(),
+                quads: record.cage.quads().len(),
                 digest: cage_digest(record.cage),
             },
         }
@@ -227,6 +255,16 @@ impl WeightsMetadata {
             ),
         })?;
         let mut options = BindOptions::for_method(method);
+        options.quads =
+            QuadSplit::from_id(&self.quad_split).ok_or_else(|| MetadataError::Field {
+                path: path.to_owned(),
+                field: "quad_split",
+                reason: format!(
+                    "{:?} is not a way to split quads ({})",
+                    self.quad_split,
+                    QuadSplit::ALL.map(QuadSplit::id).join(", ")
+                ),
+            })?;
         for (name, &value) in &self.parameters {
             let parameter = method
                 .spec()

@@ -8,13 +8,16 @@ use std::ops::Range;
 /// [`texel_bounds`] of a triangle whose corners are all in front of the face, from
 /// their projections `(x/z, y/z)`.
 #[inline(always)]
-pub(super) fn projected_bounds(
-    projections: [[f64; 2]; 3],
+pub(super) fn projected_bounds<const N: usize>(
+    projections: [[f64; 2]; N],
     table: &TexelTable,
 ) -> Option<(Range<usize>, Range<usize>)> {
-    let [[u0, v0], [u1, v1], [u2, v2]] = projections;
-    let (u_min, u_max) = (u0.min(u1).min(u2), u0.max(u1).max(u2));
-    let (v_min, v_max) = (v0.min(v1).min(v2), v0.max(v1).max(v2));
+    let [mut u_min, mut v_min] = projections[0];
+    let (mut u_max, mut v_max) = (u_min, v_min);
+    for &[u, v] in &projections[1..] {
+        (u_min, u_max) = (u_min.min(u), u_max.max(u));
+        (v_min, v_max) = (v_min.min(v), v_max.max(v));
+    }
     if u_min > 1.0 || u_max < -1.0 || v_min > 1.0 || v_max < -1.0 {
         return None;
     }
@@ -65,6 +68,53 @@ pub(super) fn texel_bounds(
             }
             if crossing.y <= 0.0 {
                 v_min = f64::NEG_INFINITY;
+            }
+        }
+    }
+    if !any_in_front || u_min > 1.0 || u_max < -1.0 || v_min > 1.0 || v_max < -1.0 {
+        return None;
+    }
+    Some((
+        index_range(u_min, u_max, table),
+        index_range(v_min, v_max, table),
+    ))
+}
+
+/// [`texel_bounds`] of the convex hull of a patch's four corners, which holds the
+/// patch: its crossings of the face plane are those of all six corner pairs.
+pub(super) fn hull_texel_bounds(
+    local: &[DVec3; 4],
+    table: &TexelTable,
+) -> Option<(Range<usize>, Range<usize>)> {
+    let (mut u_min, mut u_max, mut v_min, mut v_max) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    let mut any_in_front = false;
+    for (k, p) in local.iter().enumerate() {
+        if p.z > 0.0 {
+            any_in_front = true;
+            let (u, v) = (p.x / p.z, p.y / p.z);
+            (u_min, u_max) = (u_min.min(u), u_max.max(u));
+            (v_min, v_max) = (v_min.min(v), v_max.max(v));
+        }
+        for q in &local[k + 1..] {
+            if (p.z > 0.0) != (q.z > 0.0) {
+                let crossing = *p + p.z / (p.z - q.z) * (*q - *p);
+                if crossing.x >= 0.0 {
+                    u_max = f64::INFINITY;
+                }
+                if crossing.x <= 0.0 {
+                    u_min = f64::NEG_INFINITY;
+                }
+                if crossing.y >= 0.0 {
+                    v_max = f64::INFINITY;
+                }
+                if crossing.y <= 0.0 {
+                    v_min = f64::NEG_INFINITY;
+                }
             }
         }
     }

@@ -23,17 +23,38 @@
 //! per-texel vectors `Ω·d̂` are summed per triangle and dotted with its edge normals
 //! once. The winner is kept in the depth buffer itself, coded in the low mantissa
 //! bits of the inverse depth ([`hit_key`]).
+//!
+//! A cage with quads keeps each as one bilinear patch ([`patch`]): its lone
+//! triangles are drawn as above, and its patches solved exactly per texel into the
+//! same depth buffer, so that triangles and patches compete for each ray. A patch's
+//! hit spreads `Ω/t` by the bilinear basis, which is not linear in `Ω·d̂`, so each
+//! texel a patch wins keeps its u and `(1 − v)/t`, `v/t` for the resolve. A cage of
+//! triangles only takes the triangle code alone.
 
 mod frustum;
+mod lanes;
+mod missed;
+mod patch;
+#[cfg(test)]
+mod quad_tests;
 mod raster;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod timing_tests;
 
 use super::cubemap::TexelTable;
 use super::cubemap::TEXEL_LANES;
 use crate::geometry::Cage;
-use frustum::{faces_reached, outcode, projected_bounds, texel_bounds, FACE_FRAMES};
+use frustum::{
+    faces_reached, hull_texel_bounds, outcode, projected_bounds, texel_bounds, FACE_FRAMES,
+};
 use glam::DVec3;
+#[cfg(target_arch = "x86_64")]
+use lanes::Avx2;
+use lanes::{Lanes, Portable};
+use missed::{catch_missed_texels, Drawn};
+use patch::{FacePatch, PatchHits, PatchSetup};
 #[cfg(target_arch = "x86_64")]
 use raster::raster_triangle_avx2;
 use raster::{raster_triangle, FaceTriangle};
@@ -53,8 +74,15 @@ pub struct PmvcScratch {
     /// Triangles rasterised on the current face, with their signed edge functions.
     drawn: Vec<(u32, [DVec3; 3])>,
     /// [`BANKS`] accumulators per hit code (code 0: the misses): the sums of
-    /// [`TexelTable::texel_directions`] over the texels each code won.
+    /// [`TexelTable::texel_directions`] over the texels each code won; for a patch,
+    /// of its corners' weights.
     sums: Vec<[[f64; 4]; BANKS]>,
+    /// The cage's patches, as `by_face` for triangles, and those drawn on a face.
+    patches: Vec<PatchSetup>,
+    patches_by_face: Vec<u32>,
+    drawn_patches: Vec<(u32, FacePatch, Range<usize>)>,
+    /// Per texel of the current face, the hit of the patch that holds it.
+    patch_hits: PatchHits,
 }
 
 /// What every triangle at a cage vertex needs, computed once per vertex.
@@ -90,15 +118,15 @@ impl VertexSetup {
 }
 
 #[derive(Clone, Copy, Debug, Default)]
-struct TriangleSetup {
+pub(super) struct TriangleSetup {
     /// Its cage vertices.
-    vertices: [u32; 3],
+    pub(super) vertices: [u32; 3],
     /// Corners relative to x.
     corners: [DVec3; 3],
     /// `b×c`, `c×a`, `a×b`: a ray direction dotted with these gives unnormalised barycentrics.
     edge_normals: [DVec3; 3],
     /// `det[a, b, c]`; its sign tells which side x is on.
-    det: f64,
+    pub(super) det: f64,
 }
 
 /// Share of texels that may miss every triangle before x is treated as not enclosed.
@@ -150,16 +178,26 @@ fn dispatch<const CULL: bool>(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has just been checked to support AVX2 and FMA.
-        return unsafe { pmvc_weights_avx2::<CULL>(x, cage, table, out, scratch) };
+        return unsafe {
+            if cage.has_quads() {
+                pmvc_weights_avx2::<CULL, true>(x, cage, table, out, scratch)
+            } else {
+                pmvc_weights_avx2::<CULL, false>(x, cage, table, out, scratch)
+            }
+        };
     }
-    pmvc_weights_with::<CULL>(x, cage, table, out, scratch, raster_triangle)
+    if cage.has_quads() {
+        pmvc_weights_with::<CULL, true, Portable>(x, cage, table, out, scratch, raster_triangle)
+    } else {
+        pmvc_weights_with::<CULL, false, Portable>(x, cage, table, out, scratch, raster_triangle)
+    }
 }
 
 /// The same code compiled for AVX2 and FMA, with the depth test written four texels
 /// at a time. Both use the same fused multiply-adds, so the results are bit-identical.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn pmvc_weights_avx2<const CULL: bool>(
+unsafe fn pmvc_weights_avx2<const CULL: bool, const QUADS: bool>(
     x: DVec3,
     cage: &Cage,
     table: &TexelTable,
@@ -174,7 +212,7 @@ unsafe fn pmvc_weights_avx2<const CULL: bool>(
                   nearest: &mut [f64]| {
         raster_triangle_avx2(triangle, rows, columns, table, nearest)
     };
-    pmvc_weights_with::<CULL>(x, cage, table, out, scratch, raster)
+    pmvc_weights_with::<CULL, QUADS, Avx2>(x, cage, table, out, scratch, raster)
 }
 
 /// True when x is certainly on the outer side of the plane of the outward triangle
@@ -186,8 +224,84 @@ fn faces_away(det: f64, corners: &[DVec3; 3]) -> bool {
     det < 0.0 && det * det > 1e-24 * scale
 }
 
+/// Sets up triangle `vertices` at x, unless it can be skipped, and lists it on the
+/// cube faces it may reach.
 #[inline(always)]
-fn pmvc_weights_with<const CULL: bool>(
+fn push_triangle<const CULL: bool>(
+    vertices: &[u32; 3],
+    setups: &[VertexSetup],
+    triangles: &mut Vec<TriangleSetup>,
+    by_face: &mut [u32],
+    face_counts: &mut [usize; 6],
+    triangle_count: usize,
+) {
+    let [a, b, c] = vertices.map(|k| &setups[k as usize]);
+    let edge_normals = [
+        b.relative.cross(c.relative),
+        c.relative.cross(a.relative),
+        a.relative.cross(b.relative),
+    ];
+    let det = a.relative.dot(edge_normals[0]);
+    let corners = [a.relative, b.relative, c.relative];
+    // x in the triangle's plane: rays graze it, so it never blocks or contributes.
+    if det == 0.0 || (CULL && faces_away(det, &corners)) {
+        return;
+    }
+    let faces = faces_reached(a.outcodes & b.outcodes & c.outcodes);
+    // Written always and counted only where reached: no branch to mispredict.
+    let t = triangles.len() as u32;
+    for (f, count) in face_counts.iter_mut().enumerate() {
+        by_face[f * triangle_count + *count] = t;
+        *count += usize::from((faces >> f) & 1);
+    }
+    triangles.push(TriangleSetup {
+        vertices: *vertices,
+        corners,
+        edge_normals,
+        det,
+    });
+}
+
+/// Sets up the cage's quads as patches at x, unless they can be skipped, listing
+/// each on the cube faces it may reach. Returns how many per face.
+#[inline(always)]
+fn push_patches<const CULL: bool>(cage: &Cage, scratch: &mut PmvcScratch) -> [usize; 6] {
+    let quad_count = cage.quads().len();
+    scratch.patches.clear();
+    scratch.patches_by_face.resize(6 * quad_count, 0);
+    let mut face_counts = [0; 6];
+    for quad in cage.quads() {
+        let corners = quad.corners.map(|k| &scratch.vertices[k as usize]);
+        let setup = PatchSetup::new(quad.corners, corners.map(|c| c.relative));
+        let sides = setup.corner_sides();
+        // x in the plane of a flat patch: rays graze it, as a triangle's.
+        if sides == [0.0; 4] {
+            continue;
+        }
+        // x on the outer side of the tangent plane at every corner is on the outer
+        // side of the whole patch, which then never holds a ray's exit from inside.
+        if CULL
+            && (0..4).all(|k| {
+                let q = &setup.corners;
+                faces_away(sides[k], &[q[k], q[(k + 1) % 4], q[(k + 3) % 4]])
+            })
+        {
+            continue;
+        }
+        let common = corners.iter().fold(!0, |codes, c| codes & c.outcodes);
+        let faces = faces_reached(common);
+        let p = scratch.patches.len() as u32;
+        for (f, count) in face_counts.iter_mut().enumerate() {
+            scratch.patches_by_face[f * quad_count + *count] = p;
+            *count += usize::from((faces >> f) & 1);
+        }
+        scratch.patches.push(setup);
+    }
+    face_counts
+}
+
+#[inline(always)]
+fn pmvc_weights_with<const CULL: bool, const QUADS: bool, V: Lanes>(
     x: DVec3,
     cage: &Cage,
     table: &TexelTable,
@@ -208,38 +322,47 @@ fn pmvc_weights_with<const CULL: bool>(
     let triangle_count = cage.triangle_count();
     scratch.by_face.resize(6 * triangle_count, 0);
     let mut face_counts = [0; 6];
-    for vertices in cage.triangles() {
-        let [a, b, c] = vertices.map(|k| &scratch.vertices[k as usize]);
-        let edge_normals = [
-            b.relative.cross(c.relative),
-            c.relative.cross(a.relative),
-            a.relative.cross(b.relative),
-        ];
-        let det = a.relative.dot(edge_normals[0]);
-        let corners = [a.relative, b.relative, c.relative];
-        // x in the triangle's plane: rays graze it, so it never blocks or contributes.
-        if det == 0.0 || (CULL && faces_away(det, &corners)) {
-            continue;
+    let setups = &scratch.vertices;
+    if QUADS {
+        for t in cage.lone_triangles() {
+            let vertices = &cage.triangles()[t];
+            push_triangle::<CULL>(
+                vertices,
+                setups,
+                &mut scratch.triangles,
+                &mut scratch.by_face,
+                &mut face_counts,
+                triangle_count,
+            );
         }
-        let faces = faces_reached(a.outcodes & b.outcodes & c.outcodes);
-        // Written always and counted only where reached: no branch to mispredict.
-        let t = scratch.triangles.len() as u32;
-        for (f, count) in face_counts.iter_mut().enumerate() {
-            scratch.by_face[f * triangle_count + *count] = t;
-            *count += usize::from((faces >> f) & 1);
+    } else {
+        for vertices in cage.triangles() {
+            push_triangle::<CULL>(
+                vertices,
+                setups,
+                &mut scratch.triangles,
+                &mut scratch.by_face,
+                &mut face_counts,
+                triangle_count,
+            );
         }
-        scratch.triangles.push(TriangleSetup {
-            vertices: *vertices,
-            corners,
-            edge_normals,
-            det,
-        });
     }
-    // Triangle t is coded as `code_mask − t` in the low bits of its hit keys; 0 is a miss.
-    let code_mask = (scratch.triangles.len() + 1).next_power_of_two() - 1;
+    let (patch_face_counts, patch_count) = if QUADS {
+        let counts = push_patches::<CULL>(cage, scratch);
+        (counts, scratch.patches.len())
+    } else {
+        ([0; 6], 0)
+    };
+    // Patch p is coded as `code_mask − p` and triangle t as `code_mask − P − t` in the
+    // low bits of their hit keys (P patches); 0 is a miss.
+    let code_mask = (scratch.triangles.len() + patch_count + 1).next_power_of_two() - 1;
+    let first_triangle_code = code_mask - patch_count;
     scratch.nearest.resize(texels, 0.0);
     scratch.sums.clear();
     scratch.sums.resize(code_mask + 1, [[0.0; 4]; BANKS]);
+    if QUADS {
+        scratch.patch_hits.prepare(table);
+    }
 
     let mut total_weight = 0.0;
     let mut missed = 0.0;
@@ -272,7 +395,7 @@ fn pmvc_weights_with<const CULL: bool>(
                 frame.local(e2) * sign,
             ];
             scratch.drawn.push((t as u32, edges));
-            let code = (code_mask - t) as u64;
+            let code = (first_triangle_code - t) as u64;
             let depth = (edges[0] + edges[1] + edges[2]) * (sign / setup.det);
             // Whole steps of TEXEL_LANES, from any column; the padding never wins a
             // texel (see raster_triangle) and has zero weight.
@@ -292,6 +415,9 @@ fn pmvc_weights_with<const CULL: bool>(
                 &mut scratch.nearest,
             );
         }
+        if QUADS {
+            draw_patches::<V>(f, patch_face_counts[f], code_mask, cage, table, scratch);
+        }
         // Sum Ω·d̂ per winning triangle; then w·bₖ = Ω/r · Eₖ/ΣE = sE_k·(Ω·d̂)/|det|,
         // linear in Ω·d̂, so each triangle needs only its sum.
         // As long as the mask, so that indexing by a masked code needs no check.
@@ -309,7 +435,7 @@ fn pmvc_weights_with<const CULL: bool>(
         }
         for &(t, edges) in &scratch.drawn {
             let t = t as usize;
-            let code = code_mask - t;
+            let code = first_triangle_code - t;
             let mut sum = DVec3::ZERO;
             for bank in &mut scratch.sums[code] {
                 sum += DVec3::new(bank[0], bank[1], bank[2]);
@@ -325,18 +451,44 @@ fn pmvc_weights_with<const CULL: bool>(
                 total_weight += weight;
             }
         }
+        if QUADS {
+            // A patch's texels were summed as a triangle's above, to no use; its
+            // weights are summed over its candidate groups instead.
+            for (p, _, candidates) in &scratch.drawn_patches {
+                let code = code_mask - *p as usize;
+                scratch.sums[code] = [[0.0; 4]; BANKS];
+                let weights = scratch.patch_hits.resolve::<V>(
+                    candidates.clone(),
+                    stride,
+                    &scratch.nearest,
+                    code_mask,
+                    code as u64,
+                );
+                // Each texel's share is non-negative: the sums are.
+                let corners = scratch.patches[*p as usize].vertices;
+                for (&corner, weight) in corners.iter().zip(weights) {
+                    out[corner as usize] += weight;
+                    total_weight += weight;
+                }
+            }
+        }
         let mut face_missed = 0.0;
         for bank in &mut scratch.sums[0] {
             face_missed += bank[3];
             *bank = [0.0; 4];
         }
         if face_missed > 0.0 && face_missed <= most_missed {
+            let drawn = Drawn {
+                triangles: &scratch.drawn,
+                triangle_setups: &scratch.triangles,
+                patches: if QUADS { &scratch.drawn_patches } else { &[] },
+                patch_setups: &scratch.patches,
+            };
             face_missed -= catch_missed_texels(
                 &scratch.nearest[..texels],
                 code_mask,
                 table,
-                &scratch.drawn,
-                &scratch.triangles,
+                &drawn,
                 out,
                 &mut total_weight,
             );
@@ -353,60 +505,46 @@ fn pmvc_weights_with<const CULL: bool>(
     true
 }
 
-/// Edge values this far below zero, relative to the edge normal and the ray, still
-/// count as on the edge when a missed texel is cast again: far above the rounding
-/// of the edge values (about 1e-16), far below a texel's width.
-const EDGE_SLACK: f64 = 1e-12;
-
-/// Texels that no triangle covered although x is enclosed: rays through a cage
-/// vertex, where the triangles around it round their edge values independently,
-/// and rays along a face that x is in the plane of (skipped), which only its
-/// neighbour can catch. A lost texel takes its `Ω·d̂` out of the sum that gives
-/// linear precision, so each is cast again against the face's triangles with
-/// [`EDGE_SLACK`], and the nearest one it reaches gets its weight as the resolve
-/// would have given it. Returns how many texels were caught.
-fn catch_missed_texels(
-    nearest: &[f64],
+/// Draws the patches listed on cube face `f` into its depth buffer, keeping those
+/// drawn, with their candidate groups, in `scratch.drawn_patches`.
+#[inline(always)]
+fn draw_patches<V: Lanes>(
+    f: usize,
+    count: usize,
     code_mask: usize,
+    cage: &Cage,
     table: &TexelTable,
-    drawn: &[(u32, [DVec3; 3])],
-    triangles: &[TriangleSetup],
-    out: &mut [f64],
-    total_weight: &mut f64,
-) -> f64 {
-    let mut caught = 0.0;
-    for (key, direction) in nearest.iter().zip(&table.texel_directions) {
-        // A hit, or the padding (no weight).
-        if key.to_bits() as usize & code_mask != 0 || direction[3] == 0.0 {
+    scratch: &mut PmvcScratch,
+) {
+    let frame = &FACE_FRAMES[f];
+    let stride = table.stride;
+    scratch.drawn_patches.clear();
+    scratch.patch_hits.start_face();
+    let quad_count = cage.quads().len();
+    for &p in &scratch.patches_by_face[f * quad_count..][..count] {
+        let setup = &scratch.patches[p as usize];
+        let corners = setup.vertices.map(|k| &scratch.vertices[k as usize]);
+        let any_behind = corners.iter().fold(0, |codes, c| codes | c.outcodes);
+        let bounds = if (any_behind >> (5 * f)) & 1 == 0 {
+            projected_bounds(corners.map(|c| c.projections[f]), table)
+        } else {
+            hull_texel_bounds(&setup.corners.map(|p| frame.local(p)), table)
+        };
+        let Some((columns, rows)) = bounds else {
             continue;
-        }
-        let ray = DVec3::new(direction[0], direction[1], direction[2]);
-        let mut nearest_hit: Option<(f64, usize, [f64; 3])> = None;
-        for &(t, edges) in drawn {
-            let values = edges.map(|edge| edge.dot(ray));
-            let on_triangle = values
-                .iter()
-                .zip(&edges)
-                .all(|(&value, edge)| value >= -EDGE_SLACK * edge.length() * ray.length());
-            let setup = &triangles[t as usize];
-            // Proportional to 1/t, as the depth test's key.
-            let inverse_depth = values.iter().sum::<f64>() / setup.det.abs();
-            if on_triangle
-                && inverse_depth > 0.0
-                && nearest_hit.is_none_or(|(nearest, _, _)| inverse_depth > nearest)
-            {
-                nearest_hit = Some((inverse_depth, t as usize, values));
-            }
-        }
-        if let Some((_, t, values)) = nearest_hit {
-            let setup = &triangles[t];
-            for (&corner, value) in setup.vertices.iter().zip(values) {
-                let weight = value.max(0.0) / setup.det.abs();
-                out[corner as usize] += weight;
-                *total_weight += weight;
-            }
-            caught += 1.0;
-        }
+        };
+        let patch = setup.on_face(frame, code_mask, (code_mask - p as usize) as u64);
+        let width = columns.len().div_ceil(TEXEL_LANES) * TEXEL_LANES;
+        let first = columns.start.min(stride - width);
+        let start = scratch.patch_hits.candidate_count();
+        patch.raster::<V>(
+            rows,
+            first..first + width,
+            table,
+            &mut scratch.nearest,
+            &mut scratch.patch_hits,
+        );
+        let end = scratch.patch_hits.candidate_count();
+        scratch.drawn_patches.push((p, patch, start..end));
     }
-    caught
 }

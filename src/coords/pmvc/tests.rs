@@ -30,7 +30,7 @@ fn every_code_path_gives_identical_weights() {
         let scratch = &mut PmvcScratch::default();
         let (mut dispatched, mut portable) = (vec![0.0; n], vec![0.0; n]);
         assert!(pmvc_weights(x, &cage, table, &mut dispatched, scratch));
-        assert!(pmvc_weights_with::<false>(
+        assert!(pmvc_weights_with::<false, false, Portable>(
             x,
             &cage,
             table,
@@ -46,7 +46,7 @@ fn every_code_path_gives_identical_weights() {
             &mut dispatched,
             scratch
         ));
-        assert!(pmvc_weights_with::<true>(
+        assert!(pmvc_weights_with::<true, false, Portable>(
             x,
             &cage,
             table,

@@ -1,7 +1,7 @@
 //! One bind on a GPU: device buffers, batches of rows, flagged rows redone on the
 //! CPU, and typed readback.
 
-use super::topology::topology;
+use super::topology::{topology, Topology};
 use super::{BatchSize, BindConfig, BindError, BindInput, BindOutput, BindStats, GpuWeights};
 use crate::coords::{self, cubemap::TexelTable, BindProgress, Weights};
 use crate::geometry::{bounds_of, PointClass};
@@ -44,6 +44,8 @@ pub(super) struct GpuBind<'a> {
     input: &'a BindInput,
     config: BindConfig,
     kernel: Kernel,
+    /// The quad pipeline: PMVC with quads as bilinear patches.
+    patches: bool,
     centre: DVec3,
     rows: usize,
     cols: usize,
@@ -98,12 +100,13 @@ impl<'a> GpuBind<'a> {
             return Err(failure.into());
         }
         let rows = input.points.len();
+        // The cage the family binds: quads as patches, or split (Green, `--triangulate`).
+        let cage = input.options.cage_to_bind(&input.cage);
         // A weights row: one column per cage vertex, then for Green coordinates
         // one per cage triangle.
-        let cols = input.options.method.columns(&input.cage);
-        let triangles = input.cage.triangle_count();
+        let cols = input.options.method.columns(&cage);
         let method = input.options.method;
-        let kernel = Kernel::of(method).ok_or(BindError::NoGpuKernel { method })?;
+        let kernel = Kernel::for_cage(method, &cage).ok_or(BindError::NoGpuKernel { method })?;
         let resolution = input.options.resolution.max(1);
         if kernel == Kernel::Pmvc && resolution > BAND_TEXELS {
             return Err(BindError::ResolutionTooHigh {
@@ -115,9 +118,10 @@ impl<'a> GpuBind<'a> {
         let limit = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
-        // Corner sums per triangle, for the whole sphere and for the current band.
+        let topology = topology(&cage, kernel, resolution, rows);
+        // Corner sums per primitive, for the whole sphere and for the current band.
         let sums_per_row = if kernel == Kernel::Pmvc {
-            6 * triangles
+            2 * topology.corners * topology.primitives()
         } else {
             0
         };
@@ -132,10 +136,7 @@ impl<'a> GpuBind<'a> {
         }
         let cage_bytes = [
             ("the cage positions", byte_len::<[f32; 4]>(cols)),
-            (
-                "the cage topology",
-                byte_len::<u32>(6 * triangles + cols + 1),
-            ),
+            ("the cage topology", byte_len::<u32>(topology.words.len())),
         ];
         for (what, needed) in cage_bytes {
             if needed > limit {
@@ -158,7 +159,7 @@ impl<'a> GpuBind<'a> {
             .min(rows)
             .max(1);
 
-        let (lo, hi) = bounds_of(input.cage.positions());
+        let (lo, hi) = bounds_of(cage.positions());
         // Relative to the cage centre, so f32 keeps the precision of the differences.
         let centre = 0.5 * (lo + hi);
         let table = TexelTable::new(resolution);
@@ -175,8 +176,7 @@ impl<'a> GpuBind<'a> {
                 context.queue.write_buffer(&buffer, 0, contents);
                 buffer
             };
-            let positions: Vec<[f32; 4]> = input
-                .cage
+            let positions: Vec<[f32; 4]> = cage
                 .positions()
                 .iter()
                 .map(|&p| {
@@ -185,8 +185,12 @@ impl<'a> GpuBind<'a> {
                 })
                 .collect();
             let positions = storage("cage positions", bytemuck::cast_slice(&padded(positions)));
-            let (topology, params) = topology(&input.cage, kernel, resolution, rows);
-            let topology = storage("cage topology", bytemuck::cast_slice(&padded(topology)));
+            let Topology {
+                words,
+                params,
+                corners,
+            } = topology;
+            let topology = storage("cage topology", bytemuck::cast_slice(&padded(words)));
             let texels: Vec<f32> = if kernel == Kernel::Pmvc {
                 table
                     .solid_angle_over_length
@@ -271,6 +275,7 @@ impl<'a> GpuBind<'a> {
                 input,
                 config,
                 kernel,
+                patches: corners == 4,
                 centre,
                 rows,
                 cols,
@@ -433,7 +438,11 @@ impl<'a> GpuBind<'a> {
                     pass.set_bind_group(0, &self.bind_group, &[]);
                     let groups = match self.kernel {
                         Kernel::Pmvc => {
-                            pass.set_pipeline(&kernels.pmvc);
+                            pass.set_pipeline(if self.patches {
+                                &kernels.pmvc_quads
+                            } else {
+                                &kernels.pmvc
+                            });
                             inside.len() as u32
                         }
                         Kernel::Mvc => {

@@ -12,6 +12,11 @@
 //! kernels flag: PMVC points whose rays escape, MVC points too close to a cage
 //! vertex, triangle or triangle plane for f32, Green rows that miss their
 //! identities (Σφ = 1, the rest pose) by more than f32 rounding.
+//!
+//! On a cage with quads, PMVC's kernel takes them as bilinear patches; MVC there
+//! is QMVC, which has no kernel, so such a bind runs on the CPU whatever the
+//! backend ([`crate::gpu::kernels::Kernel::for_cage`]); Green coordinates bind
+//! the cage's triangles, as on the CPU.
 
 mod gpu_bind;
 mod topology;
@@ -316,7 +321,9 @@ fn run(
 ) -> Result<BindOutput, BindError> {
     validate(input)?;
     let started = Instant::now();
-    let has_kernel = crate::gpu::kernels::Kernel::of(input.options.method).is_some();
+    let options = input.options;
+    let patches = input.cage.has_quads() && options.split_applied(&input.cage).is_none();
+    let has_kernel = crate::gpu::kernels::Kernel::of_work(options.method, patches).is_some();
     match backend {
         Backend::Gpu(_) if has_kernel && !config.cpu_weights && !config.gpu_buffer => {
             Err(BindError::NothingKept)
@@ -326,7 +333,8 @@ fn run(
             output.stats.elapsed = started.elapsed();
             Ok(output)
         }
-        // The CPU backend, and families without a GPU kernel on any backend.
+        // The CPU backend, and families without a GPU kernel on any backend (MVC on
+        // quads among them).
         _ => {
             let weights = coords::bind_cpu(
                 &input.points,

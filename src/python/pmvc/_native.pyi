@@ -43,6 +43,10 @@ class Cage:
         """Outward triangles, int64 (t, 3): what Green's ψ columns refer to."""
         ...
     @property
+    def quads(self) -> npt.NDArray[np.int64]:
+        """The quads as bilinear patches, int64 (q, 4), corners q0..q3, outward."""
+        ...
+    @property
     def triangle_faces(self) -> npt.NDArray[np.int64]:
         """For each triangle, the face (0-based) it was cut from."""
         ...
@@ -133,12 +137,15 @@ def bind(
     grid: int = 64,
     backend: str = "auto",
     progress: Optional[Progress] = None,
+    triangulate: Optional[str] = None,
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
     ``resolution`` is PMVC's cube-map resolution, ``grid`` harmonic
     coordinates' grid; each is read only by its family and checked against its
-    range. ``backend``: "auto" (the CPU, or a hardware GPU where it is
+    range. Quads are bilinear patches (MVC on them is QMVC) unless
+    ``triangulate`` is "shorter" or "longer", which splits them along that
+    diagonal first; Green coordinates always bind on triangles. ``backend``: "auto" (the CPU, or a hardware GPU where it is
     predicted faster for this bind), "cpu" or "gpu". The GIL is released; Ctrl-C cancels within about a second."""
     ...
 
@@ -152,7 +159,8 @@ def deform(
 ) -> npt.NDArray[np.float64]:
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
-    bound first with ``parameters`` (resolution, grid, backend, progress)."""
+    bound first with ``parameters`` (resolution, grid, backend, progress,
+    triangulate)."""
     ...
 
 def classify(points: ArrayLike, cage: Cage) -> npt.NDArray[np.int8]:

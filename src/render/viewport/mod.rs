@@ -25,7 +25,7 @@ use super::weight_attributes::AttributeBlend;
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 
 mod readbacks;
-use crate::coords::{Method, Weights};
+use crate::coords::{Method, Weights, WeightsId};
 use crate::geometry::Cage;
 use glam::{DVec3, Vec3};
 
@@ -200,7 +200,7 @@ impl ViewportRenderer {
     pub fn set_weights(
         &mut self,
         device: &wgpu::Device,
-        method: Method,
+        id: WeightsId,
         weights: Option<&Weights>,
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
@@ -208,13 +208,13 @@ impl ViewportRenderer {
             return Err(RenderError::NoScene);
         };
         let Some(weights) = weights.filter(|weights| !weights.values.is_empty()) else {
-            scene.set_slot(method, None);
+            scene.set_slot(id, None);
             return Ok(());
         };
         let split = match self.chunk_limits.split(weights.rows, weights.cols) {
             Ok(split) => split,
             Err(too_large) => {
-                scene.set_slot(method, None);
+                scene.set_slot(id, None);
                 return Err(too_large.into());
             }
         };
@@ -230,7 +230,7 @@ impl ViewportRenderer {
         let attributes = AttributeBlend::new(&device.limits(), weights.cols as u32, chunks.len())
             .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
         // The columns' displacements, then room for the vertex normals.
-        let mut displacements = scene.displacements_of(method);
+        let mut displacements = scene.displacements_of(id.method);
         let uniform_displacements = uniform_displacements_buffer(device, &displacements);
         displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
@@ -242,7 +242,7 @@ impl ViewportRenderer {
                 | wgpu::BufferUsages::COPY_SRC,
         );
         scene.set_slot(
-            method,
+            id,
             Some(WeightSlot {
                 chunks,
                 split,
@@ -284,7 +284,7 @@ impl ViewportRenderer {
         scene.pose_revision += 1;
         let scene_pose = scene.origin.points_to_scene(pose, 1.0);
         queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&scene_pose));
-        for (&method, slot) in &scene.slots {
+        for (&method, slot) in scene.slots.iter().chain(&scene.twin_slots) {
             let displacements = scene.displacements_of(method);
             queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
             SceneGpu::write_uniform_displacements(queue, slot, &displacements);
@@ -308,11 +308,12 @@ impl ViewportRenderer {
 
     fn frame_uniform(&self, params: &FrameParams) -> FrameUniform {
         let shading = &params.shading;
-        let slot_of = |method: Option<Method>| {
-            let slot = self.scene.as_ref().zip(method);
-            slot.and_then(|(scene, method)| scene.slots.get(&method))
+        let slot_of = |id: Option<WeightsId>| {
+            let slot = self.scene.as_ref().zip(id);
+            slot.and_then(|(scene, id)| scene.slot(id))
         };
-        let (shown, against) = (slot_of(Some(shading.method)), slot_of(shading.against));
+        let shown = slot_of(Some(WeightsId::of(shading.method)));
+        let against = slot_of(shading.against);
         let columns = shown.map_or(0, |slot| slot.columns);
         let rows_per_chunk = |slot: Option<&WeightSlot>| slot.map_or(1, |s| s.split.rows_per_chunk);
         let cage_vertices = self
