@@ -1,8 +1,8 @@
 // Positive mean value coordinates by cube-map rasterisation, one workgroup per point.
 //
-// Follows src/coords/cubemap.rs and src/coords/pmvc.rs exactly: one ray per texel
+// Follows src/coords/cubemap.rs and src/coords/pmvc/ exactly: one ray per texel
 // centre, first hit at t > 0 on either side of a triangle, weight Ω/r, spread by the
-// hit's barycentrics. A face is rasterised in bands of rows that fit the
+// hit's barycentrics (on a patch, by its bilinear basis). A face is rasterised in bands of rows that fit the
 // workgroup-shared depth buffer; invocations own triangles. A triangle that cannot
 // reach a face (a cheap test against the face's four bounding planes) is skipped
 // before its set-up, so a large cage costs little on the faces it misses. Per band:
@@ -20,8 +20,9 @@
 // Finally each cage vertex gathers its incident triangles' sums and the row is
 // normalised by its total (Σ_k E_k/det · Ω/|d| = w, so the row sum is Σ w).
 // On a cage with quads a second pipeline (CORNERS = 4) takes bilinear patches
-// among the primitives, in the same passes (shared/pmvc_patches.wgsl); on a cage
-// of triangles every patch branch folds away.
+// among the primitives, in the same passes (shared/pmvc_patches.wgsl). For a cage
+// of triangles that import is swapped for shared/pmvc_no_patches.wgsl, and every
+// patch branch folds away.
 
 #import bind_params
 #import bind_constants

@@ -23,7 +23,11 @@ pub(super) struct BentQuad {
     quad: usize,
     /// Outward planes of the corners' tetrahedron, as (point on it, normal).
     hull: [(DVec3, DVec3); 4],
+    /// The patch's grid, relative to the quad's centre.
     grid: Vec<DVec3>,
+    /// Points closer than this to the patch take the side of the patch they
+    /// are on: ten times how far the pillow's grid strays from the patch.
+    near: f64,
 }
 
 /// The cage's quads that are not planar within `tolerance`.
@@ -31,10 +35,15 @@ pub(super) fn bent_quads(cage: &Cage, tolerance: f64) -> Vec<BentQuad> {
     (0..cage.quads().len())
         .filter_map(|k| {
             let q = cage.quad(k);
-            (out_of_plane(&q) > tolerance).then(|| BentQuad {
+            let bend = out_of_plane(&q);
+            (bend > tolerance).then(|| BentQuad {
                 quad: k,
                 hull: tetrahedron_planes(&q),
-                grid: patch_grid(&q, PILLOW_STEPS),
+                grid: {
+                    let centre = (q[0] + q[1] + q[2] + q[3]) * 0.25;
+                    patch_grid(&q.map(|p| p - centre), PILLOW_STEPS)
+                },
+                near: 10.0 * bend / (PILLOW_STEPS * PILLOW_STEPS) as f64,
             })
         })
         .collect()
@@ -67,30 +76,36 @@ pub(super) fn correct_class(
         if quad.hull.iter().any(|&(a, n)| n.dot(x - a) > tolerance) {
             continue;
         }
-        let q = cage.quad(quad.quad);
+        // Relative to the quad's centre, so that the class does not depend on
+        // where the scene is (tests/origin_offsets.rs).
+        let corners = cage.quad(quad.quad);
+        let centre = (corners[0] + corners[1] + corners[2] + corners[3]) * 0.25;
+        let q = corners.map(|p| p - centre);
+        let local = x - centre;
         let halves = cage.quads()[quad.quad].triangles;
-        let uv = nearest_uv(&q, x, [0.5, 0.5]);
-        let nearest = bilinear_point(&q, uv[0], uv[1]);
-        if nearest.distance_squared(x) <= tolerance * tolerance {
+        let uv = nearest_uv(&q, local, [0.5, 0.5]);
+        let offset = local - bilinear_point(&q, uv[0], uv[1]);
+        if offset.length_squared() <= tolerance * tolerance {
             let t = halves[0] as usize;
             let [a, b, c] = cage.triangle(t);
-            let (_, barycentric) = closest_offset_on_triangle(nearest, a, b, c);
+            let (_, barycentric) = closest_offset_on_triangle(x - offset, a, b, c);
             return PointClass::OnSurface {
                 triangle: halves[0],
                 barycentric,
             };
         }
-        let on_a_half =
-            matches!(first, PointClass::OnSurface { triangle, .. } if halves.contains(&triangle));
-        if on_a_half {
-            let inner = (x - nearest).dot(bilinear_normal(&q, uv[0], uv[1])) < 0.0;
+        let on_a_half = matches!(first, PointClass::OnSurface { triangle, .. } if halves.contains(&triangle));
+        // Near the patch, closer than the pillow grid follows it, the side of
+        // the patch decides; farther, the pillow's winding number.
+        if on_a_half || offset.length() < quad.near {
+            let inner = offset.dot(bilinear_normal(&q, uv[0], uv[1])) < 0.0;
             return if inner {
                 PointClass::Inside
             } else {
                 PointClass::Outside
             };
         }
-        let winding = pillow_winding(cage, quad, grid_triangles, halves, x);
+        let winding = pillow_winding(cage, quad, grid_triangles, halves, centre, local);
         if winding > 0.5 {
             return PointClass::Inside;
         }
@@ -107,6 +122,7 @@ fn pillow_winding(
     quad: &BentQuad,
     grid_triangles: &[[u32; 3]],
     halves: [u32; 2],
+    centre: DVec3,
     x: DVec3,
 ) -> f64 {
     let solid = |[a, b, c]: [DVec3; 3]| {

@@ -221,7 +221,30 @@ impl GpuContext {
             }
         };
         let kernels = Kernels::new(&self.device, cache.as_ref())?;
-        let fresh = cache.and_then(|cache| cache.get_data());
+        if let Some(cache) = &cache {
+            self.store_pipeline_cache(cache, known);
+        }
+        Ok(kernels)
+    }
+
+    /// PMVC's pipeline for cages with quads, compiled on the first bind that
+    /// needs one (through the pipeline cache, which is then written again).
+    pub(super) fn pmvc_quads(&self) -> Result<&wgpu::ComputePipeline, GpuError> {
+        let kernels = self.kernels()?;
+        let before = kernels.pipeline_cache().and_then(|cache| cache.get_data());
+        let (pipeline, compiled) = kernels.pmvc_quads();
+        if let (true, Some(cache)) = (compiled, kernels.pipeline_cache()) {
+            self.store_pipeline_cache(cache, before.as_deref());
+        }
+        pipeline
+    }
+
+    /// Write `cache`'s data to this adapter's cache file unless it is still `known`.
+    fn store_pipeline_cache(&self, cache: &wgpu::PipelineCache, known: Option<&[u8]>) {
+        let Some(path) = self.pipeline_cache.path() else {
+            return;
+        };
+        let fresh = cache.get_data();
         if let (Some(data), Some(key)) = (fresh, pipeline_cache::adapter_key(&self.info)) {
             if known != Some(data.as_slice()) {
                 if let Err(why) = pipeline_cache::store(path, &key, &data) {
@@ -232,7 +255,6 @@ impl GpuContext {
                 }
             }
         }
-        Ok(kernels)
     }
 }
 

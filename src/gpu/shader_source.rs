@@ -17,7 +17,7 @@ enum Shared {
 }
 
 /// Every importable name and its text.
-const SHARED: [(&str, Shared); 7] = [
+const SHARED: [(&str, Shared); 8] = [
     (
         "frame",
         Shared::File(include_str!("../../shaders/shared/frame.wgsl")),
@@ -39,6 +39,10 @@ const SHARED: [(&str, Shared); 7] = [
     (
         "pmvc_patches",
         Shared::File(include_str!("../../shaders/shared/pmvc_patches.wgsl")),
+    ),
+    (
+        "pmvc_no_patches",
+        Shared::File(include_str!("../../shaders/shared/pmvc_no_patches.wgsl")),
     ),
     ("cube_faces", Shared::Generated(cube_faces_wgsl)),
     ("bind_constants", Shared::Generated(bind_constants_wgsl)),

@@ -46,6 +46,19 @@ pub(super) trait Lanes: Copy {
     }
 }
 
+/// `[f(0), f(1), f(2), f(3)]`, always inlined: in `std::array::from_fn` the
+/// closure may stay a call, and an AVX2 instruction inside it a call too.
+#[inline(always)]
+pub(super) fn four<T>(f: impl Fn(usize) -> T) -> [T; 4] {
+    [f(0), f(1), f(2), f(3)]
+}
+
+/// [`four`] for six.
+#[inline(always)]
+pub(super) fn six<T>(f: impl Fn(usize) -> T) -> [T; 6] {
+    [f(0), f(1), f(2), f(3), f(4), f(5)]
+}
+
 /// Bit patterns as lanes, for masks and the hit key's code.
 #[inline(always)]
 pub(super) fn splat_bits<V: Lanes>(bits: u64) -> V {
@@ -64,12 +77,12 @@ impl Portable {
 
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        Self(self.0.map(f))
+        Self(four(|k| f(self.0[k])))
     }
 
     #[inline(always)]
     fn zip(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
-        Self(std::array::from_fn(|k| f(self.0[k], other.0[k])))
+        Self(four(|k| f(self.0[k], other.0[k])))
     }
 
     #[inline(always)]
@@ -86,7 +99,7 @@ impl Lanes for Portable {
     }
     #[inline(always)]
     fn load(values: &[f64]) -> Self {
-        Self(std::array::from_fn(|k| values[k]))
+        Self(four(|k| values[k]))
     }
     #[inline(always)]
     fn store(self, values: &mut [f64]) {
@@ -110,7 +123,7 @@ impl Lanes for Portable {
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
-        Self(std::array::from_fn(|k| self.0[k].mul_add(a.0[k], b.0[k])))
+        Self(four(|k| self.0[k].mul_add(a.0[k], b.0[k])))
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -150,7 +163,7 @@ impl Lanes for Portable {
     }
     #[inline(always)]
     fn select(self, if_set: Self, if_clear: Self) -> Self {
-        Self(std::array::from_fn(|k| {
+        Self(four(|k| {
             if self.0[k].is_sign_negative() {
                 if_set.0[k]
             } else {

@@ -422,15 +422,29 @@ fn pmvc_weights_with<const CULL: bool, const QUADS: bool, V: Lanes>(
         // linear in Ω·d̂, so each triangle needs only its sum.
         // As long as the mask, so that indexing by a masked code needs no check.
         let sums = &mut scratch.sums[..=code_mask];
-        for (keys, directions) in scratch.nearest[..texels]
-            .chunks_exact(BANKS)
-            .zip(table.texel_directions.chunks_exact(BANKS))
-        {
-            for bank in 0..BANKS {
-                let code = keys[bank].to_bits() as usize & code_mask;
-                let (s, d) = (sums[code][bank], directions[bank]);
-                // Whole arrays, so that this is one four-wide add.
-                sums[code][bank] = [s[0] + d[0], s[1] + d[1], s[2] + d[2], s[3] + d[3]];
+        if QUADS && scratch.drawn.is_empty() {
+            // Patches only: their resolve is their own; count the misses alone (in
+            // integers, which add four at a time), the padding's weightless texels not.
+            let missed: usize = scratch.nearest[..texels]
+                .iter()
+                .zip(&table.texel_directions)
+                .map(|(key, direction)| {
+                    let missed = key.to_bits() as usize & code_mask == 0;
+                    usize::from(missed & (direction[3] != 0.0))
+                })
+                .sum();
+            sums[0][0][3] += missed as f64;
+        } else {
+            for (keys, directions) in scratch.nearest[..texels]
+                .chunks_exact(BANKS)
+                .zip(table.texel_directions.chunks_exact(BANKS))
+            {
+                for bank in 0..BANKS {
+                    let code = keys[bank].to_bits() as usize & code_mask;
+                    let (s, d) = (sums[code][bank], directions[bank]);
+                    // Whole arrays, so that this is one four-wide add.
+                    sums[code][bank] = [s[0] + d[0], s[1] + d[1], s[2] + d[2], s[3] + d[3]];
+                }
             }
         }
         for &(t, edges) in &scratch.drawn {

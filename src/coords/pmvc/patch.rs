@@ -15,7 +15,7 @@
 
 use super::super::cubemap::{TexelTable, TEXEL_LANES};
 use super::frustum::FaceFrame;
-use super::lanes::{splat_bits, Lanes, Pair};
+use super::lanes::{four, six, splat_bits, Lanes, Pair};
 use glam::DVec3;
 use std::ops::Range;
 
@@ -159,7 +159,7 @@ impl PatchHits {
                 *sum = sum.add(held.and(share));
             }
         }
-        sums.map(V::sum)
+        four(|k| sums[k].sum())
     }
 }
 
@@ -184,10 +184,10 @@ impl<V: Lanes> Constants<V> {
     fn pair(&self) -> Constants<Pair<V>> {
         let both = |v: &V| Pair(*v, *v);
         Constants {
-            slopes: self.slopes.each_ref().map(both),
-            x: self.x.each_ref().map(both),
-            minus_z: self.minus_z.each_ref().map(both),
-            z: self.z.each_ref().map(both),
+            slopes: six(|k| both(&self.slopes[k])),
+            x: four(|k| both(&self.x[k])),
+            minus_z: four(|k| both(&self.minus_z[k])),
+            z: four(|k| both(&self.z[k])),
             scale: both(&self.scale),
             key_bits: both(&self.key_bits),
             code: both(&self.code),
@@ -205,8 +205,8 @@ impl<V: Lanes> Row<V> {
     #[inline(always)]
     fn new(values: &[f64; 10]) -> Self {
         Self {
-            offsets: std::array::from_fn(|k| V::splat(values[k])),
-            y: std::array::from_fn(|k| V::splat(values[6 + k])),
+            offsets: six(|k| V::splat(values[k])),
+            y: four(|k| V::splat(values[6 + k])),
         }
     }
 
@@ -215,8 +215,8 @@ impl<V: Lanes> Row<V> {
     fn pair(first: &[f64; 10], second: &[f64; 10]) -> Row<Pair<V>> {
         let [first, second] = [Self::new(first), Self::new(second)];
         Row {
-            offsets: std::array::from_fn(|k| Pair(first.offsets[k], second.offsets[k])),
-            y: std::array::from_fn(|k| Pair(first.y[k], second.y[k])),
+            offsets: six(|k| Pair(first.offsets[k], second.offsets[k])),
+            y: four(|k| Pair(first.y[k], second.y[k])),
         }
     }
 }
@@ -258,10 +258,10 @@ impl FacePatch {
         let [l1, m1, r1] = self.along_v;
         let corners = [self.origin, self.edge_u, self.edge_v, self.twist];
         Constants {
-            slopes: [l0.x, m0.x, r0.x, l1.x, m1.x, r1.x].map(V::splat),
-            x: corners.map(|k| V::splat(k.x)),
-            minus_z: corners.map(|k| V::splat(-k.z)),
-            z: corners.map(|k| V::splat(k.z)),
+            slopes: six(|k| V::splat([l0.x, m0.x, r0.x, l1.x, m1.x, r1.x][k])),
+            x: four(|k| V::splat(corners[k].x)),
+            minus_z: four(|k| V::splat(-corners[k].z)),
+            z: four(|k| V::splat(corners[k].z)),
             scale: V::splat(self.scale),
             key_bits: splat_bits(!(self.code_mask as u64)),
             code: splat_bits(self.code),
@@ -293,7 +293,7 @@ impl FacePatch {
     /// The six Bernstein coefficient functions at the rays `(s, r, 1)` of a group.
     #[inline(always)]
     fn coefficients<V: Lanes>(c: &Constants<V>, row: &Row<V>, s: V) -> [V; 6] {
-        std::array::from_fn(|k| s.mul_add(c.slopes[k], row.offsets[k]))
+        six(|k| s.mul_add(c.slopes[k], row.offsets[k]))
     }
 
     /// Whether a lane of the group may hit the patch: a polynomial whose Bernstein
@@ -318,7 +318,7 @@ impl FacePatch {
         let discriminant = beta.mul_add(beta, alpha.mul(V::splat(-4.0)).mul(gl));
         let root = discriminant.max(zero).sqrt();
         let q = beta.and(sign).or(root).add(beta).mul(V::splat(-0.5));
-        let x: [V; 4] = std::array::from_fn(|k| s.mul_add(c.minus_z[k], c.x[k]));
+        let x = four(|k| s.mul_add(c.minus_z[k], c.x[k]));
         let hit = self.hit(c, row, &x, gl, q, discriminant);
         // q/α lies in [0, 1] only on a patch bent enough to be met twice.
         let along = q.mul(alpha);

@@ -119,6 +119,9 @@ impl<'a> GpuBind<'a> {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
         let topology = topology(&cage, kernel, resolution, rows);
+        if topology.corners == 4 {
+            context.pmvc_quads()?;
+        }
         // Corner sums per primitive, for the whole sphere and for the current band.
         let sums_per_row = if kernel == Kernel::Pmvc {
             2 * topology.corners * topology.primitives()
@@ -439,7 +442,7 @@ impl<'a> GpuBind<'a> {
                     let groups = match self.kernel {
                         Kernel::Pmvc => {
                             pass.set_pipeline(if self.patches {
-                                &kernels.pmvc_quads
+                                self.context.pmvc_quads()?
                             } else {
                                 &kernels.pmvc
                             });
