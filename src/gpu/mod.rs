@@ -8,7 +8,9 @@
 //! - [`backend_choice`]: where a bind runs (`auto`, `cpu`, `gpu`), one rule for the
 //!   command line, Python and the editor, with `auto`'s cost model.
 //! - [`pipeline_cache`]: the compiled kernels kept on disk between runs.
-//! - Kernels in `shaders/bind_pmvc.wgsl` and `shaders/bind_mvc.wgsl`.
+//! - Kernels in `shaders/bind_pmvc.wgsl` (quads as bilinear patches through
+//!   `shaders/shared/pmvc_patches.wgsl`), `shaders/bind_mvc.wgsl` (triangles
+//!   only: MVC on quads is QMVC, bound on the CPU) and `shaders/bind_green.wgsl`.
 
 pub mod backend_choice;
 mod binder;

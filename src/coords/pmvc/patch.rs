@@ -251,6 +251,11 @@ pub(super) struct Hit<V> {
 
 const SIGN: u64 = 1 << 63;
 
+/// How far outside [0, 1] a patch's u and v may round and still count as on it:
+/// far above the solve's rounding, far below a texel (the hit is clamped onto the
+/// patch, so its weight moves by about this much).
+const RANGE_SLACK: f64 = 1e-10;
+
 impl FacePatch {
     #[inline(always)]
     fn constants<V: Lanes>(&self) -> Constants<V> {
@@ -364,16 +369,25 @@ impl FacePatch {
         // d·depth = d⁴·t·(B·B): positive exactly when t > 0.
         let signed = d.mul(depth);
         let (nd, dd) = (n.mul(d), d.mul(d));
-        let below = denominator.sub(numerator);
-        // u = n/d in [0, 1], v in [0, 1] and a real root: no sign bit set.
-        let outside = nd.or(dd.sub(nd)).or(numerator).or(below).or(discriminant);
+        // u = n/d and v in [−ε, 1 + ε] (ε = RANGE_SLACK) and a real root: no sign bit
+        // set. A ray along the edge two patches share may round to just outside
+        // both; with the slack both take it, and the depth test picks one.
+        let slack = V::splat(RANGE_SLACK);
+        let outside = slack
+            .mul_add(dd, nd)
+            .or(slack.mul_add(dd, dd.sub(nd)))
+            .or(slack.mul_add(denominator, numerator))
+            .or(slack.mul_add(denominator, denominator.sub(numerator)))
+            .or(discriminant);
         let inverse = one.div(signed);
         let factor = dd.mul(inverse.mul(c.scale));
         let key = factor.mul(denominator).and(c.key_bits).or(c.code);
+        // v·(B·B), clamped into [0, B·B] as u into [0, 1].
+        let numerator = numerator.max(zero).min(denominator);
         Hit {
             key: outside.select(zero, key).and(signed.greater(zero)),
             u: n.mul(depth).mul(inverse).max(zero).min(one),
-            below: factor.mul(below),
+            below: factor.mul(denominator.sub(numerator)),
             above: factor.mul(numerator),
         }
     }

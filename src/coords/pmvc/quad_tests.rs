@@ -350,3 +350,33 @@ fn every_code_path_gives_identical_quad_weights() {
         }
     }
 }
+
+/// Points placed so that whole columns of texel rays run exactly along the edges
+/// two patches of a cube share (x = 1 − s·(1 − z) for a texel centre s), where each
+/// patch's solve may put the ray just outside it: the rays must still be caught
+/// (linear precision to rounding) and the weights must be the definition's.
+#[test]
+fn rays_along_shared_patch_edges_are_caught() {
+    let cage = cube_of_quads();
+    for resolution in [8, 16] {
+        let table = TexelTable::new(resolution);
+        for i in [resolution / 2, resolution / 2 + 1, resolution - 2] {
+            let s = texel_centre(i, resolution);
+            for (y, z) in [(0.0, 0.0), (0.3, -0.25), (-0.5, 0.5)] {
+                let x = DVec3::new(1.0 - s * (1.0 - z), y, z);
+                let expected = ray_cast_quad_pmvc(x, &cage, resolution);
+                for weights in both_weights(x, &cage, &table) {
+                    let reproduced: DVec3 = weights
+                        .iter()
+                        .zip(cage.positions())
+                        .map(|(&w, &v)| w * v)
+                        .sum();
+                    let precision = reproduced.distance(x) / cage.diagonal();
+                    assert!(precision < 1e-12, "R={resolution} x={x}: {precision:e}");
+                    let worst = worst_difference(&expected, &weights);
+                    assert!(worst < 1e-9, "R={resolution} x={x}: off by {worst:e}");
+                }
+            }
+        }
+    }
+}

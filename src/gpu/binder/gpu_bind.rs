@@ -12,8 +12,9 @@ use glam::DVec3;
 use std::time::Instant;
 
 /// Largest share of the device limits one batch buffer may take. PMVC keeps 6 floats
-/// per cage triangle per row, so a 3,000-triangle cage fits about 3,600 rows: few
-/// enough batches that their round trips stay a small part of a bind.
+/// per cage triangle per row (8 per patch or triangle on a cage with quads), so a
+/// 3,000-triangle cage fits about 3,600 rows: few enough batches that their round
+/// trips stay a small part of a bind.
 const MAX_BATCH_BUFFER_BYTES: u64 = 256 << 20;
 
 /// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
