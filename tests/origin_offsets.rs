@@ -28,9 +28,15 @@ fn cage_at(cage: &Cage, offset: f64) -> Cage {
     let (shifted, report) = Cage::new(TriMesh {
         positions: shift(cage.positions(), offset),
         triangles: cage.triangles().to_vec(),
-        triangle_faces: Vec::new(),
+        // The faces keep the quads: without them the shifted cage would be split.
+        triangle_faces: cage.triangle_faces().to_vec(),
     })
     .unwrap_or_else(|e| panic!("offset {offset}: {e}"));
+    assert_eq!(
+        shifted.quads().len(),
+        cage.quads().len(),
+        "offset {offset}: quads lost"
+    );
     assert!(
         !report.flipped,
         "offset {offset}: an outward cage was flipped"

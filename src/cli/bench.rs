@@ -266,14 +266,16 @@ fn bench_scene_split(
         for &(method, resolution, quads) in configurations {
             // A family without a GPU kernel binds on the CPU on every backend: its
             // CPU row says all there is.
-            let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
-            if gpu_backend && crate::gpu::kernels::Kernel::of(method).is_none() {
-                continue;
-            }
             let mut options = BindOptions {
                 quads,
                 ..BindOptions::for_method(method)
             };
+            // MVC on quads is QMVC, which has no GPU kernel either.
+            let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
+            let kernel = crate::gpu::kernels::Kernel::for_cage(method, &options.cage_to_bind(cage));
+            if gpu_backend && kernel.is_none() {
+                continue;
+            }
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
             }

@@ -94,7 +94,8 @@ pub(super) fn correct_class(
                 barycentric,
             };
         }
-        let on_a_half = matches!(first, PointClass::OnSurface { triangle, .. } if halves.contains(&triangle));
+        let on_a_half =
+            matches!(first, PointClass::OnSurface { triangle, .. } if halves.contains(&triangle));
         // Near the patch, closer than the pillow grid follows it, the side of
         // the patch decides; farther, the pillow's winding number.
         if on_a_half || offset.length() < quad.near {
@@ -138,7 +139,7 @@ fn pillow_winding(
         .sum();
     let split: f64 = halves
         .iter()
-        .map(|&t| solid(cage.triangle(t as usize)))
+        .map(|&t| solid(cage.triangle(t as usize).map(|p| p - centre)))
         .sum();
     (patch - split) / (4.0 * std::f64::consts::PI)
 }

@@ -250,6 +250,15 @@ pub(crate) fn find_patch_crossing(
     quads: &[CageQuad],
     diagonal: f64,
 ) -> Option<[usize; 2]> {
+    // Relative to the cage's box, so that the grids and the orientation tests
+    // round the same wherever the cage is.
+    let (low, high) = positions.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(low, high), &p| (low.min(p), high.max(p)),
+    );
+    let centre = 0.5 * (low + high);
+    let local: Vec<DVec3> = positions.iter().map(|&p| p - centre).collect();
+    let positions = local.as_slice();
     let flat = 1e-9 * diagonal;
     let bent: Vec<&CageQuad> = quads
         .iter()

@@ -303,8 +303,10 @@ fn autocage_error(cause: &autocage::AutoCageError) -> PyErr {
 /// argument), ``name``, ``summary``, ``parameters`` (each with ``id``,
 /// ``label``, ``default``, ``min``, ``max`` and the editor's ``choices``),
 /// ``positive_inside`` (whether weights inside the cage are never negative),
-/// ``outside_policy``, ``columns_layout`` and ``gpu_kernel`` (whether
-/// ``backend="gpu"`` runs it on the GPU; otherwise it binds on the CPU).
+/// ``outside_policy``, ``columns_layout``, ``gpu_kernel`` (whether
+/// ``backend="gpu"`` runs it on the GPU on a cage of triangles; otherwise it
+/// binds on the CPU) and ``gpu_kernel_quads`` (the same on a cage whose quads
+/// the family binds as bilinear patches: MVC there is QMVC, CPU only).
 #[pyfunction]
 pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let list = PyList::empty(py);
@@ -331,7 +333,12 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
         family.set_item("columns_layout", columns_layout(spec.columns))?;
         family.set_item(
             "gpu_kernel",
-            crate::gpu::kernels::Kernel::of(method).is_some(),
+            crate::gpu::kernels::Kernel::of_work(method, false).is_some(),
+        )?;
+        let on_quads = matches!(spec.quads, crate::coords::QuadSupport::Patches { .. });
+        family.set_item(
+            "gpu_kernel_quads",
+            crate::gpu::kernels::Kernel::of_work(method, on_quads).is_some(),
         )?;
         list.append(family)?;
     }

@@ -39,7 +39,7 @@ pub(super) trait Lanes: Copy {
     /// The sum of the lanes, in the same order in every implementation.
     #[inline(always)]
     fn sum(self) -> f64 {
-        let mut values = [0.0; 8];
+        let mut values = [0.0; 32];
         self.store(&mut values);
         let lanes = &values[..Self::ALL.count_ones() as usize];
         lanes.iter().fold(0.0, |sum, value| sum + value)
@@ -193,19 +193,21 @@ impl<V: Lanes> Pair<V> {
 }
 
 impl<V: Lanes> Lanes for Pair<V> {
-    const ALL: u32 = V::ALL | (V::ALL << 4);
+    const ALL: u32 = V::ALL | (V::ALL << V::ALL.count_ones());
     #[inline(always)]
     fn splat(value: f64) -> Self {
         Self(V::splat(value), V::splat(value))
     }
     #[inline(always)]
     fn load(values: &[f64]) -> Self {
-        Self(V::load(values), V::load(&values[4..]))
+        let half = V::ALL.count_ones() as usize;
+        Self(V::load(values), V::load(&values[half..]))
     }
     #[inline(always)]
     fn store(self, values: &mut [f64]) {
+        let half = V::ALL.count_ones() as usize;
         self.0.store(values);
-        self.1.store(&mut values[4..]);
+        self.1.store(&mut values[half..]);
     }
     #[inline(always)]
     fn add(self, other: Self) -> Self {
@@ -272,7 +274,7 @@ impl<V: Lanes> Lanes for Pair<V> {
     }
     #[inline(always)]
     fn signs(self) -> u32 {
-        self.0.signs() | (self.1.signs() << 4)
+        self.0.signs() | (self.1.signs() << V::ALL.count_ones())
     }
 }
 

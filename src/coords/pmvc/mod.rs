@@ -26,10 +26,13 @@
 //!
 //! A cage with quads keeps each as one bilinear patch ([`patch`]): its lone
 //! triangles are drawn as above, and its patches solved exactly per texel into the
-//! same depth buffer, so that triangles and patches compete for each ray. A patch's
-//! hit spreads `Ω/t` by the bilinear basis, which is not linear in `Ω·d̂`, so each
-//! texel a patch wins keeps its u and `(1 − v)/t`, `v/t` for the resolve. A cage of
-//! triangles only takes the triangle code alone.
+//! same depth buffer (keys as the triangles'), so that triangles and patches compete
+//! for each ray. A patch's hit spreads `Ω/t` by the bilinear basis, which is not
+//! linear in `Ω·d̂`, so each texel a patch wins keeps its u and `(1 − v)/t`, `v/t`,
+//! and the patch's weights are summed over the texel groups it was drawn on. Inside
+//! points skip a patch only when x is on the outer side of its tangent planes at
+//! all four corners, which bound the whole patch (see [`PatchSetup::corner_sides`]).
+//! A cage of triangles only takes the triangle code alone, unchanged.
 
 mod frustum;
 mod lanes;

@@ -7,8 +7,12 @@
 //! coefficients `d·(q0×q3)`, `d·(q0×q2 + q1×q3)`, `d·(q1×q2)` are linear in the texel
 //! coordinates, like a triangle's edge functions. Where they all have one sign no
 //! root lies in [0, 1] (likewise for v), which rejects most texels outside the patch
-//! cheaply. Otherwise both roots are solved (in the stable form) and v found along
-//! the segment; a ray that meets a bent patch twice keeps the nearer hit.
+//! cheaply: those groups of texels are listed first, then solved. Each root of g
+//! (in the stable form) gives v along its segment by least squares and t; a ray
+//! that meets a bent patch twice keeps the nearer hit. The solve is written once
+//! over [`Lanes`], for the portable and the AVX2 code alike, and runs two texel
+//! groups side by side ([`Pair`]) so that their chains through a square root and a
+//! division overlap.
 //!
 //! A hit weighs `Ω/t` spread by the bilinear basis; each texel stores u and
 //! `(1 − v)/t`, `v/t`, so the resolve needs no division.

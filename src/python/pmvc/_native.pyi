@@ -181,7 +181,7 @@ def generate_cage(
 
 def families() -> List[Dict[str, Any]]:
     """Every family: id, name, summary, parameters, positive_inside,
-    outside_policy, columns_layout, gpu_kernel."""
+    outside_policy, columns_layout, gpu_kernel, gpu_kernel_quads."""
     ...
 
 def save_weights(path: Path, weights: Weights) -> None:
