@@ -84,6 +84,9 @@ fn the_quads_setting_splits_them_rebinds_and_is_kept_by_a_session() {
     let patch_weights = patches.weights.clone();
     // The setting is in the side panel, only for a cage with quads.
     harness.get_by_label("Quads");
+    // The quality table names what was bound: MVC on quads is QMVC.
+    assert!(harness.state().document().bound(Method::Mvc).is_some());
+    assert!(harness.query_all_by_label("QMVC").next().is_some());
 
     harness
         .state_mut()
@@ -103,7 +106,11 @@ fn the_quads_setting_splits_them_rebinds_and_is_kept_by_a_session() {
         largest_change > 1e-3,
         "the split changed the weights by {largest_change}"
     );
-    // The side panel says how the quads are bound.
+    // The quality table names the split; the side panel says how quads are bound.
+    assert!(harness
+        .query_all_by_label("PMVC (longer split)")
+        .next()
+        .is_some());
     let quads = harness.get_by_label("Quads").value();
     assert_eq!(quads.as_deref(), Some("split: longer diagonal"));
 

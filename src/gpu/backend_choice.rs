@@ -192,6 +192,30 @@ struct FamilyCosts {
     cpu: PointCost,
     discrete: PointCost,
     software_vs_cpu: f64,
+    /// A cage of bilinear patches' time per point against the same cage split,
+    /// on the CPU path and on a GPU (1 where quads are never patches here).
+    patches_vs_split: Patches,
+}
+
+/// Time per point on patches ÷ on the split cage.
+#[derive(Clone, Copy, Debug)]
+struct Patches {
+    cpu: f64,
+    gpu: f64,
+}
+
+impl Patches {
+    const NONE: Patches = Patches { cpu: 1.0, gpu: 1.0 };
+
+    /// `ratio` scaled by the share of the cage's triangles that are halves of
+    /// patches, so that a cage with a few quads costs nearly its split.
+    fn factor(ratio: f64, work: &Work) -> f64 {
+        if work.cage_triangles == 0 {
+            return 1.0;
+        }
+        let share = (2 * work.cage_quads) as f64 / work.cage_triangles as f64;
+        1.0 + (ratio - 1.0) * share.min(1.0)
+    }
 }
 
 // The model's coefficients, all in one place; recalibrate here when a kernel
@@ -221,6 +245,10 @@ const COSTS: [FamilyCosts; 3] = [
             per_triangle: 0.0025,
         },
         software_vs_cpu: 13.5,
+        // `pmvc bench` on the 2-core machine, 2026-11-28 (docs/benchmarks.md):
+        // CPU 2.2-3.6 (Ogre, FireHydrant, ManHead), lavapipe 1.64 (ManHead).
+        // No hardware GPU measured yet: taken as lavapipe's.
+        patches_vs_split: Patches { cpu: 3.0, gpu: 1.6 },
     },
     FamilyCosts {
         kernel: Kernel::Mvc,
@@ -237,6 +265,7 @@ const COSTS: [FamilyCosts; 3] = [
         // Measured 0.73 in one run ("about as fast on either"); taken as 1 so
         // that a tie stays on the CPU path, whose cores lavapipe would share.
         software_vs_cpu: 1.0,
+        patches_vs_split: Patches::NONE,
     },
     FamilyCosts {
         kernel: Kernel::Green,
@@ -251,6 +280,7 @@ const COSTS: [FamilyCosts; 3] = [
             per_triangle: 0.0056,
         },
         software_vs_cpu: 1.0,
+        patches_vs_split: Patches::NONE,
     },
 ];
 
@@ -342,7 +372,9 @@ pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
     };
     let points = work.points as f64;
     let threads = (work.cpu_threads.max(1) as f64).powf(CPU_THREAD_EXPONENT);
-    let cpu_s = points * costs.cpu.micros(work) * 1e-6 / threads;
+    let cpu_patches = Patches::factor(costs.patches_vs_split.cpu, work);
+    let gpu_patches = Patches::factor(costs.patches_vs_split.gpu, work);
+    let cpu_s = cpu_patches * points * costs.cpu.micros(work) * 1e-6 / threads;
     let (cold, warm) = match gpu.class {
         AdapterClass::Software => COMPILE_SOFTWARE_S,
         _ => COMPILE_HARDWARE_S,
@@ -352,12 +384,11 @@ pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
         Pipelines::CacheHit => warm,
         Pipelines::Cold => cold,
     };
+    let gpu_points = gpu_patches * points * costs.discrete.micros(work) * 1e-6;
     let run_s = match gpu.class {
-        AdapterClass::Discrete => GPU_BIND_FIXED_S + points * costs.discrete.micros(work) * 1e-6,
-        AdapterClass::Integrated => {
-            GPU_BIND_FIXED_S + INTEGRATED_VS_DISCRETE * points * costs.discrete.micros(work) * 1e-6
-        }
-        AdapterClass::Software => costs.software_vs_cpu * cpu_s,
+        AdapterClass::Discrete => GPU_BIND_FIXED_S + gpu_points,
+        AdapterClass::Integrated => GPU_BIND_FIXED_S + INTEGRATED_VS_DISCRETE * gpu_points,
+        AdapterClass::Software => costs.software_vs_cpu * cpu_s * gpu_patches / cpu_patches,
     };
     Prediction {
         cpu_s: Some(cpu_s),

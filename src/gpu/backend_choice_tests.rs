@@ -185,3 +185,32 @@ fn work_counts_the_quads_a_family_binds_as_patches() {
     let green = Work::of(BindOptions::for_method(Method::Green), 10, &cage);
     assert_eq!((green.cage_quads, green.kernel()), (0, Some(Kernel::Green)));
 }
+
+#[test]
+fn patches_cost_the_cpu_more_than_the_gpu_so_the_gpu_wins_sooner() {
+    let ready = device(AdapterClass::Discrete, Pipelines::Ready);
+    // A 110-vertex cage on two threads, few enough points that its split binds
+    // on the CPU.
+    let split = work(Method::Pmvc, 600, 110, 2);
+    let patches = Work {
+        cage_quads: split.cage_triangles / 2,
+        ..split
+    };
+    let (on_split, on_patches) = (predict(&split, &ready), predict(&patches, &ready));
+    assert!(!on_split.gpu_wins(), "{}", on_split.explain());
+    assert!(on_patches.gpu_wins(), "{}", on_patches.explain());
+    let cpu_ratio = on_patches.cpu_s.unwrap() / on_split.cpu_s.unwrap();
+    assert!((cpu_ratio - 3.0).abs() < 1e-9, "{cpu_ratio}");
+    // A few quads among many triangles cost nearly the split.
+    let few = Work {
+        cage_quads: 2,
+        ..split
+    };
+    let few_ratio = predict(&few, &ready).cpu_s.unwrap() / on_split.cpu_s.unwrap();
+    assert!(few_ratio < 1.05, "{few_ratio}");
+    // A software adapter pays lavapipe's ratio, not the CPU path's.
+    let software = device(AdapterClass::Software, Pipelines::Ready);
+    let gpu = |w: &Work| predict(w, &software).gpu_s.unwrap();
+    let software_ratio = gpu(&patches) / gpu(&split);
+    assert!((software_ratio - 1.6).abs() < 1e-9, "{software_ratio}");
+}

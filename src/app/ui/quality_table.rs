@@ -48,8 +48,12 @@ pub fn quality_table(ui: &mut egui::Ui, cx: &PanelContext) {
         .striped(true)
         .show(ui, |ui| {
             ui.label("");
-            for method in &methods {
-                ui.strong(method.name());
+            // The name of what was bound: QMVC for MVC on quads, "(shorter split)".
+            for &method in &methods {
+                let name = document.bound(method).map_or(method.name().into(), |set| {
+                    set.options.family_name(document.cage())
+                });
+                ui.strong(name);
             }
             ui.end_row();
             for (name, value) in ROWS {
