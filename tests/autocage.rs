@@ -168,32 +168,8 @@ fn comb() -> TriMesh {
     ))
 }
 
-/// A torus around z: major radius 1, tube radius 0.35, outward-facing.
 fn torus() -> TriMesh {
-    let (around, tube) = (48u32, 20u32);
-    let mut positions = Vec::new();
-    for i in 0..around {
-        for j in 0..tube {
-            let (u, v) = (
-                2.0 * PI * i as f64 / around as f64,
-                2.0 * PI * j as f64 / tube as f64,
-            );
-            let r = 1.0 + 0.35 * v.cos();
-            positions.push(DVec3::new(r * u.cos(), r * u.sin(), 0.35 * v.sin()));
-        }
-    }
-    let at = |i: u32, j: u32| (i % around) * tube + j % tube;
-    let mut triangles = Vec::new();
-    for i in 0..around {
-        for j in 0..tube {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            triangles.extend([[a, b, c], [a, c, d]]);
-        }
-    }
-    if signed_volume(&positions, &triangles) < 0.0 {
-        triangles.iter_mut().for_each(|t| t.swap(1, 2));
-    }
-    mesh(positions, triangles)
+    common::torus_mesh()
 }
 
 /// Two unit spheres on the x axis whose surfaces are `gap` apart.

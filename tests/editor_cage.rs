@@ -393,3 +393,36 @@ fn a_generated_cage_is_unsaved_work_that_quitting_and_opening_ask_about() {
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("\"inline\""), "the cage is in the session");
 }
+
+/// The Quads box pairs the proposal's triangles into quads, which the editor
+/// then binds as bilinear patches.
+#[test]
+fn the_quads_box_proposes_a_cage_with_quads_that_binds_as_patches() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    choose_in_file_menu(&mut harness, "Generate cage…");
+    harness.state_mut().cage_generation_mut().target_vertices = 60;
+    assert!(!harness.state().cage_generation().options().quads);
+    harness.get_by_label("where they fit").click();
+    harness.run_steps(2);
+    assert!(harness.state().cage_generation().options().quads);
+    click_button(&mut harness, "Generate");
+    run_until_generated(&mut harness);
+    let quads = {
+        let proposal = harness
+            .state()
+            .cage_generation()
+            .proposal()
+            .expect("a proposal");
+        proposal.generated.cage.quads().len()
+    };
+    assert!(quads > 0, "no quads proposed");
+    harness.get_by_label_contains(&format!("{quads} quads and "));
+    click_button(&mut harness, "Use this cage");
+    run_until_bound(&mut harness);
+    let document = harness.state().document();
+    assert_eq!(document.cage().quads().len(), quads);
+    let method = harness.state().active_method();
+    let bound = document.bound(method).expect("bound");
+    assert_eq!(bound.options.quads, pmvc::coords::QuadSplit::None);
+}

@@ -39,6 +39,8 @@ pub struct CageGeneration {
     pub clearance_percent: f64,
     /// Whether to ask for a voxel size (else the generator's default).
     pub use_cell_size: bool,
+    /// Pair triangles into quads where they fit (`CageOptions::quads`).
+    pub quads: bool,
     /// The voxel size, in % of the mesh's bounding-box diagonal.
     pub cell_size_percent: f64,
     state: State,
@@ -57,6 +59,7 @@ impl Default for CageGeneration {
             // The box shows, greyed, what the generator uses when it is off.
             clearance_percent: 100.0 * DEFAULT_CLEARANCE,
             use_cell_size: false,
+            quads: false,
             cell_size_percent: 100.0 * DEFAULT_CELL_SIZE,
             state: State::Idle { message: None },
         }
@@ -155,6 +158,7 @@ impl CageGeneration {
         CageOptions {
             clearance: self.use_clearance.then_some(self.clearance_percent / 100.0),
             cell_size: self.use_cell_size.then_some(self.cell_size_percent / 100.0),
+            quads: self.quads,
             ..CageOptions::new(self.target_vertices)
         }
     }
@@ -257,11 +261,19 @@ impl CageGeneration {
 /// The measured properties of a generated cage, one line each: what the CLI
 /// prints and the window shows. `seconds` is left out when timings are hidden.
 pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
+    let faces = if stats.quads > 0 {
+        format!(
+            "{} quads and {} triangles",
+            stats.quads,
+            stats.triangles - 2 * stats.quads
+        )
+    } else {
+        format!("{} triangles", stats.triangles)
+    };
     let mut lines = vec![format!(
-        "vertices: {} (target {}), {} triangles, {} shell{}",
+        "vertices: {} (target {}), {faces}, {} shell{}",
         stats.vertices,
         stats.target_vertices,
-        stats.triangles,
         stats.shells,
         if stats.shells == 1 { "" } else { "s" }
     )];

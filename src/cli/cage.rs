@@ -29,6 +29,11 @@ pub struct CageArgs {
     /// here is never coarsened, even when N is then missed.
     #[arg(long, value_name = "FRACTION")]
     pub cell_size: Option<f64>,
+    /// Pair triangles into near-planar, well-shaped quads where the quad's
+    /// bilinear patch keeps the clearance and every check; they are written as
+    /// quads (`f a b c d`).
+    #[arg(long)]
+    pub quads: bool,
 }
 
 pub(super) fn cage(args: &CageArgs) -> Result<()> {
@@ -37,6 +42,7 @@ pub(super) fn cage(args: &CageArgs) -> Result<()> {
     let options = CageOptions {
         clearance: args.clearance,
         cell_size: args.cell_size,
+        quads: args.quads,
         ..CageOptions::new(args.vertices)
     };
     // Options and the memory they need are checked before any file is made.
@@ -53,7 +59,8 @@ pub(super) fn cage(args: &CageArgs) -> Result<()> {
     bar.finish_and_clear();
     let generated = generated.map_err(|error| anyhow!("{}: {error}", shown_path(&args.mesh)))?;
     let cage = &generated.cage;
-    output.finish(|out| geometry::write_obj_to(out, cage.positions(), cage.triangles()))?;
+    output
+        .finish(|out| geometry::write_polygons_obj_to(out, cage.positions(), &cage.polygons()))?;
     say!(
         "wrote {}: a cage around {} ({} vertices, {} triangles)",
         shown_path(&args.out),

@@ -243,6 +243,26 @@ pub fn write_obj_to(
     Ok(())
 }
 
+/// [`write_obj_to`] with polygons (triangles and quads) as faces.
+pub fn write_polygons_obj_to(
+    out: &mut dyn Write,
+    positions: &[DVec3],
+    polygons: &[Vec<u32>],
+) -> std::io::Result<()> {
+    writeln!(out, "# written by pmvc")?;
+    for p in positions {
+        write_vertex(out, *p)?;
+    }
+    for polygon in polygons {
+        write!(out, "f")?;
+        for corner in polygon {
+            write!(out, " {}", corner + 1)?;
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
 /// Write a cage as the artist made it and its pose beside it: `rest_path` gets
 /// the rest positions and `posed_path` the pose, both with the polygons the
 /// cage was read with (quads stay quads), replaced together or not at all.

@@ -35,7 +35,7 @@ pub use error::{shown_path, CageError, CageLoadError, LoadError, WriteError};
 pub use intersect::{find_crossing, Crossing};
 pub use io::{
     cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, write_obj_to,
+    write_mesh_with_normals, write_obj, write_obj_to, write_polygons_obj_to,
 };
 pub use normals::vertex_normals;
 pub use output::{

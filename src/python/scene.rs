@@ -204,9 +204,12 @@ pub(super) fn classify<'py>(
 /// ``pmvc cage`` does. Returns ``(cage, report)``; ``report`` is a dict of what
 /// ``pmvc cage`` prints. ``clearance`` and ``cell_size`` are fractions of the
 /// mesh's bounding-box diagonal (None: chosen). ``progress``, if given, is
-/// called with ``(done, total)`` (thousandths). Ctrl-C cancels.
+/// called with ``(done, total)`` (thousandths). ``quads=True`` pairs triangles
+/// into quads (bilinear patches) where they fit, as ``pmvc cage --quads``.
+/// Ctrl-C cancels.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, target, clearance=None, cell_size=None, progress=None))]
+#[pyo3(signature = (vertices, faces, target, clearance=None, cell_size=None, progress=None, quads=false))]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments
 pub(super) fn generate_cage<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
@@ -215,6 +218,7 @@ pub(super) fn generate_cage<'py>(
     clearance: Option<f64>,
     cell_size: Option<f64>,
     progress: Option<Bound<'py, PyAny>>,
+    quads: bool,
 ) -> PyResult<(PyCage, Bound<'py, PyDict>)> {
     let target = usize::try_from(target).map_err(|_| {
         error(
@@ -231,6 +235,7 @@ pub(super) fn generate_cage<'py>(
     let options = CageOptions {
         clearance,
         cell_size,
+        quads,
         ..CageOptions::new(target)
     };
     autocage::plan_cage(&mesh, &options).map_err(|cause| autocage_error(&cause))?;
@@ -254,6 +259,7 @@ pub(super) fn generate_cage<'py>(
     let report = PyDict::new(py);
     report.set_item("vertices", stats.vertices)?;
     report.set_item("triangles", stats.triangles)?;
+    report.set_item("quads", stats.quads)?;
     report.set_item("target_vertices", stats.target_vertices)?;
     report.set_item("target_reached", stats.target_reached())?;
     report.set_item("shells", stats.shells)?;
@@ -277,7 +283,8 @@ pub(super) fn generate_cage<'py>(
         geometry::TriMesh {
             positions: generated.cage.positions().to_vec(),
             triangles: generated.cage.triangles().to_vec(),
-            triangle_faces: Vec::new(),
+            // Keeps the quads.
+            triangle_faces: generated.cage.triangle_faces().to_vec(),
         },
         None,
         py,

@@ -238,3 +238,45 @@ impl Random {
         (self.next() % n.max(1) as u64) as usize
     }
 }
+
+/// A torus around z: major radius 1, tube radius 0.35, 48 × 20 quads split in
+/// two, outward-facing.
+pub fn torus_mesh() -> pmvc::geometry::TriMesh {
+    use glam::DVec3;
+    use std::f64::consts::PI;
+    let (around, tube) = (48u32, 20u32);
+    let mut positions = Vec::new();
+    for i in 0..around {
+        for j in 0..tube {
+            let (u, v) = (
+                2.0 * PI * f64::from(i) / f64::from(around),
+                2.0 * PI * f64::from(j) / f64::from(tube),
+            );
+            let r = 1.0 + 0.35 * v.cos();
+            positions.push(DVec3::new(r * u.cos(), r * u.sin(), 0.35 * v.sin()));
+        }
+    }
+    let at = |i: u32, j: u32| (i % around) * tube + j % tube;
+    let mut triangles = Vec::new();
+    for i in 0..around {
+        for j in 0..tube {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            triangles.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    let volume: f64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            a.dot(b.cross(c))
+        })
+        .sum();
+    if volume < 0.0 {
+        triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    pmvc::geometry::TriMesh {
+        positions,
+        triangles,
+        triangle_faces: Vec::new(),
+    }
+}

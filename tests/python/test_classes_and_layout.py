@@ -146,6 +146,16 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert calls[0] == 0 and calls[-1] == 1000 and calls == sorted(calls)
 
 
+def test_generate_cage_with_quads_keeps_them_in_the_cage(comb_points):
+    _, faces = pmvc.load_mesh(pmvc_assets() / "comb_mesh.obj")
+    cage, report = pmvc.generate_cage(comb_points, faces, target=60, quads=True)
+    assert report["quads"] > 0 and report["quads"] == len(cage.quads)
+    assert report["outside_vertices"] == 0
+    assert (pmvc.classify(comb_points, cage) == pmvc.INSIDE).all()
+    _, triangles = pmvc.generate_cage(comb_points, faces, target=60)
+    assert triangles["quads"] == 0
+
+
 def pmvc_assets():
     from conftest import ASSETS
 

@@ -75,6 +75,10 @@ fn contents(
                         &mut generation.cell_size_percent,
                         (0.2, 20.0),
                     );
+                    ui.label("Quads");
+                    ui.checkbox(&mut generation.quads, "where they fit")
+                        .on_hover_text("Pair triangles into near-planar, near-square quads (bilinear patches) wherever a quad keeps the clearance and every check");
+                    ui.end_row();
                 });
         });
     if let Some(fraction) = generation.progress() {

@@ -30,6 +30,7 @@
 mod checks;
 mod guard;
 mod measure;
+mod pairing;
 mod plan;
 mod points;
 mod shrink;
@@ -57,6 +58,9 @@ pub struct CageOptions {
     /// Voxel size, as a fraction of the diagonal. `None` picks one from the
     /// mesh's size and the target. Parts closer than about three voxels merge.
     pub cell_size: Option<f64>,
+    /// Pair triangles into near-planar, well-shaped quads (bilinear patches)
+    /// where that keeps every guarantee.
+    pub quads: bool,
 }
 
 impl CageOptions {
@@ -65,6 +69,7 @@ impl CageOptions {
             target_vertices,
             clearance: None,
             cell_size: None,
+            quads: false,
         }
     }
 }
@@ -87,6 +92,8 @@ pub struct GeneratedCage {
 pub struct CageStats {
     pub vertices: usize,
     pub triangles: usize,
+    /// Quads among the faces (with `quads` asked for); the rest are triangles.
+    pub quads: usize,
     pub target_vertices: usize,
     /// Connected parts of the cage (separate solids).
     pub shells: usize,
@@ -341,6 +348,7 @@ pub fn generate_cage(
     let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
     let request = Request {
         target_vertices: target,
+        quads: options.quads.then_some((&mesh_points, clearance)),
         cell_size_chosen: chosen,
         cell_size_asked: plan.cell_size_asked,
         centre: plan.centre,
@@ -367,8 +375,10 @@ enum MeshVolume {
 }
 
 /// What was asked, and what finishing needs besides the attempt.
-struct Request {
+struct Request<'a> {
     target_vertices: usize,
+    /// With quads: the mesh's surface samples and the clearance they keep.
+    quads: Option<(&'a points::PointTree, f64)>,
     cell_size_chosen: bool,
     cell_size_asked: Option<f64>,
     /// Where the centred cage goes back to.
@@ -487,14 +497,23 @@ fn finish(
         ..
     } = attempt;
     let reach = f64::from(simplified.envelope_limit) * cell;
-    let triangle_faces = (0..simplified.triangles.len() as u32).collect();
-    let (cage, report) = Cage::new(TriMesh {
-        positions: simplified.positions,
-        triangles: simplified.triangles,
-        triangle_faces,
-    })
+    let (cage, report) = match request.quads {
+        Some((samples, clearance)) => {
+            let triangles = &simplified.triangles;
+            pairing::quad_cage(simplified.positions, triangles, samples, clearance)
+        }
+        None => Cage::new(TriMesh {
+            triangle_faces: (0..simplified.triangles.len() as u32).collect(),
+            positions: simplified.positions,
+            triangles: simplified.triangles,
+        }),
+    }
     .map_err(AutoCageError::Invalid)?;
-    let enclosure = measure::enclosure(&cage, mesh);
+    let enclosure = if cage.has_quads() {
+        pairing::enclosure_on_patches(&cage, mesh)
+    } else {
+        measure::enclosure(&cage, mesh)
+    };
     if let Some(first) = enclosure.first_outside {
         return Err(AutoCageError::NotEnclosing {
             outside: enclosure.outside,
@@ -509,6 +528,7 @@ fn finish(
     let stats = CageStats {
         vertices: cage.vertex_count(),
         triangles: cage.triangle_count(),
+        quads: cage.quads().len(),
         target_vertices: request.target_vertices,
         shells: measure::shell_count(&cage),
         min_clearance: enclosure.min_clearance,

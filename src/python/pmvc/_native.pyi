@@ -174,9 +174,11 @@ def generate_cage(
     clearance: Optional[float] = None,
     cell_size: Optional[float] = None,
     progress: Optional[Progress] = None,
+    quads: bool = False,
 ) -> Tuple[Cage, Dict[str, Any]]:
     """A cage of about ``target`` vertices around a triangle mesh, and a dict
-    of what ``pmvc cage`` prints."""
+    of what ``pmvc cage`` prints; ``quads=True`` pairs triangles into quads
+    where they fit."""
     ...
 
 def families() -> List[Dict[str, Any]]:
