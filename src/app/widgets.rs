@@ -3,6 +3,7 @@
 //! come from [`super::compare`] and the colours from [`crate::render::colormap`].
 
 use super::compare::{HoverReadout, ValueRange, HOVER_TOP_WEIGHTS};
+use crate::coords::quality::NEGATIVE_TOLERANCE;
 use crate::render::colormap::{self, Scale};
 use crate::render::{Colouring, Shading};
 use egui::{Color32, Pos2, Rect, Stroke};
@@ -44,7 +45,11 @@ pub fn draw_colour_bar(
             format!("≤ {}", number(limit * 10f32.powf(-colormap::LOG_DECADES)))
         }
     };
-    let middle = format!("min {} · max {}", number(range.min), number(range.max));
+    let middle = format!(
+        "min {} · max {}",
+        measured(range.min, signed),
+        measured(range.max, signed)
+    );
     let width_of = |label: &str| {
         painter
             .layout_no_wrap(label.to_owned(), font.clone(), text)
@@ -146,6 +151,26 @@ pub fn draw_colour_bar(
     );
 }
 
+/// Distances below this share of the cage diagonal are the f32 rounding of the
+/// positions (about 1e-7 of their size), not a difference between methods.
+const DISTANCE_ROUNDING: f32 = 1e-6;
+
+/// A measured minimum or maximum on the colour bar, with rounding noise said to
+/// be below what the data resolves rather than printed as a number: weights
+/// within [`NEGATIVE_TOLERANCE`] of zero read "0.000", distances under
+/// [`DISTANCE_ROUNDING`] of the diagonal "< 1.00e-4%".
+fn measured(value: f32, signed: bool) -> String {
+    if signed && f64::from(value.abs()) < NEGATIVE_TOLERANCE {
+        short(0.0)
+    } else if signed {
+        short(value)
+    } else if value.abs() < DISTANCE_ROUNDING {
+        format!("< {}", percent(DISTANCE_ROUNDING))
+    } else {
+        percent(value)
+    }
+}
+
 /// A fraction as a percentage with three significant digits ("0.100%").
 pub fn percent(fraction: f32) -> String {
     let value = fraction * 100.0;
@@ -185,4 +210,20 @@ pub fn hover_box(ui: &mut egui::Ui, readout: &HoverReadout) {
         ),
         None => ui.label("no negative weight"),
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::measured;
+
+    #[test]
+    fn rounding_noise_on_the_colour_bar_reads_as_below_resolution() {
+        // Two identical deformations differ by f64 cancellation only.
+        assert_eq!(measured(4.06e-19, false), "< 1.00e-4%");
+        assert_eq!(measured(0.0, false), "< 1.00e-4%");
+        assert_eq!(measured(2.5e-3, false), "0.250%");
+        assert_eq!(measured(-1e-9, true), "0.000");
+        assert_eq!(measured(-0.0132, true), "-0.013");
+        assert_eq!(measured(3e-4, true), "3.00e-4");
+    }
 }
