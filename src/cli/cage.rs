@@ -17,7 +17,8 @@ pub struct CageArgs {
     /// within ±15% of it unless the mesh's shape needs more or allows fewer.
     #[arg(long, value_name = "N")]
     pub vertices: usize,
-    /// Output cage as OBJ: closed, outward-facing triangles.
+    /// Output cage as OBJ: closed and outward-facing, of triangles (and quads
+    /// with --quads).
     #[arg(long, value_name = "C.obj")]
     pub out: PathBuf,
     /// The gap between the mesh and the cage, as a fraction of the mesh's
