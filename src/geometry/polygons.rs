@@ -59,19 +59,28 @@ pub fn polygons_of(mesh: &TriMesh) -> Vec<Vec<u32>> {
     if mesh.triangle_faces.len() != mesh.triangles.len() {
         return mesh.triangles.iter().map(|t| t.to_vec()).collect();
     }
-    let mut faces = Vec::new();
+    face_runs(&mesh.triangle_faces)
+        .map(|run| polygon(&mesh.triangles[run], &mesh.positions))
+        .collect()
+}
+
+/// The runs of consecutive triangles with the same face in `triangle_faces`:
+/// one range of triangle indices per polygon, in order.
+pub(crate) fn face_runs(
+    triangle_faces: &[u32],
+) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
     let mut start = 0;
-    while start < mesh.triangles.len() {
-        let face = mesh.triangle_faces[start];
+    std::iter::from_fn(move || {
+        let face = *triangle_faces.get(start)?;
         let end = start
-            + mesh.triangle_faces[start..]
+            + triangle_faces[start..]
                 .iter()
                 .take_while(|&&f| f == face)
                 .count();
-        faces.push(polygon(&mesh.triangles[start..end], &mesh.positions));
+        let run = start..end;
         start = end;
-    }
-    faces
+        Some(run)
+    })
 }
 
 /// The corners of the polygon that `triangulate_polygon` cut into `triangles`.

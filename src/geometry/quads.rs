@@ -111,15 +111,9 @@ pub(crate) fn find_quads(mesh: &TriMesh) -> (Vec<CageQuad>, usize) {
     if mesh.triangle_faces.len() != mesh.triangles.len() {
         return (quads, polygons);
     }
-    let mut start = 0;
-    while start < mesh.triangles.len() {
-        let face = mesh.triangle_faces[start];
-        let end = start
-            + mesh.triangle_faces[start..]
-                .iter()
-                .take_while(|&&f| f == face)
-                .count();
-        match end - start {
+    for run in super::polygons::face_runs(&mesh.triangle_faces) {
+        let (start, face) = (run.start, mesh.triangle_faces[run.start]);
+        match run.len() {
             1 => {}
             2 => {
                 let [first, second] = [mesh.triangles[start], mesh.triangles[start + 1]];
@@ -133,7 +127,6 @@ pub(crate) fn find_quads(mesh: &TriMesh) -> (Vec<CageQuad>, usize) {
             }
             _ => polygons += 1,
         }
-        start = end;
     }
     (quads, polygons)
 }

@@ -2,6 +2,7 @@
 //! Mouse and keyboard handling is in [`input`], handle and vertex picking in
 //! [`picking`].
 
+mod colour_bar;
 mod input;
 mod modal;
 mod picking;
@@ -10,10 +11,8 @@ pub use modal::{handles_without_partner, pose_transformed, transform_selection, 
 
 use super::cage_generation::{Proposal, PROPOSAL_GREEN};
 use super::compare::{HoverReadout, Pane};
-use super::document::Document;
 use super::views::{ViewportContext, Views};
-use super::widgets::{draw_colour_bar, BarNote};
-use crate::coords::Method;
+use super::widgets::draw_colour_bar;
 use crate::render::{
     Colouring, FrameParams, OrbitCamera, SceneOrigin, ScreenProjection, ViewportCallback, MAX_VIEWS,
 };
@@ -372,7 +371,7 @@ impl Views {
             let document = cx.model.document();
             if let Some(range) = self.value_range(document, shading.colouring, kind) {
                 let note = self.colour_bar_note(document, shading.colouring, kind);
-                let title = self.colour_bar_title(kind);
+                let title = self.colour_bar_title(document, kind);
                 draw_colour_bar(&painter, rect, &shading, range, title, note);
             }
         }
@@ -467,68 +466,6 @@ impl Views {
             Pane::Difference { against, shown } => {
                 format!("{against} vs {shown}: distance / cage diagonal")
             }
-        }
-    }
-
-    /// What the colour bar must also say: in the negativity view, that a family
-    /// does not promise positive weights and how many vertices are outside the cage (grey,
-    /// and why); for ψ, that it is signed or missing.
-    fn colour_bar_note(
-        &self,
-        document: &Document,
-        colouring: Colouring,
-        kind: Pane,
-    ) -> Option<BarNote> {
-        let outside = document.outside().len();
-        let method = kind.method();
-        let mut notes = Vec::new();
-        // The grey swatch goes with the first line, so the outside count leads.
-        let grey_swatch = colouring == Colouring::MostNegativeWeight && outside > 0;
-        if grey_swatch {
-            let policy = if method == Method::Green {
-                "exterior extension"
-            } else {
-                "MVC"
-            };
-            notes.push(format!(
-                "{outside} outside the cage ({policy} by policy), not counted"
-            ));
-        }
-        if colouring == Colouring::MostNegativeWeight && !method.spec().positive_inside {
-            notes.push(format!("{method} does not promise positive weights"));
-        }
-        if let Colouring::TriangleWeight(_) = colouring {
-            let has_triangle_columns =
-                method.columns(document.cage()) > method.vertex_columns(document.cage());
-            notes.push(if has_triangle_columns {
-                "ψ is signed: blue below 0, red above".to_owned()
-            } else {
-                format!("{method} has no ψ: shaded")
-            });
-        }
-        (!notes.is_empty()).then(|| BarNote {
-            text: notes.join("; "),
-            grey_swatch,
-        })
-    }
-
-    fn colour_bar_title(&self, kind: Pane) -> String {
-        let method = kind.method().name();
-        match (self.settings.colouring(kind), kind) {
-            (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
-            (Colouring::TriangleWeight(triangle), _) => format!("ψ{triangle} ({method})"),
-            (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
-            (Colouring::MethodDistance, Pane::Difference { .. }) => {
-                // The pane's title names the methods; the bar says how it scales.
-                match self.settings.difference_limit {
-                    Some(_) => "distance / cage diagonal · fixed scale".to_owned(),
-                    None => format!(
-                        "distance / cage diagonal · auto, ≥ {}",
-                        super::widgets::percent(super::compare::DIFFERENCE_FLOOR)
-                    ),
-                }
-            }
-            _ => String::new(),
         }
     }
 

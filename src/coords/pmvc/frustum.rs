@@ -35,55 +35,15 @@ pub(super) fn texel_bounds(
     local: &[DVec3; 3],
     table: &TexelTable,
 ) -> Option<(Range<usize>, Range<usize>)> {
-    let (mut u_min, mut u_max, mut v_min, mut v_max) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    let mut any_in_front = false;
-    for k in 0..3 {
-        let (p, q) = (local[k], local[(k + 1) % 3]);
-        if p.z > 0.0 {
-            any_in_front = true;
-            let (u, v) = (p.x / p.z, p.y / p.z);
-            u_min = u_min.min(u);
-            u_max = u_max.max(u);
-            v_min = v_min.min(v);
-            v_max = v_max.max(v);
-        }
-        if (p.z > 0.0) != (q.z > 0.0) {
-            // The edge crosses the face's plane: its projection runs off to infinity
-            // in the direction of the crossing point.
-            let s = p.z / (p.z - q.z);
-            let crossing = p + s * (q - p);
-            if crossing.x >= 0.0 {
-                u_max = f64::INFINITY;
-            }
-            if crossing.x <= 0.0 {
-                u_min = f64::NEG_INFINITY;
-            }
-            if crossing.y >= 0.0 {
-                v_max = f64::INFINITY;
-            }
-            if crossing.y <= 0.0 {
-                v_min = f64::NEG_INFINITY;
-            }
-        }
-    }
-    if !any_in_front || u_min > 1.0 || u_max < -1.0 || v_min > 1.0 || v_max < -1.0 {
-        return None;
-    }
-    Some((
-        index_range(u_min, u_max, table),
-        index_range(v_min, v_max, table),
-    ))
+    hull_texel_bounds(local, table)
 }
 
-/// [`texel_bounds`] of the convex hull of a patch's four corners, which holds the
-/// patch: its crossings of the face plane are those of all six corner pairs.
-pub(super) fn hull_texel_bounds(
-    local: &[DVec3; 4],
+/// [`texel_bounds`] of the convex hull of `local` (a triangle, or a patch's four
+/// corners, whose hull holds the patch): its crossings of the face plane are
+/// those of all pairs of corners (for a triangle, its edges).
+#[inline(always)]
+pub(super) fn hull_texel_bounds<const N: usize>(
+    local: &[DVec3; N],
     table: &TexelTable,
 ) -> Option<(Range<usize>, Range<usize>)> {
     let (mut u_min, mut u_max, mut v_min, mut v_max) = (
@@ -102,6 +62,8 @@ pub(super) fn hull_texel_bounds(
         }
         for q in &local[k + 1..] {
             if (p.z > 0.0) != (q.z > 0.0) {
+                // The segment crosses the face's plane: its projection runs off
+                // to infinity in the direction of the crossing point.
                 let crossing = *p + p.z / (p.z - q.z) * (*q - *p);
                 if crossing.x >= 0.0 {
                     u_max = f64::INFINITY;

@@ -326,28 +326,24 @@ fn pmvc_weights_with<const CULL: bool, const QUADS: bool, V: Lanes>(
     scratch.by_face.resize(6 * triangle_count, 0);
     let mut face_counts = [0; 6];
     let setups = &scratch.vertices;
+    let mut push = |vertices: &[u32; 3]| {
+        push_triangle::<CULL>(
+            vertices,
+            setups,
+            &mut scratch.triangles,
+            &mut scratch.by_face,
+            &mut face_counts,
+            triangle_count,
+        )
+    };
+    // A cage of triangles takes the plain loop, with no test per triangle.
     if QUADS {
         for t in cage.lone_triangles() {
-            let vertices = &cage.triangles()[t];
-            push_triangle::<CULL>(
-                vertices,
-                setups,
-                &mut scratch.triangles,
-                &mut scratch.by_face,
-                &mut face_counts,
-                triangle_count,
-            );
+            push(&cage.triangles()[t]);
         }
     } else {
         for vertices in cage.triangles() {
-            push_triangle::<CULL>(
-                vertices,
-                setups,
-                &mut scratch.triangles,
-                &mut scratch.by_face,
-                &mut face_counts,
-                triangle_count,
-            );
+            push(vertices);
         }
     }
     let (patch_face_counts, patch_count) = if QUADS {
