@@ -26,37 +26,24 @@
 
 #import bind_params
 #import bind_constants
+#import pmvc_bindings
+#import pmvc_face
 #import pmvc_patches
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
-const FAR: f32 = 1e30;
 // Corner slots per primitive: 3 on a cage of triangles, 4 on a cage with quads
 // (set per pipeline; the layout `topology` and `triangle_sums` follow).
 override CORNERS: u32 = 3u;
 
-@group(0) @binding(0) var<uniform> params: Params;
-// Cage vertices relative to the cage centre, xyz.
-@group(0) @binding(1) var<storage, read> cage_positions: array<vec4<f32>>;
-// CORNERS corners per primitive (NO_CORNER fills a triangle's fourth), then
-// incidence offsets (vertex_count + 1), then incident corners as t * CORNERS + corner.
-@group(0) @binding(2) var<storage, read> topology: array<u32>;
-// Ω/|d| per texel of one face (row-major, j is the row).
-@group(0) @binding(3) var<storage, read> texels: array<f32>;
-// xyz relative to the cage centre; w = output row within the batch.
-@group(0) @binding(4) var<storage, read> points: array<vec4<f32>>;
 // Per point: the CORNERS corner sums of every primitive, then their sums for the
 // current band.
 @group(0) @binding(5) var<storage, read_write> triangle_sums: array<f32>;
-@group(0) @binding(6) var<storage, read_write> weights: array<f32>;
-// Per point: 0, or FALLBACK when too many rays escaped (the CPU redoes the row).
-@group(0) @binding(7) var<storage, read_write> status: array<u32>;
 
 var<workgroup> nearest: array<atomic<u32>, BAND_TEXELS>;
 var<workgroup> nearest_triangle: array<atomic<u32>, BAND_TEXELS>;
 var<workgroup> missed: atomic<u32>;
 // Set when two triangles claim a texel of the band.
 var<workgroup> tied: atomic<u32>;
-var<workgroup> partial_totals: array<f32, WORKGROUP_SIZE>;
 // The band's shared triangles (more than SHARED_TEXELS texels in it), and the
 // invocations' sums over one of them.
 var<workgroup> shared_count: atomic<u32>;
@@ -67,17 +54,6 @@ var<workgroup> partial_sums: array<vec4<f32>, WORKGROUP_SIZE>;
 const SHARED_TEXELS: u32 = 128u;
 const MAX_SHARED: u32 = 64u;
 
-struct Triangle {
-    a: vec3<f32>,
-    b: vec3<f32>,
-    c: vec3<f32>,
-    // b×c, c×a, a×b: a ray direction dotted with these gives unnormalised barycentrics.
-    e0: vec3<f32>,
-    e1: vec3<f32>,
-    e2: vec3<f32>,
-    det: f32,
-}
-
 // A triangle's edge functions on one face: E = u·along_right + v·along_up + along_normal.
 struct FaceSetup {
     along_right: vec3<f32>,
@@ -87,76 +63,6 @@ struct FaceSetup {
     inverse_det: f32,
     // Texel ranges [i0, i1) × [j0, j1); empty when i0 >= i1 or j0 >= j1.
     range: vec4<u32>,
-}
-
-fn triangle_at(t: u32, x: vec3<f32>) -> Triangle {
-    let a = cage_positions[topology[CORNERS * t]].xyz - x;
-    let b = cage_positions[topology[CORNERS * t + 1u]].xyz - x;
-    let c = cage_positions[topology[CORNERS * t + 2u]].xyz - x;
-    let e0 = cross(b, c);
-    return Triangle(a, b, c, e0, cross(c, a), cross(a, b), dot(a, e0));
-}
-
-#import cube_faces
-
-// False only when no ray through the face can reach primitive t: all its corners
-// lie outside one of the four planes that bound the face's pyramid (n·p ≥ |r·p|,
-// n·p ≥ |u·p|); a patch lies in its corners' hull. Texel centres lie strictly
-// inside, so rounding here cannot drop a hit. A few loads and multiplies instead
-// of a full set-up: most primitives of a large cage miss most faces.
-fn may_reach_face(t: u32, x: vec3<f32>, axes: mat3x3<f32>, corners: u32) -> bool {
-    var outside = 15u;
-    for (var k = 0u; k < corners; k++) {
-        let p = cage_positions[topology[CORNERS * t + k]].xyz - x;
-        let r = dot(p, axes[0]);
-        let u = dot(p, axes[1]);
-        let n = dot(p, axes[2]);
-        outside &= select(0u, 1u, n - r < 0.0) | select(0u, 2u, n + r < 0.0)
-            | select(0u, 4u, n - u < 0.0) | select(0u, 8u, n + u < 0.0);
-    }
-    return outside == 0u;
-}
-
-// Conservative texel bounds of the triangle's projection on the face, widened by a
-// texel against rounding, as in the CPU's `texel_bounds`.
-fn texel_range(tri: Triangle, axes: mat3x3<f32>) -> vec4<u32> {
-    var corners = array<vec3<f32>, 3>(tri.a, tri.b, tri.c);
-    var lo = vec2<f32>(FAR, FAR);
-    var hi = vec2<f32>(-FAR, -FAR);
-    var any_in_front = false;
-    for (var k = 0u; k < 3u; k++) {
-        let p3 = corners[k];
-        let q3 = corners[(k + 1u) % 3u];
-        let p = vec3<f32>(dot(p3, axes[0]), dot(p3, axes[1]), dot(p3, axes[2]));
-        let q = vec3<f32>(dot(q3, axes[0]), dot(q3, axes[1]), dot(q3, axes[2]));
-        if p.z > 0.0 {
-            any_in_front = true;
-            let projected = p.xy / p.z;
-            lo = min(lo, projected);
-            hi = max(hi, projected);
-        }
-        if (p.z > 0.0) != (q.z > 0.0) {
-            // The edge crosses the face's plane: the projection runs off towards the crossing.
-            let s = p.z / (p.z - q.z);
-            let crossing = p + s * (q - p);
-            if crossing.x >= 0.0 { hi.x = FAR; }
-            if crossing.x <= 0.0 { lo.x = -FAR; }
-            if crossing.y >= 0.0 { hi.y = FAR; }
-            if crossing.y <= 0.0 { lo.y = -FAR; }
-        }
-    }
-    return texels_within(lo, hi, any_in_front);
-}
-
-// The texel ranges covering face bounds [lo, hi], widened by a texel.
-fn texels_within(lo: vec2<f32>, hi: vec2<f32>, any_in_front: bool) -> vec4<u32> {
-    if !any_in_front || lo.x > 1.0 || hi.x < -1.0 || lo.y > 1.0 || hi.y < -1.0 {
-        return vec4<u32>(0u, 0u, 0u, 0u);
-    }
-    let r = f32(params.resolution);
-    let first = max(floor((clamp(lo, vec2(-1.0), vec2(1.0)) + 1.0) * 0.5 * r - 0.5), vec2(0.0));
-    let last = min(floor((clamp(hi, vec2(-1.0), vec2(1.0)) + 1.0) * 0.5 * r - 0.5) + 2.0, vec2(r));
-    return vec4<u32>(u32(first.x), u32(last.x), u32(first.y), u32(last.y));
 }
 
 fn face_setup(tri: Triangle, axes: mat3x3<f32>) -> FaceSetup {
@@ -209,12 +115,6 @@ fn next_texel(part: vec4<u32>, at: vec2<u32>, step: vec2<u32>) -> vec2<u32> {
 
 fn reaches(reaching: vec2<u32>, owned: u32) -> bool {
     return owned >= 64u || (reaching[owned / 32u] & (1u << (owned % 32u))) != 0u;
-}
-
-// Computed rather than loaded: storage loads dominate the inner loop on lavapipe.
-// The same expression for every triangle, so shared edges still cancel exactly.
-fn texel_centre(index: u32) -> f32 {
-    return f32(2u * index + 1u) / f32(params.resolution) - 1.0;
 }
 
 // Edge values of texel (i, j); .w is the inverse hit depth, or 0 when the ray misses.
@@ -492,24 +392,6 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         weights[out_base + v] = sum;
         total += sum;
     }
-    partial_totals[lane] = total;
-    workgroupBarrier();
-    var row_total = 0.0;
-    for (var k = 0u; k < WORKGROUP_SIZE; k++) {
-        row_total += partial_totals[k];
-    }
-    let escaped = atomicLoad(&missed) > params.max_missed;
-    if escaped || !(row_total > 0.0) {
-        if lane == 0u {
-            status[point] = FALLBACK;
-        }
-        return;
-    }
-    if lane == 0u {
-        status[point] = 0u;
-    }
-    let inverse_total = 1.0 / row_total;
-    for (var v = lane; v < params.vertex_count; v += WORKGROUP_SIZE) {
-        weights[out_base + v] *= inverse_total;
-    }
+    let row_total = workgroup_sum(lane, total);
+    finish_row(point, lane, out_base, row_total, atomicLoad(&missed) > params.max_missed);
 }

@@ -164,3 +164,26 @@ fn a_file_name_with_a_newline_keeps_each_message_on_one_line() {
     assert_eq!(output.status.code(), Some(1));
     assert_one_line_per_message(&output, "no\ndata");
 }
+
+#[test]
+fn bench_times_only_the_families_asked_for_and_refuses_unknown_pmvc_kernels() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = tiny_data(dir.path());
+    let output = bench(&data, &["--scenes", "tiny", "--methods", "mvc"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let table = String::from_utf8_lossy(&output.stdout);
+    assert!(table.contains("| tiny | 20 |"), "{table}");
+    assert!(
+        table.contains("| MVC |") && !table.contains("PMVC") && !table.contains("HC"),
+        "{table}"
+    );
+    // Refused by the argument parser, as an unknown family is, before any work.
+    let output = bench(&data, &["--scenes", "tiny", "--pmvc-kernels", "tiles,warp"]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains("unknown PMVC kernel 'warp' (expected auto, tiles or bands)"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(output.stdout.is_empty(), "a table was printed");
+}

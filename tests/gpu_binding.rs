@@ -77,6 +77,7 @@ fn resident_gpu_weights_match_the_readback() {
         cpu_weights: true,
         gpu_buffer: true,
         batch: BatchSize::Fixed(50),
+        ..BindConfig::default()
     };
     let output = Binder::new(Backend::Gpu(Arc::clone(&context)))
         .with_config(config)
@@ -134,6 +135,7 @@ fn a_handed_in_device_keeps_the_weights_on_the_gpu_only() {
             cpu_weights: false,
             gpu_buffer: true,
             batch: BatchSize::default(),
+            ..BindConfig::default()
         };
         let output = Binder::new(Backend::Gpu(Arc::clone(&context)))
             .with_config(config)
@@ -243,6 +245,7 @@ fn a_resident_matrix_beyond_the_limits_is_an_error() {
         cpu_weights: false,
         gpu_buffer: true,
         batch: BatchSize::default(),
+        ..BindConfig::default()
     };
     let result = Binder::new(Backend::Gpu(context))
         .with_config(config)

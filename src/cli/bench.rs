@@ -4,7 +4,7 @@
 
 use crate::coords::{BindOptions, BindProgress, Method, QuadSplit};
 use crate::geometry::{self, classify_points, procedural, shown_path, Cage};
-use crate::gpu::{Backend, BindInput, Binder, GpuContext};
+use crate::gpu::{Backend, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
 use anyhow::{bail, Result};
 use glam::DVec3;
 use std::path::PathBuf;
@@ -33,6 +33,13 @@ pub struct BenchArgs {
     /// are run only on a hardware adapter.
     #[arg(long)]
     pub software_gpu: bool,
+    /// PMVC kernels to time on the GPU, each as its own rows: auto (the tile
+    /// kernel where the cage allows it), tiles, bands.
+    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = PmvcKernel::parse)]
+    pub pmvc_kernels: Vec<PmvcKernel>,
+    /// Only these families (e.g. `pmvc,mvc`); all by default.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub methods: Vec<Method>,
 }
 
 /// The `--scenes` name of the paper's Table 2 rows.
@@ -98,6 +105,8 @@ fn paper_seconds(scene: &str, method: Method, parameter: u32) -> Option<f64> {
 struct Timed {
     name: String,
     backend: Backend,
+    /// On a GPU, the PMVC kernel; other families' rows are timed with the first.
+    pmvc_kernel: Option<PmvcKernel>,
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
@@ -118,14 +127,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut backends = vec![Timed {
         name: format!("cpu ({threads} threads)"),
         backend: Backend::Cpu,
+        pmvc_kernel: None,
     }];
     let adapter = match GpuContext::new() {
         Ok(context) if !context.is_software() || args.software_gpu => {
             let name = context.describe();
-            backends.push(Timed {
-                name: name.clone(),
-                backend: Backend::Gpu(Arc::new(context)),
-            });
+            let context = Arc::new(context);
+            let mut kernels = args.pmvc_kernels.clone();
+            kernels.dedup();
+            for &kernel in &kernels {
+                backends.push(Timed {
+                    name: if kernels.len() > 1 {
+                        format!("{name} [{}]", kernel_name(kernel))
+                    } else {
+                        name.clone()
+                    },
+                    backend: Backend::Gpu(Arc::clone(&context)),
+                    pmvc_kernel: Some(kernel),
+                });
+            }
             name
         }
         Ok(context) => format!(
@@ -158,6 +178,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 &table1,
                 &backends,
                 usize::from(args.runs),
+                &args.methods,
             )?);
         }
     }
@@ -175,6 +196,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 &[(Method::Pmvc, 32)],
                 &backends,
                 usize::from(args.runs),
+                &args.methods,
             )?);
         }
     }
@@ -243,12 +265,13 @@ fn bench_scene(
     configurations: &[(Method, u32)],
     backends: &[Timed],
     runs: usize,
+    only: &[Method],
 ) -> Result<Vec<BenchRow>> {
     let as_patches: Vec<_> = configurations
         .iter()
         .map(|&(method, value)| (method, value, QuadSplit::None))
         .collect();
-    bench_scene_split(name, cage, points, &as_patches, backends, runs)
+    bench_scene_split(name, cage, points, &as_patches, backends, runs, only)
 }
 
 /// [`bench_scene`] with each configuration's quads bound as patches or split.
@@ -259,11 +282,15 @@ fn bench_scene_split(
     configurations: &[(Method, u32, QuadSplit)],
     backends: &[Timed],
     runs: usize,
+    only: &[Method],
 ) -> Result<Vec<BenchRow>> {
     let classes = classify_points(cage, points);
     let mut rows = Vec::new();
     for timed in backends {
         for &(method, resolution, quads) in configurations {
+            if !only.is_empty() && !only.contains(&method) {
+                continue;
+            }
             // A family without a GPU kernel binds on the CPU on every backend: its
             // CPU row says all there is.
             let mut options = BindOptions {
@@ -276,6 +303,18 @@ fn bench_scene_split(
             if gpu_backend && kernel.is_none() {
                 continue;
             }
+            let first_kernel = backends
+                .iter()
+                .find(|other| other.pmvc_kernel.is_some())
+                .and_then(|other| other.pmvc_kernel);
+            let pmvc_kernel = timed.pmvc_kernel.unwrap_or_default();
+            let work = crate::gpu::backend_choice::Work::of(options, points.len(), cage);
+            if gpu_backend
+                && (method != Method::Pmvc && timed.pmvc_kernel != first_kernel
+                    || pmvc_kernel.takes_tiles(&work).is_err())
+            {
+                continue;
+            }
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
             }
@@ -285,7 +324,10 @@ fn bench_scene_split(
                 cage: Arc::new(cage.clone()),
                 options,
             };
-            let binder = Binder::new(timed.backend.clone());
+            let binder = Binder::new(timed.backend.clone()).with_config(BindConfig {
+                pmvc_kernel,
+                ..BindConfig::default()
+            });
             let mut times = Vec::with_capacity(runs);
             let mut waits = Vec::with_capacity(runs);
             let mut last = None;
@@ -362,9 +404,18 @@ fn bench_shared_data(
             &configurations,
             backends,
             usize::from(args.runs),
+            &args.methods,
         )?);
     }
     Ok(rows)
+}
+
+fn kernel_name(kernel: PmvcKernel) -> &'static str {
+    match kernel {
+        PmvcKernel::Auto => "auto",
+        PmvcKernel::Tiles => "tiles",
+        PmvcKernel::Bands => "bands",
+    }
 }
 
 fn median(times: &[f64]) -> f64 {

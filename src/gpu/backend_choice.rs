@@ -2,7 +2,7 @@
 //! model that predicts the CPU's and the GPU's time for the work and takes the
 //! faster. The command line, Python and the editor all decide here.
 
-use super::kernels::Kernel;
+use super::kernels::{Kernel, PmvcKernel};
 use super::{Backend, GpuContext, GpuError};
 use crate::coords::{BindOptions, Method};
 use crate::geometry::Cage;
@@ -202,10 +202,15 @@ struct FamilyCosts {
 struct Patches {
     cpu: f64,
     gpu: f64,
+    software: f64,
 }
 
 impl Patches {
-    const NONE: Patches = Patches { cpu: 1.0, gpu: 1.0 };
+    const NONE: Patches = Patches {
+        cpu: 1.0,
+        gpu: 1.0,
+        software: 1.0,
+    };
 
     /// `ratio` scaled by the share of the cage's triangles that are halves of
     /// patches, so that a cage with a few quads costs nearly its split.
@@ -245,10 +250,16 @@ const COSTS: [FamilyCosts; 3] = [
             per_triangle: 0.0025,
         },
         software_vs_cpu: 13.5,
-        // `pmvc bench` on the 2-core machine, 2026-11-28 (docs/benchmarks.md):
-        // CPU 2.2-3.6 (Ogre, FireHydrant, ManHead), lavapipe 1.64 (ManHead).
-        // No hardware GPU measured yet: taken as lavapipe's.
-        patches_vs_split: Patches { cpu: 3.0, gpu: 1.6 },
+        // `pmvc bench`, 2026-11-28 (docs/benchmarks.md): the 2-core machine's
+        // CPU 2.2-3.6 (Ogre, FireHydrant, ManHead) and the H200 host's 16
+        // threads 2.4-3.5 (the seven shared models); the H200's band kernel
+        // 1.17-1.35 on patches against the same kernel on the split (lavapipe
+        // 1.64 on ManHead).
+        patches_vs_split: Patches {
+            cpu: 3.0,
+            gpu: 1.3,
+            software: 1.6,
+        },
     },
     FamilyCosts {
         kernel: Kernel::Mvc,
@@ -283,6 +294,33 @@ const COSTS: [FamilyCosts; 3] = [
         patches_vs_split: Patches::NONE,
     },
 ];
+
+/// The tile kernel's discrete-GPU cost per point, µs (PMVC on the cages of
+/// triangles it takes; `FamilyCosts::discrete` is the band kernel's). Fitted to
+/// `pmvc bench --runs 5 --pmvc-kernels tiles,bands` on an NVIDIA H200
+/// (2026-11-28): PMVC 32² Horse size 0.97 µs a point, Armadillo size 1.67, Hand
+/// size 2.94, Table 2 spheres of 98 to 800 triangles 1.13 to 4.5; 64² Horse
+/// size 2.39. Its cost grows about twice as fast with the cage as the band
+/// kernel's, so past about 500 triangles the band kernel is faster.
+const PMVC_TILES_DISCRETE: PointCost = PointCost {
+    fixed: 0.03,
+    per_texel: 0.000_077,
+    per_triangle: 0.0048,
+};
+/// Below this many triangles the tile kernel lost to the band kernel on the
+/// H200 (the 12-triangle box cages SpikyBox and WireSphere: 0.083 s against
+/// 0.036 s and 0.055 against 0.029), though the model above predicts it faster.
+const PMVC_TILES_MIN_TRIANGLES: usize = 16;
+
+/// Whether PMVC on `work`'s cage binds faster by the tile kernel than by the band
+/// kernel on a GPU, by the model (for a cage the tile kernel can take).
+pub fn tiles_predicted_faster(work: &Work) -> bool {
+    let bands = COSTS
+        .iter()
+        .find(|costs| costs.kernel == Kernel::Pmvc)
+        .map_or(f64::INFINITY, |costs| costs.discrete.micros(work));
+    work.cage_triangles >= PMVC_TILES_MIN_TRIANGLES && PMVC_TILES_DISCRETE.micros(work) <= bands
+}
 
 /// CPU threads scale as `threads^0.8` (16 threads of the H200 host did about
 /// 9.2 times one thread's work; 2 threads about 1.7 times).
@@ -384,11 +422,20 @@ pub fn predict(work: &Work, gpu: &GpuState) -> Prediction {
         Pipelines::CacheHit => warm,
         Pipelines::Cold => cold,
     };
-    let gpu_points = gpu_patches * points * costs.discrete.micros(work) * 1e-6;
+    let tiles = costs.kernel == Kernel::Pmvc && PmvcKernel::Auto.takes_tiles(work).unwrap_or(false);
+    let per_point = if tiles {
+        PMVC_TILES_DISCRETE.micros(work)
+    } else {
+        costs.discrete.micros(work)
+    };
+    let gpu_points = gpu_patches * points * per_point * 1e-6;
     let run_s = match gpu.class {
         AdapterClass::Discrete => GPU_BIND_FIXED_S + gpu_points,
         AdapterClass::Integrated => GPU_BIND_FIXED_S + INTEGRATED_VS_DISCRETE * gpu_points,
-        AdapterClass::Software => costs.software_vs_cpu * cpu_s * gpu_patches / cpu_patches,
+        AdapterClass::Software => {
+            let software_patches = Patches::factor(costs.patches_vs_split.software, work);
+            costs.software_vs_cpu * cpu_s * software_patches / cpu_patches
+        }
     };
     Prediction {
         cpu_s: Some(cpu_s),

@@ -214,3 +214,53 @@ fn patches_cost_the_cpu_more_than_the_gpu_so_the_gpu_wins_sooner() {
     let software_ratio = gpu(&patches) / gpu(&split);
     assert!((software_ratio - 1.6).abs() < 1e-9, "{software_ratio}");
 }
+
+#[test]
+fn auto_takes_the_tile_kernel_for_mid_sized_cages_of_triangles_and_bands_otherwise() {
+    // Table 1's Horse size (98 triangles) and Hand size (500): tiles were faster
+    // on the H200; Table 2's 1,523-vertex sphere (3,042) and the 12-triangle
+    // box cages: bands.
+    let horse = work(Method::Pmvc, 48_485, 51, 16);
+    let hand = work(Method::Pmvc, 24_795, 252, 16);
+    let sphere = work(Method::Pmvc, 24_795, 1_523, 16);
+    let cube = work(Method::Pmvc, 60_802, 8, 16);
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&horse), Ok(true));
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&hand), Ok(true));
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&sphere), Ok(false));
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&cube), Ok(false));
+    // Asked for by name, each kernel binds whatever the model prefers...
+    assert_eq!(PmvcKernel::Tiles.takes_tiles(&sphere), Ok(true));
+    assert_eq!(PmvcKernel::Bands.takes_tiles(&horse), Ok(false));
+    // ...except tiles on a cage they cannot hold: patches, or too many vertices.
+    let patches = Work {
+        cage_quads: 6,
+        ..work(Method::Pmvc, 1_000, 8, 16)
+    };
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&patches), Ok(false));
+    let why = PmvcKernel::Tiles.takes_tiles(&patches).unwrap_err();
+    assert!(why.contains("bilinear patches"), "{why}");
+    let large = work(Method::Pmvc, 1_000, 2_100, 16);
+    assert_eq!(PmvcKernel::Auto.takes_tiles(&large), Ok(false));
+    let why = PmvcKernel::Tiles.takes_tiles(&large).unwrap_err();
+    assert!(why.contains("2100") && why.contains("2048"), "{why}");
+}
+
+#[test]
+fn the_gpu_prediction_follows_the_kernel_auto_picks() {
+    // The H200's `pmvc bench` medians (2026-11-28), bind only: Horse size 0.047 s
+    // by tiles (0.075 by bands), the 1,523-vertex sphere 0.180 s by bands (0.374
+    // by tiles). The model's per-point part must land within 30% of the faster.
+    let ready = device(AdapterClass::Discrete, Pipelines::Ready);
+    for (scene, measured) in [
+        (work(Method::Pmvc, 48_485, 51, 16), 0.047),
+        (work(Method::Pmvc, 24_795, 1_523, 16), 0.180),
+    ] {
+        let points_s = predict(&scene, &ready).gpu_s.expect("PMVC has a kernel") - GPU_BIND_FIXED_S;
+        assert!(
+            (0.7 * measured..1.3 * measured).contains(&points_s),
+            "{} points, {} vertices: predicted {points_s:.3} s, measured {measured} s",
+            scene.points,
+            scene.cage_vertices
+        );
+    }
+}

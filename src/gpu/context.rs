@@ -227,12 +227,13 @@ impl GpuContext {
         Ok(kernels)
     }
 
-    /// PMVC's pipeline for cages with quads, compiled on the first bind that
-    /// needs one (through the pipeline cache, which is then written again).
-    pub(super) fn pmvc_quads(&self) -> Result<&wgpu::ComputePipeline, GpuError> {
+    /// PMVC's band pipeline (for cages with quads where `patches`), compiled on
+    /// the first bind that needs one (through the pipeline cache, which is then
+    /// written again).
+    pub(super) fn pmvc_bands(&self, patches: bool) -> Result<&wgpu::ComputePipeline, GpuError> {
         let kernels = self.kernels()?;
         let before = kernels.pipeline_cache().and_then(|cache| cache.get_data());
-        let (pipeline, compiled) = kernels.pmvc_quads();
+        let (pipeline, compiled) = kernels.pmvc_bands(patches);
         if let (true, Some(cache)) = (compiled, kernels.pipeline_cache()) {
             self.store_pipeline_cache(cache, before.as_deref());
         }

@@ -2,6 +2,7 @@
 
 use super::GpuError;
 
+use super::backend_choice::{self, Work};
 use super::shader_source::compose;
 use crate::coords::Method;
 use crate::geometry::Cage;
@@ -43,6 +44,7 @@ impl Kernel {
 }
 
 const PMVC_SOURCE: &str = include_str!("../../shaders/bind_pmvc.wgsl");
+const PMVC_TILES_SOURCE: &str = include_str!("../../shaders/bind_pmvc_tiles.wgsl");
 const MVC_SOURCE: &str = include_str!("../../shaders/bind_mvc.wgsl");
 const GREEN_SOURCE: &str = include_str!("../../shaders/bind_green.wgsl");
 
@@ -53,9 +55,13 @@ fn composed(name: &str, source: &str) -> String {
 
 /// The binding kernels' WGSL with imports resolved, by file name; PMVC's with
 /// its patch code, as the quad pipeline compiles it.
-pub fn kernel_sources() -> [(&'static str, String); 3] {
+pub fn kernel_sources() -> [(&'static str, String); 4] {
     [
         ("bind_pmvc.wgsl", composed("bind_pmvc.wgsl", PMVC_SOURCE)),
+        (
+            "bind_pmvc_tiles.wgsl",
+            composed("bind_pmvc_tiles.wgsl", PMVC_TILES_SOURCE),
+        ),
         ("bind_mvc.wgsl", composed("bind_mvc.wgsl", MVC_SOURCE)),
         ("bind_green.wgsl", composed("bind_green.wgsl", GREEN_SOURCE)),
     ]
@@ -76,6 +82,55 @@ pub(super) const WORKGROUP_SIZE: u32 = 64;
 pub(super) const BAND_TEXELS: u32 = 1024;
 /// Status bit the kernels set for rows the CPU must redo.
 pub(super) const FALLBACK: u32 = 1;
+/// Cage vertices whose sums fit the tile kernel's workgroup memory (8 KiB; with
+/// its chunk of triangles it stays under the 16 KiB every device offers).
+pub(super) const TILES_MAX_VERTICES: u32 = 2048;
+
+/// Which PMVC kernel binds a cage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PmvcKernel {
+    /// Tiles where the cage allows it (triangles only, at most 2,048 vertices),
+    /// else bands.
+    #[default]
+    Auto,
+    /// `shaders/bind_pmvc_tiles.wgsl`: invocations own texels.
+    Tiles,
+    /// `shaders/bind_pmvc.wgsl`: invocations own primitives, the face in bands.
+    Bands,
+}
+
+impl PmvcKernel {
+    /// Whether `work` binds with the tile kernel. `Auto` takes it for cages of
+    /// triangles that fit it where the cost model predicts it faster
+    /// ([`backend_choice::tiles_predicted_faster`]); `Tiles` on a cage it cannot
+    /// take is refused.
+    pub fn takes_tiles(self, work: &Work) -> Result<bool, String> {
+        let patches = work.cage_quads > 0;
+        let vertices = work.cage_vertices;
+        let fits = !patches && vertices <= TILES_MAX_VERTICES as usize;
+        match self {
+            PmvcKernel::Auto => Ok(fits && backend_choice::tiles_predicted_faster(work)),
+            PmvcKernel::Bands => Ok(false),
+            PmvcKernel::Tiles if fits => Ok(true),
+            PmvcKernel::Tiles => Err(format!(
+                "the tile kernel takes cages of triangles with at most {TILES_MAX_VERTICES} \
+                 vertices; this one has {vertices}{}",
+                if patches { " and bilinear patches" } else { "" }
+            )),
+        }
+    }
+
+    pub fn parse(text: &str) -> Result<Self, String> {
+        match text {
+            "auto" => Ok(PmvcKernel::Auto),
+            "tiles" => Ok(PmvcKernel::Tiles),
+            "bands" => Ok(PmvcKernel::Bands),
+            other => Err(format!(
+                "unknown PMVC kernel '{other}' (expected auto, tiles or bands)"
+            )),
+        }
+    }
+}
 
 /// Uniform block of both kernels: `Params` in `shaders/shared/bind_params.wgsl`
 /// (layouts compared by `tests/shader_layouts.rs`).
@@ -94,21 +149,24 @@ pub struct Params {
 
 pub(crate) struct Kernels {
     pub layout: wgpu::BindGroupLayout,
-    pub pmvc: wgpu::ComputePipeline,
+    /// PMVC for cages of triangles up to [`TILES_MAX_VERTICES`].
+    pub pmvc_tiles: wgpu::ComputePipeline,
     pub mvc: wgpu::ComputePipeline,
     pub green: wgpu::ComputePipeline,
-    /// PMVC on a cage with quads (patches among the primitives), compiled on the
-    /// first bind that needs it: compiled with the others, it made every bind's
-    /// start about 0.4 s longer on lavapipe.
-    quads: QuadPipeline,
+    /// PMVC's band kernel, for larger cages of triangles and for cages with
+    /// quads (patches among the primitives), each compiled on the first bind
+    /// that needs it: compiled with the others, the quad pipeline made every
+    /// bind's start about 0.4 s longer on lavapipe.
+    bands: BandPipelines,
 }
 
-/// What compiling the quad pipeline later needs.
-struct QuadPipeline {
+/// What compiling the band pipelines later needs.
+struct BandPipelines {
     device: wgpu::Device,
     layout: wgpu::PipelineLayout,
     cache: Option<wgpu::PipelineCache>,
-    pipeline: OnceLock<Result<wgpu::ComputePipeline, GpuError>>,
+    triangles: OnceLock<Result<wgpu::ComputePipeline, GpuError>>,
+    quads: OnceLock<Result<wgpu::ComputePipeline, GpuError>>,
 }
 
 /// `module`'s entry point as a pipeline with `constants` for its overrides.
@@ -194,7 +252,7 @@ impl Kernels {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-            let [_, (_, mvc_source), (_, green_source)] = kernel_sources();
+            let [_, (_, tiles_source), (_, mvc_source), (_, green_source)] = kernel_sources();
             let module = |label: &str, source: String| {
                 device.create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(label),
@@ -205,42 +263,51 @@ impl Kernels {
                 compute_pipeline(device, &pipeline_layout, module, label, &[], cache)
             };
             Self {
-                pmvc: pipeline("bind_pmvc", &module("bind_pmvc", pmvc_triangles_source())),
+                pmvc_tiles: pipeline("bind_pmvc_tiles", &module("bind_pmvc_tiles", tiles_source)),
                 mvc: pipeline("bind_mvc", &module("bind_mvc", mvc_source)),
                 green: pipeline("bind_green", &module("bind_green", green_source)),
                 layout,
-                quads: QuadPipeline {
+                bands: BandPipelines {
                     device: device.clone(),
                     layout: pipeline_layout,
                     cache: cache.cloned(),
-                    pipeline: OnceLock::new(),
+                    triangles: OnceLock::new(),
+                    quads: OnceLock::new(),
                 },
             }
         })
     }
 
-    /// The PMVC pipeline for cages with quads (`CORNERS` = 4 in
-    /// shaders/bind_pmvc.wgsl), compiled on first use; and whether this call
-    /// compiled it (the pipeline cache then has more to keep).
-    pub fn pmvc_quads(&self) -> (Result<&wgpu::ComputePipeline, GpuError>, bool) {
+    /// PMVC's band pipeline for cages with quads (`CORNERS` = 4 in
+    /// shaders/bind_pmvc.wgsl) or of triangles, compiled on first use; and
+    /// whether this call compiled it (the pipeline cache then has more to keep).
+    pub fn pmvc_bands(&self, patches: bool) -> (Result<&wgpu::ComputePipeline, GpuError>, bool) {
         let mut compiled = false;
-        let quads = &self.quads;
-        let pipeline = quads.pipeline.get_or_init(|| {
+        let bands = &self.bands;
+        let slot = if patches {
+            &bands.quads
+        } else {
+            &bands.triangles
+        };
+        let pipeline = slot.get_or_init(|| {
             compiled = true;
-            scoped(&quads.device, || {
-                let source = composed("bind_pmvc.wgsl", PMVC_SOURCE);
-                let module = quads
+            scoped(&bands.device, || {
+                let (source, constants, label) = if patches {
+                    let source = composed("bind_pmvc.wgsl", PMVC_SOURCE);
+                    (source, vec![("CORNERS", 4.0)], "bind_pmvc quads")
+                } else {
+                    (pmvc_triangles_source(), Vec::new(), "bind_pmvc")
+                };
+                let module = bands
                     .device
                     .create_shader_module(wgpu::ShaderModuleDescriptor {
-                        label: Some("bind_pmvc quads"),
+                        label: Some(label),
                         source: wgpu::ShaderSource::Wgsl(source.into()),
                     });
-                let constants = [("CORNERS", 4.0)];
-                let cache = quads.cache.as_ref();
-                let label = "bind_pmvc quads";
+                let cache = bands.cache.as_ref();
                 compute_pipeline(
-                    &quads.device,
-                    &quads.layout,
+                    &bands.device,
+                    &bands.layout,
                     &module,
                     label,
                     &constants,
@@ -253,7 +320,7 @@ impl Kernels {
 
     /// The pipeline cache the kernels compile through, if the device keeps one.
     pub fn pipeline_cache(&self) -> Option<&wgpu::PipelineCache> {
-        self.quads.cache.as_ref()
+        self.bands.cache.as_ref()
     }
 }
 

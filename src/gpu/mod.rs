@@ -25,6 +25,7 @@ pub use binder::{
     Binder, GpuWeights,
 };
 pub use context::{adapters_report, GpuContext, DEFAULT_BACKENDS};
+pub use kernels::PmvcKernel;
 
 /// Why a GPU operation failed. Device loss and out-of-memory end up here, never in a panic.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

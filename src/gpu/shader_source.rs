@@ -4,7 +4,7 @@
 //! defines (`Frame`, `Params`) and tables that Rust owns (the cube faces) are thus
 //! written once; `tests/shader_layouts.rs` checks the structs against Rust.
 
-use super::kernels::{BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
+use super::kernels::{BAND_TEXELS, FALLBACK, TILES_MAX_VERTICES, WORKGROUP_SIZE};
 use crate::coords::cubemap::CUBE_FACES;
 use std::collections::HashSet;
 
@@ -17,7 +17,7 @@ enum Shared {
 }
 
 /// Every importable name and its text.
-const SHARED: [(&str, Shared); 8] = [
+const SHARED: [(&str, Shared); 10] = [
     (
         "frame",
         Shared::File(include_str!("../../shaders/shared/frame.wgsl")),
@@ -39,6 +39,14 @@ const SHARED: [(&str, Shared); 8] = [
     (
         "pmvc_patches",
         Shared::File(include_str!("../../shaders/shared/pmvc_patches.wgsl")),
+    ),
+    (
+        "pmvc_bindings",
+        Shared::File(include_str!("../../shaders/shared/pmvc_bindings.wgsl")),
+    ),
+    (
+        "pmvc_face",
+        Shared::File(include_str!("../../shaders/shared/pmvc_face.wgsl")),
     ),
     (
         "pmvc_no_patches",
@@ -114,6 +122,8 @@ fn bind_constants_wgsl() -> String {
         "// Generated from gpu::kernels.\n\
          const WORKGROUP_SIZE: u32 = {WORKGROUP_SIZE}u;\n\
          const BAND_TEXELS: u32 = {BAND_TEXELS}u;\n\
+         // Cage vertices the tile kernel's workgroup sums can hold.\n\
+         const TILES_MAX_VERTICES: u32 = {TILES_MAX_VERTICES}u;\n\
          // Status bit the kernels set for rows the CPU must redo.\n\
          const FALLBACK: u32 = {FALLBACK}u;\n"
     )

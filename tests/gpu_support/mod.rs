@@ -6,7 +6,7 @@ use glam::DVec3;
 use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
 use pmvc::geometry::procedural::{comb_outline, extrude, star_outline};
 use pmvc::geometry::{classify_points, Cage, PointClass};
-use pmvc::gpu::{Backend, BatchSize, BindConfig, BindInput, Binder, GpuContext};
+use pmvc::gpu::{Backend, BatchSize, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
 use std::io::Write as _;
 use std::sync::{Arc, OnceLock};
 use std::time::Duration;
@@ -180,9 +180,27 @@ pub fn pmvc_agrees(
     cage: &Cage,
     points: Vec<DVec3>,
 ) -> usize {
-    let input = input(cage, points, Method::Pmvc);
+    pmvc_kernel_agrees(test, context, cage, points, PmvcKernel::Auto, 32)
+}
+
+/// [`pmvc_agrees`] with the PMVC kernel and the cube-map resolution chosen.
+pub fn pmvc_kernel_agrees(
+    test: &str,
+    context: &Arc<GpuContext>,
+    cage: &Cage,
+    points: Vec<DVec3>,
+    kernel: PmvcKernel,
+    resolution: u32,
+) -> usize {
+    let mut input = input(cage, points, Method::Pmvc);
+    input.options.resolution = resolution;
     let expected = cpu(&input);
+    let config = BindConfig {
+        pmvc_kernel: kernel,
+        ..BindConfig::default()
+    };
     let output = Binder::new(Backend::Gpu(Arc::clone(context)))
+        .with_config(config)
         .bind_blocking(&input, &BindProgress::default())
         .expect("GPU bind");
     let inside = input.classes.iter().filter(|c| **c == PointClass::Inside);

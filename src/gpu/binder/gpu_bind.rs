@@ -1,10 +1,12 @@
 //! One bind on a GPU: device buffers, batches of rows, flagged rows redone on the
 //! CPU, and typed readback.
 
+use super::buffers::{byte_len, cpu_rows, entry, padded, scoped};
 use super::topology::{topology, Topology};
 use super::{BatchSize, BindConfig, BindError, BindInput, BindOutput, BindStats, GpuWeights};
-use crate::coords::{self, cubemap::TexelTable, BindProgress, Weights};
+use crate::coords::{cubemap::TexelTable, BindProgress, Weights};
 use crate::geometry::{bounds_of, PointClass};
+use crate::gpu::backend_choice::Work;
 use crate::gpu::context::GpuContext;
 use crate::gpu::kernels::{Kernel, Params, BAND_TEXELS, FALLBACK, WORKGROUP_SIZE};
 use crate::gpu::GpuError;
@@ -17,28 +19,6 @@ use std::time::Instant;
 /// trips stay a small part of a bind.
 const MAX_BATCH_BUFFER_BYTES: u64 = 256 << 20;
 
-/// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
-/// the same row loop as a CPU bind.
-fn cpu_rows(input: &BindInput, rows: &[usize]) -> Vec<f32> {
-    let mut out = vec![0.0f32; rows.len() * input.options.method.columns(&input.cage)];
-    // A batch's own progress: the bind advances once per batch.
-    let batch_progress = BindProgress::default();
-    let finished = coords::bind_rows(
-        &input.points,
-        &input.classes,
-        &input.cage,
-        input.options,
-        rows,
-        &mut out,
-        &batch_progress,
-    );
-    debug_assert!(
-        finished.is_ok(),
-        "a batch's own progress is never cancelled"
-    );
-    out
-}
-
 /// Device buffers and state of one GPU bind.
 pub(super) struct GpuBind<'a> {
     context: &'a GpuContext,
@@ -47,6 +27,8 @@ pub(super) struct GpuBind<'a> {
     kernel: Kernel,
     /// The quad pipeline: PMVC with quads as bilinear patches.
     patches: bool,
+    /// PMVC by the tile kernel (else by bands).
+    tiles: bool,
     centre: DVec3,
     rows: usize,
     cols: usize,
@@ -60,34 +42,6 @@ pub(super) struct GpuBind<'a> {
     weights_readback: Option<wgpu::Buffer>,
     status_readback: wgpu::Buffer,
     resident: Option<wgpu::Buffer>,
-}
-
-fn byte_len<T>(count: usize) -> u64 {
-    (count * std::mem::size_of::<T>()).max(16) as u64
-}
-
-/// Pop an error scope, turning a captured error into a [`GpuError`].
-fn pop_scope(scope: wgpu::ErrorScopeGuard) -> Result<(), GpuError> {
-    match pollster::block_on(scope.pop()) {
-        Some(error) => Err(error.into()),
-        None => Ok(()),
-    }
-}
-
-/// Run `body` inside out-of-memory and validation error scopes.
-fn scoped<T>(
-    device: &wgpu::Device,
-    body: impl FnOnce() -> Result<T, GpuError>,
-) -> Result<T, GpuError> {
-    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-    let result = body();
-    let memory = pop_scope(memory);
-    let validation = pop_scope(validation);
-    let value = result?;
-    memory?;
-    validation?;
-    Ok(value)
 }
 
 impl<'a> GpuBind<'a> {
@@ -120,11 +74,18 @@ impl<'a> GpuBind<'a> {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
         let topology = topology(&cage, kernel, resolution, rows);
-        if topology.corners == 4 {
-            context.pmvc_quads()?;
+        let patches = topology.corners == 4;
+        let tiles = kernel == Kernel::Pmvc
+            && config
+                .pmvc_kernel
+                .takes_tiles(&Work::of(input.options, rows, &input.cage))
+                .map_err(BindError::InvalidInput)?;
+        if kernel == Kernel::Pmvc && !tiles {
+            context.pmvc_bands(patches)?;
         }
-        // Corner sums per primitive, for the whole sphere and for the current band.
-        let sums_per_row = if kernel == Kernel::Pmvc {
+        // The band kernel's corner sums per primitive, for the whole sphere and
+        // for the current band.
+        let sums_per_row = if kernel == Kernel::Pmvc && !tiles {
             2 * topology.corners * topology.primitives()
         } else {
             0
@@ -280,6 +241,7 @@ impl<'a> GpuBind<'a> {
                 config,
                 kernel,
                 patches: corners == 4,
+                tiles,
                 centre,
                 rows,
                 cols,
@@ -442,10 +404,10 @@ impl<'a> GpuBind<'a> {
                     pass.set_bind_group(0, &self.bind_group, &[]);
                     let groups = match self.kernel {
                         Kernel::Pmvc => {
-                            pass.set_pipeline(if self.patches {
-                                self.context.pmvc_quads()?
+                            pass.set_pipeline(if self.tiles {
+                                &kernels.pmvc_tiles
                             } else {
-                                &kernels.pmvc
+                                self.context.pmvc_bands(self.patches)?
                             });
                             inside.len() as u32
                         }
@@ -537,21 +499,6 @@ impl<'a> GpuBind<'a> {
         }
         Ok(())
     }
-}
-
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
-    }
-}
-
-/// Non-empty, so that every binding has a size.
-fn padded<T: Default + Clone>(mut values: Vec<T>) -> Vec<T> {
-    if values.is_empty() {
-        values.push(T::default());
-    }
-    values
 }
 
 /// Map `buffer`, wait for the device, and copy out its first `bytes` as `T`s.

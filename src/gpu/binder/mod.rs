@@ -18,10 +18,12 @@
 //! backend ([`crate::gpu::kernels::Kernel::for_cage`]); Green coordinates bind
 //! the cage's triangles, as on the CPU.
 
+mod buffers;
 mod gpu_bind;
 mod topology;
 
 use super::context::GpuContext;
+use super::kernels::PmvcKernel;
 use super::GpuError;
 use crate::coords::{self, BindOptions, BindProgress, Weights};
 use crate::geometry::{Cage, PointClass};
@@ -67,6 +69,8 @@ pub struct BindConfig {
     /// backend only.
     pub gpu_buffer: bool,
     pub batch: BatchSize,
+    /// Which PMVC kernel binds (`Auto`: the tile kernel where the cage allows it).
+    pub pmvc_kernel: PmvcKernel,
 }
 
 impl Default for BindConfig {
@@ -75,6 +79,7 @@ impl Default for BindConfig {
             cpu_weights: true,
             gpu_buffer: false,
             batch: BatchSize::default(),
+            pmvc_kernel: PmvcKernel::Auto,
         }
     }
 }
