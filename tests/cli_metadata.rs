@@ -373,6 +373,8 @@ fn metadata_records_where_the_rows_were_computed() {
     assert_eq!(json["backend"], "gpu");
     let device = json["device"].as_str().unwrap();
     assert!(!device.is_empty() && device != "CPU", "{device}");
+    // The PMVC kernel that computed the rows is part of where they were computed.
+    assert!(device.ends_with("PMVC tile kernel"), "{device}");
     // Harmonic coordinates have no GPU kernel: their rows come from the CPU.
     let (output, json) = bind_on_gpu("harmonic", &["--grid", "16"]);
     assert!(output.status.success(), "{}", stderr(&output));

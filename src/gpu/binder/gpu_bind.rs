@@ -266,7 +266,13 @@ impl<'a> GpuBind<'a> {
             .cpu_weights
             .then(|| Weights::zeros(self.rows, self.cols));
         let mut stats = BindStats {
-            device: self.context.describe(),
+            // Which PMVC kernel computed the rows goes with them (W.json's
+            // "device"): the two differ where a ray grazes an edge.
+            device: match (self.kernel, self.tiles) {
+                (Kernel::Pmvc, true) => format!("{}, PMVC tile kernel", self.context.describe()),
+                (Kernel::Pmvc, false) => format!("{}, PMVC band kernel", self.context.describe()),
+                _ => self.context.describe(),
+            },
             ..BindStats::default()
         };
         let mut batch_rows = match self.config.batch {
