@@ -385,8 +385,18 @@ impl Prediction {
         } else {
             String::new()
         };
+        // Which PMVC kernel the GPU's time is for (software adapters are
+        // modelled from the CPU path, whichever kernel runs).
+        let kernel = match (self.work.kernel(), self.gpu.class) {
+            (Some(Kernel::Pmvc), AdapterClass::Software) => "",
+            (Some(Kernel::Pmvc), _) => match PmvcKernel::Auto.takes_tiles(&self.work) {
+                Ok(true) => "PMVC tile kernel, ",
+                _ => "PMVC band kernel, ",
+            },
+            _ => "",
+        };
         format!(
-            "predicted CPU {} ({} threads), GPU {} ({}, {pipelines}{start})",
+            "predicted CPU {} ({} threads), GPU {} ({}, {kernel}{pipelines}{start})",
             seconds(self.cpu_s),
             self.work.cpu_threads,
             seconds(self.gpu_s),

@@ -215,6 +215,11 @@ fn patches_cost_the_cpu_more_than_the_gpu_so_the_gpu_wins_sooner() {
     assert!((software_ratio - 1.6).abs() < 1e-9, "{software_ratio}");
 }
 
+/// PMVC 32² on Table 2's 24,795 points in a cage of `vertices` vertices.
+fn sphere_of(vertices: usize) -> Work {
+    work(Method::Pmvc, 24_795, vertices, 16)
+}
+
 #[test]
 fn auto_takes_the_tile_kernel_for_mid_sized_cages_of_triangles_and_bands_otherwise() {
     // Table 1's Horse size (98 triangles) and Hand size (500): tiles were faster
@@ -222,10 +227,22 @@ fn auto_takes_the_tile_kernel_for_mid_sized_cages_of_triangles_and_bands_otherwi
     // box cages: bands.
     let horse = work(Method::Pmvc, 48_485, 51, 16);
     let hand = work(Method::Pmvc, 24_795, 252, 16);
-    let sphere = work(Method::Pmvc, 24_795, 1_523, 16);
+    let sphere = sphere_of(1_523);
     let cube = work(Method::Pmvc, 60_802, 8, 16);
     assert_eq!(PmvcKernel::Auto.takes_tiles(&horse), Ok(true));
     assert_eq!(PmvcKernel::Auto.takes_tiles(&hand), Ok(true));
+    // --verbose says which kernel the GPU's prediction is for.
+    let ready = device(AdapterClass::Discrete, Pipelines::Ready);
+    let said = predict(&horse, &ready).explain();
+    assert!(
+        said.contains("(discrete, PMVC tile kernel, kernels compiled)"),
+        "{said}"
+    );
+    let said = predict(&sphere_of(1_523), &ready).explain();
+    assert!(
+        said.contains("(discrete, PMVC band kernel, kernels compiled)"),
+        "{said}"
+    );
     assert_eq!(PmvcKernel::Auto.takes_tiles(&sphere), Ok(false));
     assert_eq!(PmvcKernel::Auto.takes_tiles(&cube), Ok(false));
     // Asked for by name, each kernel binds whatever the model prefers...
