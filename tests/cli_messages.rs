@@ -187,3 +187,51 @@ fn bench_times_only_the_families_asked_for_and_refuses_unknown_pmvc_kernels() {
     );
     assert!(output.stdout.is_empty(), "a table was printed");
 }
+
+#[test]
+fn the_tile_kernel_asked_for_on_a_quad_cage_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, _, _, _) = comb_scene(dir.path(), 20);
+    // A box of six quads around the comb's points.
+    let cage = dir.path().join("box.obj");
+    std::fs::write(
+        &cage,
+        "v -9 -9 -9\nv 9 -9 -9\nv 9 9 -9\nv -9 9 -9\nv -9 -9 9\nv 9 -9 9\nv 9 9 9\nv -9 9 9\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let out = dir.path().join("w.npy");
+    let output = bind_with(
+        &mesh,
+        &cage,
+        &out,
+        &["--backend", "gpu", "--pmvc-kernel", "tiles"],
+    );
+    if !ran_on_gpu_or_refused(&output) {
+        return;
+    }
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    let text = stderr(&output);
+    assert!(
+        text.contains("tile kernel") && text.contains("bilinear patches"),
+        "{text}"
+    );
+    assert!(!out.exists(), "weights written after a refusal");
+    // An unknown kernel is refused before any work.
+    let output = bind_with(&mesh, &cage, &out, &["--pmvc-kernel", "fast"]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains("unknown PMVC kernel 'fast'"),
+        "{}",
+        stderr(&output)
+    );
+}
+
+/// False (after saying so) when `--backend gpu` found no adapter, as
+/// `ran_on_gpu` does, but a refusal of the input counts as having run.
+fn ran_on_gpu_or_refused(output: &Output) -> bool {
+    if stderr(output).contains("no GPU adapter") {
+        return ran_on_gpu(output);
+    }
+    true
+}

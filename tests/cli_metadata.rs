@@ -375,6 +375,12 @@ fn metadata_records_where_the_rows_were_computed() {
     assert!(!device.is_empty() && device != "CPU", "{device}");
     // The PMVC kernel that computed the rows is part of where they were computed.
     assert!(device.ends_with("PMVC tile kernel"), "{device}");
+    // Asked for, the band kernel binds instead (as GPU binds did before the tile
+    // kernel), and says so.
+    let (output, json) = bind_on_gpu("pmvc", &["--resolution", "8", "--pmvc-kernel", "bands"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let device = read_json(&json)["device"].as_str().unwrap().to_owned();
+    assert!(device.ends_with("PMVC band kernel"), "{device}");
     // Harmonic coordinates have no GPU kernel: their rows come from the CPU.
     let (output, json) = bind_on_gpu("harmonic", &["--grid", "16"]);
     assert!(output.status.success(), "{}", stderr(&output));

@@ -9,7 +9,7 @@ use crate::geometry::{
 use crate::gpu::backend_choice::{
     decide, decide_and_open, device_for, BackendRequest, Decision, Work,
 };
-use crate::gpu::{Backend, BindInput, Binder};
+use crate::gpu::{Backend, BindConfig, BindInput, Binder};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::DVec3;
 use std::io::Write as _;
@@ -157,11 +157,15 @@ pub(super) fn bind_rows(
         cage: Arc::new(input.cage.clone()),
         options: choice.options(),
     };
+    let binder = Binder::new(backend.clone()).with_config(BindConfig {
+        pmvc_kernel: choice.pmvc_kernel,
+        ..BindConfig::default()
+    });
     let output = if bar.is_hidden() {
         // Nothing to show: wait on the bind directly, not in steps of the poll below.
-        Binder::new(backend.clone()).bind_blocking(&bind_input, &BindProgress::default())
+        binder.bind_blocking(&bind_input, &BindProgress::default())
     } else {
-        let handle = Binder::new(backend.clone()).start(bind_input);
+        let handle = binder.start(bind_input);
         while !handle.is_finished() {
             bar.set_position((range.start + handle.progress().done()) as u64);
             std::thread::sleep(Duration::from_millis(50));

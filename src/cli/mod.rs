@@ -131,6 +131,13 @@ pub struct MethodChoice {
     /// Where binding runs (harmonic coordinates always bind on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
+    /// PMVC on a GPU: the kernel. `auto` takes the tile kernel where the cage
+    /// allows it and a cost model predicts it faster, else the band kernel
+    /// (the only one before 2026-11-28: to reproduce earlier GPU weights);
+    /// `tiles` on a cage with quads or over 2,048 vertices is an error. The two
+    /// differ where a ray grazes an edge (up to about 1e-4 in a weight, measured).
+    #[arg(long, default_value = "auto", value_name = "auto|tiles|bands", value_parser = crate::gpu::PmvcKernel::parse)]
+    pub pmvc_kernel: crate::gpu::PmvcKernel,
     /// Print where the bind runs and why: for `auto`, the CPU's and the GPU's
     /// predicted times; on a GPU, how long the device took to open and whether
     /// the compiled kernels came from the pipeline cache.

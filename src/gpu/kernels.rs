@@ -112,10 +112,14 @@ impl PmvcKernel {
             PmvcKernel::Auto => Ok(fits && backend_choice::tiles_predicted_faster(work)),
             PmvcKernel::Bands => Ok(false),
             PmvcKernel::Tiles if fits => Ok(true),
+            PmvcKernel::Tiles if patches => Err(format!(
+                "the tile kernel takes cages of triangles only; this one keeps {} quads \
+                 as bilinear patches (bind it with the band kernel, or split its quads)",
+                work.cage_quads
+            )),
             PmvcKernel::Tiles => Err(format!(
-                "the tile kernel takes cages of triangles with at most {TILES_MAX_VERTICES} \
-                 vertices; this one has {vertices}{}",
-                if patches { " and bilinear patches" } else { "" }
+                "the tile kernel takes cages of at most {TILES_MAX_VERTICES} vertices; \
+                 this one has {vertices} (bind it with the band kernel)"
             )),
         }
     }

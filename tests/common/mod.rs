@@ -71,6 +71,13 @@ pub fn pmvc(args: &[&str]) -> Output {
 /// `pmvc bind --mesh mesh --cage cage --out out --backend cpu`, then `extra`.
 #[cfg(feature = "editor")]
 pub fn bind_on_cpu(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["--backend", "cpu"];
+    args.extend(extra);
+    bind_with(mesh, cage, out, &args)
+}
+
+/// `pmvc bind --mesh mesh --cage cage --out out`, then `extra`.
+pub fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "bind",
         "--mesh",
@@ -79,8 +86,6 @@ pub fn bind_on_cpu(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Outp
         path_str(cage),
         "--out",
         path_str(out),
-        "--backend",
-        "cpu",
     ];
     args.extend(extra);
     pmvc(&args)
