@@ -12,7 +12,7 @@ use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
 use crate::geometry::classify_points;
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
-use crate::gpu::{Backend, BindError, BindInput, Binder};
+use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder, PmvcKernel};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -211,14 +211,15 @@ fn bind_options(
 /// first, as before quads were patches (Green coordinates always bind on
 /// triangles, split along the shorter diagonal unless told otherwise). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
 /// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
-/// a GPU kernel bind on the CPU.
+/// a GPU kernel bind on the CPU. ``pmvc_kernel`` is PMVC's GPU kernel:
+/// ``"auto"``, ``"tiles"`` or ``"bands"`` (as ``pmvc bind --pmvc-kernel``).
 /// ``progress``, if given, is called with ``(done, total)`` rows, from
 /// ``(0, total)`` to ``(total, total)``. The GIL is released while binding;
 /// Ctrl-C cancels within about a second.
 #[pyfunction]
 #[pyo3(
-    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None, triangulate=None),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None)"
+    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None, triangulate=None, pmvc_kernel="auto"),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto')"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(
@@ -231,8 +232,10 @@ pub(super) fn bind<'py>(
     backend: &str,
     progress: Option<Bound<'py, PyAny>>,
     triangulate: Option<Bound<'py, PyAny>>,
+    pmvc_kernel: &str,
 ) -> PyResult<PyWeights> {
     let method = method_from(method)?;
+    let pmvc_kernel = pmvc_kernel_from("bind", pmvc_kernel)?;
     let options = bind_options(
         method,
         resolution.as_ref(),
@@ -240,7 +243,22 @@ pub(super) fn bind<'py>(
         triangulate.as_ref(),
     )?;
     let points = positions(points, "points")?;
-    bind_points(py, points, &cage, options, backend, progress.as_ref())
+    let how = HowToBind {
+        backend,
+        pmvc_kernel,
+    };
+    bind_points(py, points, &cage, options, &how, progress.as_ref())
+}
+
+/// Where and by which GPU kernel a bind runs, as `bind` and `deform` were told.
+pub(super) struct HowToBind<'a> {
+    pub backend: &'a str,
+    pub pmvc_kernel: PmvcKernel,
+}
+
+/// `pmvc_kernel=` checked by the command line's one parser.
+fn pmvc_kernel_from(function: &str, text: &str) -> PyResult<PmvcKernel> {
+    PmvcKernel::parse(text).map_err(|cause| error(Kind::Parameter, format!("{function}: {cause}")))
 }
 
 /// Bind already-checked points; `bind` and `deform` share it.
@@ -249,10 +267,11 @@ pub(super) fn bind_points(
     points: Vec<glam::DVec3>,
     cage: &PyCage,
     options: BindOptions,
-    backend: &str,
+    how: &HowToBind<'_>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyWeights> {
-    let decision = choose_backend(py, backend, options, points.len(), cage)?;
+    let decision = choose_backend(py, how.backend, options, points.len(), cage)?;
+    let pmvc_kernel = how.pmvc_kernel;
     let on_gpu = decision.on_gpu(options.method);
     let backend = decision.backend;
     let device = backend.clone();
@@ -280,7 +299,12 @@ pub(super) fn bind_points(
             cage: cage_arc,
             options,
         };
-        let result = Binder::new(backend).bind_blocking(&input, &shared);
+        let result = Binder::new(backend)
+            .with_config(BindConfig {
+                pmvc_kernel,
+                ..BindConfig::default()
+            })
+            .bind_blocking(&input, &shared);
         (classes, result)
     })?;
     if let Backend::Gpu(context) = &device {
@@ -375,11 +399,19 @@ pub(super) fn deform<'py>(
     if let Some(given) = parameters {
         for key in given.keys() {
             let key: String = key.extract()?;
-            if !["resolution", "grid", "backend", "progress", "triangulate"].contains(&key.as_str())
+            if ![
+                "resolution",
+                "grid",
+                "backend",
+                "progress",
+                "triangulate",
+                "pmvc_kernel",
+            ]
+            .contains(&key.as_str())
             {
                 return Err(error(
                     Kind::Parameter,
-                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress, triangulate)"),
+                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress, triangulate, pmvc_kernel)"),
                 ));
             }
             if weights.is_some() {
@@ -420,17 +452,18 @@ pub(super) fn deform<'py>(
                 Some(value) => value.extract()?,
                 None => "auto".into(),
             };
+            let pmvc_kernel: String = match parameter("pmvc_kernel")? {
+                Some(value) => value.extract()?,
+                None => "auto".into(),
+            };
+            let how = HowToBind {
+                backend: &backend,
+                pmvc_kernel: pmvc_kernel_from("deform", &pmvc_kernel)?,
+            };
             let progress = parameter("progress")?.filter(|p| !p.is_none());
             fresh = Py::new(
                 py,
-                bind_points(
-                    py,
-                    points.clone(),
-                    &cage,
-                    options,
-                    &backend,
-                    progress.as_ref(),
-                )?,
+                bind_points(py, points.clone(), &cage, options, &how, progress.as_ref())?,
             )?;
             fresh.borrow(py)
         }

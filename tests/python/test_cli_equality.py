@@ -61,6 +61,18 @@ def test_every_family_is_bit_for_bit_the_command_lines(
     assert weights.parameters == PYTHON_PARAMETERS[method]
 
 
+@pytest.mark.parametrize("kernel,name", [("tiles", "tile"), ("bands", "band")])
+def test_each_pmvc_kernel_is_bit_for_bit_the_command_lines_and_named(
+    pmvc_bin, tmp_path, test_points, comb_cage, kernel, name
+):
+    gpu_or_skip()
+    flags = ["--resolution", "16", "--pmvc-kernel", kernel]
+    expected = cli_weights(pmvc_bin, tmp_path, test_points, "pmvc", flags, "gpu")
+    weights = pmvc.bind(test_points, comb_cage, resolution=16, backend="gpu", pmvc_kernel=kernel)
+    assert weights.matrix.tobytes() == expected.astype(np.float32).tobytes()
+    assert weights.device.endswith(f"PMVC {name} kernel"), weights.device
+
+
 def test_deform_is_what_pmvc_deform_writes_with_stored_and_fresh_weights(
     pmvc_bin, tmp_path, test_points, comb_cage
 ):

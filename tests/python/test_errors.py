@@ -105,6 +105,7 @@ def test_a_bad_file_names_the_file_and_line(tmp_path):
         ({"method": "pmvc", "resolution": 1.5}, "resolution must be an integer"),
         ({"method": "harmonic", "grid": 3}, "grid 3 is out of range: the harmonic grid must be 4 to 2048"),
         ({"method": "mvc", "backend": "tpu"}, 'backend "tpu" is not one of "auto", "cpu", "gpu"'),
+        ({"method": "pmvc", "pmvc_kernel": "warp"}, "unknown PMVC kernel 'warp' (expected auto, tiles or bands)"),
     ],
 )
 def test_bad_parameters_raise_parameter_errors(box, arguments, words):

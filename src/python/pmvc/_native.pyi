@@ -138,6 +138,7 @@ def bind(
     backend: str = "auto",
     progress: Optional[Progress] = None,
     triangulate: Optional[str] = None,
+    pmvc_kernel: str = "auto",
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
@@ -146,7 +147,10 @@ def bind(
     range. Quads are bilinear patches (MVC on them is QMVC) unless
     ``triangulate`` is "shorter" or "longer", which splits them along that
     diagonal first; Green coordinates always bind on triangles. ``backend``: "auto" (the CPU, or a hardware GPU where it is
-    predicted faster for this bind), "cpu" or "gpu". The GIL is released; Ctrl-C cancels within about a second."""
+    predicted faster for this bind), "cpu" or "gpu". ``pmvc_kernel``: PMVC's GPU
+    kernel, "auto", "tiles" or "bands" (as ``pmvc bind --pmvc-kernel``; "bands"
+    reproduces GPU weights bound before the tile kernel). The GIL is released;
+    Ctrl-C cancels within about a second."""
     ...
 
 def deform(
@@ -160,7 +164,7 @@ def deform(
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
     bound first with ``parameters`` (resolution, grid, backend, progress,
-    triangulate)."""
+    triangulate, pmvc_kernel)."""
     ...
 
 def classify(points: ArrayLike, cage: Cage) -> npt.NDArray[np.int8]:
