@@ -133,12 +133,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         Ok(context) if !context.is_software() || args.software_gpu => {
             let name = context.describe();
             let context = Arc::new(context);
-            let mut kernels = args.pmvc_kernels.clone();
-            kernels.dedup();
+            let mut kernels: Vec<PmvcKernel> = Vec::new();
+            for &kernel in &args.pmvc_kernels {
+                if !kernels.contains(&kernel) {
+                    kernels.push(kernel);
+                }
+            }
             for &kernel in &kernels {
                 backends.push(Timed {
                     name: if kernels.len() > 1 {
-                        format!("{name} [{}]", kernel_name(kernel))
+                        format!("{name} [{}]", kernel.name())
                     } else {
                         name.clone()
                     },
@@ -286,6 +290,8 @@ fn bench_scene_split(
 ) -> Result<Vec<BenchRow>> {
     let classes = classify_points(cage, points);
     let mut rows = Vec::new();
+    // Families without a choice of kernel are timed once per GPU, with its first.
+    let first_kernel = backends.iter().find_map(|timed| timed.pmvc_kernel);
     for timed in backends {
         for &(method, resolution, quads) in configurations {
             if !only.is_empty() && !only.contains(&method) {
@@ -303,20 +309,15 @@ fn bench_scene_split(
             if gpu_backend && kernel.is_none() {
                 continue;
             }
-            let first_kernel = backends
-                .iter()
-                .find(|other| other.pmvc_kernel.is_some())
-                .and_then(|other| other.pmvc_kernel);
-            let pmvc_kernel = timed.pmvc_kernel.unwrap_or_default();
-            let work = crate::gpu::backend_choice::Work::of(options, points.len(), cage);
-            if gpu_backend
-                && (method != Method::Pmvc && timed.pmvc_kernel != first_kernel
-                    || pmvc_kernel.takes_tiles(&work).is_err())
-            {
-                continue;
-            }
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
+            }
+            let pmvc_kernel = timed.pmvc_kernel.unwrap_or_default();
+            let work = crate::gpu::backend_choice::Work::of(options, points.len(), cage);
+            let repeated = method != Method::Pmvc && timed.pmvc_kernel != first_kernel;
+            // Tiles asked for on a cage they cannot take: no row, not an error.
+            if gpu_backend && (repeated || pmvc_kernel.takes_tiles(&work).is_err()) {
+                continue;
             }
             let input = BindInput {
                 points: points.into(),
@@ -408,14 +409,6 @@ fn bench_shared_data(
         )?);
     }
     Ok(rows)
-}
-
-fn kernel_name(kernel: PmvcKernel) -> &'static str {
-    match kernel {
-        PmvcKernel::Auto => "auto",
-        PmvcKernel::Tiles => "tiles",
-        PmvcKernel::Bands => "bands",
-    }
 }
 
 fn median(times: &[f64]) -> f64 {

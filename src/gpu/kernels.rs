@@ -124,15 +124,23 @@ impl PmvcKernel {
         }
     }
 
-    pub fn parse(text: &str) -> Result<Self, String> {
-        match text {
-            "auto" => Ok(PmvcKernel::Auto),
-            "tiles" => Ok(PmvcKernel::Tiles),
-            "bands" => Ok(PmvcKernel::Bands),
-            other => Err(format!(
-                "unknown PMVC kernel '{other}' (expected auto, tiles or bands)"
-            )),
+    const ALL: [PmvcKernel; 3] = [PmvcKernel::Auto, PmvcKernel::Tiles, PmvcKernel::Bands];
+
+    /// The name `--pmvc-kernel` and Python's `pmvc_kernel=` take.
+    pub fn name(self) -> &'static str {
+        match self {
+            PmvcKernel::Auto => "auto",
+            PmvcKernel::Tiles => "tiles",
+            PmvcKernel::Bands => "bands",
         }
+    }
+
+    /// The one check of a kernel's name, whatever its source.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|kernel| kernel.name() == text)
+            .ok_or_else(|| format!("unknown PMVC kernel '{text}' (expected auto, tiles or bands)"))
     }
 }
 
