@@ -174,14 +174,7 @@ fn torus() -> TriMesh {
 
 /// Two unit spheres on the x axis whose surfaces are `gap` apart.
 fn two_blobs(gap: f64) -> TriMesh {
-    let sphere = procedural::icosphere(1.0, 3);
-    let n = sphere.vertex_count() as u32;
-    let offset = DVec3::X * (1.0 + gap / 2.0);
-    let mut positions: Vec<DVec3> = sphere.positions().iter().map(|p| *p - offset).collect();
-    positions.extend(sphere.positions().iter().map(|p| *p + offset));
-    let mut triangles = sphere.triangles().to_vec();
-    triangles.extend(sphere.triangles().iter().map(|t| t.map(|i| i + n)));
-    mesh(positions, triangles)
+    common::shapes::two_blobs(gap).mesh
 }
 
 /// A unit sphere with its cap above z = 0.7 removed: open, with a hole.

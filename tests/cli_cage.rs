@@ -60,6 +60,7 @@ fn a_cage_around_the_comb_is_written_and_its_properties_printed() {
         "% of the mesh diagonal",
         "volume ratio (cage / mesh): ",
         "minimum angle: ",
+        "gaps between parts: ",
         "time: ",
     ] {
         assert!(text.contains(heading), "no '{heading}' in: {text}");
@@ -82,6 +83,11 @@ fn the_voxel_size_is_chosen_or_used_as_asked_and_reported() {
     let text = stdout(&auto);
     assert!(text.contains("chosen for the target"), "{text}");
     assert!(text.contains("may share one part of the cage"), "{text}");
+    // A box around five fingers bridges the gaps between them, and says so.
+    assert!(
+        text.contains("points midway across them are inside the cage (bridged gaps up to"),
+        "{text}"
+    );
     let asked = pmvc(&[
         "cage",
         "--mesh",

@@ -344,10 +344,32 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
             ""
         }
     ));
+    lines.push(gap_line(stats));
     if show_time {
         lines.push(format!("time: {:.2} s", stats.seconds));
     }
     lines
+}
+
+/// Which gaps between parts of the mesh the cage keeps open, measured at
+/// points midway across them.
+fn gap_line(stats: &CageStats) -> String {
+    let gaps = &stats.gaps;
+    let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
+    let width = |w: f64| format!("{} ({:.1}% of the diagonal)", significant(w), percent(w));
+    match (gaps.points, gaps.closed(), gaps.widest_closed) {
+        (0, _, _) => "gaps between parts: none narrow enough to be bridged".to_owned(),
+        (n, 0, _) => format!("gaps between parts: all open ({n} points midway across them stay outside)"),
+        (n, closed, Some(widest)) => format!(
+            "gaps between parts: {closed} of {n} points midway across them are inside the cage (bridged gaps up to {} wide){}",
+            width(widest),
+            match gaps.narrowest_open {
+                Some(narrowest) => format!("; gaps from {} wide stay open where the cage keeps them", width(narrowest)),
+                None => "; none stays open: more vertices keep parts apart".to_owned(),
+            }
+        ),
+        (n, closed, None) => format!("gaps between parts: {closed} of {n} points inside the cage"),
+    }
 }
 
 /// A length or volume with four significant digits, however small or large

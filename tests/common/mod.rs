@@ -4,6 +4,8 @@
 #[cfg(feature = "ui-tests")]
 pub mod editor;
 pub mod gltf_reader;
+#[allow(dead_code)]
+pub mod shapes;
 
 use pmvc::geometry::{procedural, Cage};
 use std::path::{Path, PathBuf};

@@ -142,6 +142,11 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert isinstance(cage, pmvc.Cage)
     assert report["vertices"] == len(cage.vertices) and report["outside_vertices"] == 0
     assert report["target_vertices"] == 60
+    # The gap report's keys, as pmvc cage's "gaps between parts" line has them
+    # (their meaning is tested in tests/autocage_shapes.rs).
+    assert isinstance(report["gap_points"], int) and isinstance(report["gap_points_open"], int)
+    for key in ("narrowest_open_gap", "widest_closed_gap"):
+        assert report[key] is None or report[key] > 0
     assert (pmvc.classify(comb_points, cage) == pmvc.INSIDE).all()
     assert calls[0] == 0 and calls[-1] == 1000 and calls == sorted(calls)
 

@@ -24,6 +24,15 @@ impl State<'_> {
         })
     }
 
+    /// Whether a gap point lies between the old faces and the new ones, and
+    /// so would end up inside the cage.
+    pub(super) fn covers_gap_points(&self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
+        let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
+        self.gap_points.any_enclosed(&faces, |q, faces| {
+            faces.iter().filter(|t| ray_hits_triangle(q, **t)).count() % 2 == 1
+        })
+    }
+
     /// The edge's two ends share exactly the two vertices opposite it, and
     /// those keep at least three neighbours: the surface stays a manifold and
     /// no part shrinks to a flat pair of faces.

@@ -15,9 +15,12 @@
 //!    the cage cross itself, swallow another part, fold or make a sliver
 //!    ([`simplify`]), and that stay within an envelope of the mesh (cells at
 //!    most a few voxels away, widened step by step only when no collapse is
-//!    left), so that parts a few voxels apart are not bridged;
+//!    left), so that parts a few voxels apart are not bridged, and that would
+//!    cover a point midway across a gap between parts of the mesh that the
+//!    voxels left outside ([`gaps`]);
 //! 5. slide each vertex back inward as far as the same checks allow, keeping
-//!    the clearance from a dense sample of the mesh's surface ([`shrink`]).
+//!    the clearance from a dense sample of the mesh's surface ([`shrink`]),
+//!    whenever the collapses are stuck and at the end.
 //!
 //! Step 4 keeps every surface it makes around the previous one, so the cage
 //! contains the voxels, which contain every point of the mesh's surface; each
@@ -28,6 +31,7 @@
 //! check fails.
 
 mod checks;
+mod gaps;
 mod guard;
 mod measure;
 mod pairing;
@@ -42,6 +46,7 @@ mod winding;
 use super::output::human_bytes;
 use super::{Cage, CageError, TriMesh};
 use crate::geometry::budget::TooLarge;
+pub use gaps::GapReport;
 use glam::DVec3;
 pub use plan::{plan_cage, CagePlan, MAX_GRID_CELLS, MAX_SURFACE_SAMPLES};
 use std::time::Instant;
@@ -125,6 +130,8 @@ pub struct CageStats {
     pub grid: [usize; 3],
     /// Vertices of the voxel surface before simplification.
     pub surface_vertices: usize,
+    /// The gaps between parts of the mesh, and which the cage keeps open.
+    pub gaps: GapReport,
     pub seconds: f64,
 }
 
@@ -281,11 +288,16 @@ pub fn generate_cage(
     let tree = TriangleTree::new(&mesh.positions, &mesh.triangles);
     let target = options.target_vertices;
     let mesh_points = points::PointTree::new(measure::surface_samples(mesh, 0.5 * clearance));
+    // Gaps wider than the cage's two clearances can be kept open; those
+    // narrower than the widest reach could be bridged.
+    let gap_widths = (2.0 * clearance, 2.0 * (clearance + MAX_REACH * diagonal));
+    let gap_points = gaps::gap_points(mesh, &tree, 2.0 * clearance, gap_widths);
     let context = Context {
         mesh,
         tree: &tree,
         clearance,
         open: closed_volume.is_none(),
+        gap_points: &gap_points,
     };
 
     let mut cell = plan.cell_size;
@@ -353,6 +365,7 @@ pub fn generate_cage(
         cell_size_asked: plan.cell_size_asked,
         centre: plan.centre,
         volume,
+        gap_points: &gap_points,
     };
     finish(mesh, best, &request, started, progress)
 }
@@ -365,6 +378,7 @@ struct Context<'a> {
     /// The mesh has edges with other than two faces: its volume is measured
     /// by winding number.
     open: bool,
+    gap_points: &'a [gaps::GapPoint],
 }
 
 /// The mesh's volume, for the volume ratio.
@@ -384,6 +398,8 @@ struct Request<'a> {
     /// Where the centred cage goes back to.
     centre: DVec3,
     volume: MeshVolume,
+    /// Every gap point found, to report which the cage keeps outside.
+    gap_points: &'a [gaps::GapPoint],
 }
 
 /// A closed voxel surface around the mesh, at least `clearance` from it.
@@ -392,6 +408,8 @@ struct VoxelSurface {
     envelope: voxels::Envelope,
     clearance_cells: usize,
     winding_volume: f64,
+    /// The gap points outside the voxels, which the cage keeps outside.
+    gaps: Vec<DVec3>,
 }
 
 /// The cage of one voxel size, before it is checked.
@@ -436,6 +454,12 @@ impl Context<'_> {
         voxels::fill_cavities(&mut voxels);
         step(0.9)?;
         voxels::make_well_composed(&mut voxels);
+        let gaps = self
+            .gap_points
+            .iter()
+            .map(|g| g.position)
+            .filter(|&p| voxels.is_outside(p))
+            .collect();
         step(1.0)?;
         let faces = surface::boundary_face_count(&voxels);
         plan::check_surface(faces as u64, cell, mesh.diagonal())?;
@@ -444,6 +468,7 @@ impl Context<'_> {
             envelope,
             clearance_cells,
             winding_volume: winding_volume.unwrap_or(0.0),
+            gaps,
         })
     }
 }
@@ -458,12 +483,14 @@ fn simplify_surface(
         surface,
         envelope,
         winding_volume,
+        gaps,
         ..
     } = voxel_surface;
+    let gap_tree = points::PointTree::new(gaps);
     let (cell, grid) = (envelope.cell, envelope.dims);
     let surface_vertices = surface.positions.len();
     let simplified = simplify::simplify(
-        mesh_points,
+        (mesh_points, &gap_tree),
         surface.positions,
         surface.triangles,
         envelope,
@@ -520,6 +547,7 @@ fn finish(
             first,
         });
     }
+    let gaps = gaps::report(request.gap_points, &cage);
     let (mesh_volume, mesh_volume_from_voxels) = match request.volume {
         MeshVolume::Closed(volume) => (volume, false),
         MeshVolume::Winding(volume) => (volume, true),
@@ -544,6 +572,7 @@ fn finish(
         reach,
         grid,
         surface_vertices,
+        gaps,
         seconds: started.elapsed().as_secs_f64(),
     };
     // Validated where it was built; a translation changes neither its

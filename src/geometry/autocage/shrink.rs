@@ -62,6 +62,7 @@ impl State<'_> {
             && !self.crosses_anything(&replaced, &sorted_star)
             && !self.sweeps_over_vertices(v, v, old, &sorted_star, &new_corners)
             && !self.uncovers_mesh_points(&old_corners, &new_corners)
+            && !self.covers_gap_points(&old_corners, &new_corners)
             && !self.near_mesh_points(&new_corners, self.clearance);
         if !accepted {
             self.positions[v] = old;

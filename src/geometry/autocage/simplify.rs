@@ -99,6 +99,9 @@ pub(super) struct State<'a> {
     pub(super) seen_vertices: Vec<u32>,
     /// Points of the mesh (vertices and face centres) that must stay inside.
     pub(super) mesh_points: &'a PointTree,
+    /// Points midway across gaps between parts of the mesh that must stay
+    /// outside ([`super::gaps`]).
+    pub(super) gap_points: &'a PointTree,
     /// Least distance from the mesh points that a change may leave.
     pub(super) clearance: f64,
     pub(super) stamp: u32,
@@ -120,21 +123,30 @@ pub(super) struct Goal {
 /// collapse is allowed, then tighten it. Returns `None` when `progress` asks
 /// to stop.
 pub(super) fn simplify(
-    mesh_points: &PointTree,
+    (mesh_points, gap_points): (&PointTree, &PointTree),
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     mut envelope: Envelope,
     goal: &Goal,
     progress: &dyn Fn(f32) -> bool,
 ) -> Option<Simplified> {
-    let mut state = State::new(positions, triangles, envelope.cell, mesh_points, goal);
+    let points = (mesh_points, gap_points);
+    let mut state = State::new(positions, triangles, envelope.cell, points, goal);
     let start = state.alive_vertices;
     let mut heap = state.all_candidates(&envelope);
     let mut steps = 0usize;
     let target = goal.target_vertices;
+    let mut shrunk_at = None;
     while state.alive_vertices > target {
         let Some(entry) = heap.pop() else {
-            // Stuck: let the cage move further from the mesh, and go on.
+            // Stuck: tighten once, which makes room for more outward
+            // collapses, and then let the cage move further from the mesh.
+            if shrunk_at != Some(envelope.limit) {
+                shrunk_at = Some(envelope.limit);
+                state.shrink(2.0 * envelope.cell);
+                heap = state.all_candidates(&envelope);
+                continue;
+            }
             if envelope.limit >= goal.max_limit {
                 break;
             }
@@ -207,7 +219,7 @@ impl<'a> State<'a> {
         positions: Vec<DVec3>,
         triangles: Vec<[u32; 3]>,
         cell: f64,
-        mesh_points: &'a PointTree,
+        (mesh_points, gap_points): (&'a PointTree, &'a PointTree),
         goal: &Goal,
     ) -> State<'a> {
         let diagonal = goal.diagonal;
@@ -236,6 +248,7 @@ impl<'a> State<'a> {
             seen_triangles: vec![0; triangles.len()],
             seen_vertices: vec![0; count],
             mesh_points,
+            gap_points,
             clearance: goal.clearance,
             stamp: 0,
             tolerance: 1e-9 * diagonal,
@@ -464,6 +477,7 @@ impl<'a> State<'a> {
             && !self.crosses_anything(replaced, star)
             && !self.sweeps_over_vertices(a, b, position, star, old_corners)
             && !self.uncovers_mesh_points(old_corners, &new_corners)
+            && !self.covers_gap_points(old_corners, &new_corners)
             && !self.near_mesh_points(&new_corners, self.clearance)
     }
 

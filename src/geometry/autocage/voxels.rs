@@ -158,6 +158,15 @@ fn winding_volume(mesh: &TriMesh, voxels: &Voxels, surface: &[bool], tree: &Tria
     (empty_inside as f64 + fraction * surface_cells as f64) * voxels.cell.powi(3)
 }
 
+impl Voxels {
+    /// Whether `p` lies in a cell outside the set (or beyond the grid).
+    pub(super) fn is_outside(&self, p: DVec3) -> bool {
+        let c = ((p - self.origin) / self.cell).floor();
+        let beyond = (0..3).any(|k| c[k] < 0.0 || c[k] >= self.dims[k] as f64);
+        beyond || !self.inside[cell_of(self, p)]
+    }
+}
+
 fn cell_of(voxels: &Voxels, p: DVec3) -> usize {
     let c = ((p - voxels.origin) / voxels.cell).floor();
     let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);

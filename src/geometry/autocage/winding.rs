@@ -104,7 +104,20 @@ impl TriangleTree {
 
     /// Distance from `q` to the nearest triangle.
     pub(super) fn distance(&self, q: DVec3) -> f64 {
-        let mut best = f64::INFINITY;
+        self.distance_below(q, f64::INFINITY)
+    }
+
+    /// Whether a triangle is nearer to `q` than `limit`.
+    pub(super) fn is_within(&self, q: DVec3, limit: f64) -> bool {
+        self.distance_below(q, limit) < limit
+    }
+
+    /// The distance from `q` to the nearest triangle when it is below `limit`,
+    /// otherwise `limit` or more; the search stops at the first triangle found
+    /// nearer than the limit only when the limit is finite.
+    fn distance_below(&self, q: DVec3, limit: f64) -> f64 {
+        let early = limit.is_finite();
+        let mut best = limit;
         let mut stack = vec![0usize];
         while let Some(index) = stack.pop() {
             let node = &self.nodes[index];
@@ -117,6 +130,9 @@ impl TriangleTree {
                 for [a, b, c] in &self.triangles[range] {
                     let (closest, _) = closest_point_on_triangle(q, *a, *b, *c);
                     best = best.min(closest.distance(q));
+                }
+                if early && best < limit {
+                    return best;
                 }
             } else {
                 // Nearer child first, so the farther one is more often pruned.
@@ -131,6 +147,69 @@ impl TriangleTree {
         }
         best
     }
+    /// The nearest `t` in `(0, max_t]` at which the ray `origin + t · direction`
+    /// (unit direction) meets a triangle, either side.
+    pub(super) fn first_hit(&self, origin: DVec3, direction: DVec3, max_t: f64) -> Option<f64> {
+        let inverse = DVec3::ONE / direction;
+        let entry = |node: &Node| {
+            // Slab test: where the ray enters the node's box, if it does.
+            let (t0, t1) = ((node.lo - origin) * inverse, (node.hi - origin) * inverse);
+            let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+            (far >= 0.0 && near <= far).then_some(near)
+        };
+        let mut best = max_t;
+        let mut found = false;
+        // The tree halves its triangles at each level, so 64 levels hold any mesh.
+        let mut stack = [(0usize, 0.0f64); 64];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let (index, near) = stack[depth];
+            if near > best {
+                continue;
+            }
+            let node = &self.nodes[index];
+            if Self::is_leaf(node) {
+                let range = node.first as usize..(node.first + node.count) as usize;
+                for triangle in &self.triangles[range] {
+                    if let Some(t) = ray_triangle(origin, direction, triangle) {
+                        if t > 0.0 && t <= best {
+                            (best, found) = (t, true);
+                        }
+                    }
+                }
+            } else {
+                // Nearer child on top, so that it is searched first.
+                let (l, r) = (node.first as usize, node.first as usize + 1);
+                let mut children = [(l, entry(&self.nodes[l])), (r, entry(&self.nodes[r]))];
+                if children[0].1.unwrap_or(f64::INFINITY) < children[1].1.unwrap_or(f64::INFINITY) {
+                    children.swap(0, 1);
+                }
+                for (child, near) in children {
+                    if let Some(near) = near.filter(|&near| near <= best) {
+                        stack[depth] = (child, near);
+                        depth += 1;
+                    }
+                }
+            }
+        }
+        found.then_some(best)
+    }
+}
+
+/// Möller–Trumbore: the ray parameter where it crosses the triangle, if it does.
+fn ray_triangle(origin: DVec3, direction: DVec3, [a, b, c]: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (*b - *a, *c - *a);
+    let p = direction.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() <= 1e-300 {
+        return None;
+    }
+    let s = origin - *a;
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = direction.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0).then(|| e2.dot(q) / det)
 }
 
 fn leaf(corners: &[[DVec3; 3]], start: usize, count: usize) -> Node {
