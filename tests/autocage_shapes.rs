@@ -180,9 +180,11 @@ fn a_torus_knot_keeps_its_strands_apart() {
         0
     );
     let floor = tube_ratio_floor(0.25, DEFAULT_CLEARANCE * knot.mesh.diagonal());
-    // Measured 2.36, against a floor of 1.63 for any cage at this clearance.
+    // Measured 2.28, against a floor of 1.63 for any cage at this clearance;
+    // 2.36 without the final tightening along face normals, 2.48 without
+    // tightening when the collapses are stuck either.
     assert!(
-        ratio >= floor && ratio < 2.6,
+        ratio >= floor && ratio < 2.33,
         "ratio {ratio}, floor {floor}"
     );
 }

@@ -9,29 +9,66 @@ use glam::DVec3;
 /// Fractions of the step tried for each vertex, largest first.
 const TRIES: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0625];
 const PASSES: usize = 4;
+/// Fewer for the faces' normals, each of which costs as much as the vertex's.
+const FACE_TRIES: [f64; 2] = [0.5, 0.125];
 
 impl State<'_> {
-    /// Slide vertices inward, `PASSES` times over all of them, by at most
-    /// `step` each time, never closer than the clearance to a mesh point.
-    pub(super) fn shrink(&mut self, step: f64) {
+    /// Slide vertices inward by at most `step` at a time, never closer than
+    /// the clearance to a mesh point: up to `PASSES` passes, the first over
+    /// every vertex, the next over those that moved and their neighbours.
+    /// With `along_faces`, a vertex that cannot move along its normal tries
+    /// each of its faces' inward normals: that tilts its other faces, which
+    /// the gap points keep from swinging across a gap.
+    pub(super) fn shrink(&mut self, step: f64, along_faces: bool) {
+        // A vertex that could not move stays stuck until it or a neighbour
+        // moves, so later passes try only those.
+        let mut active = self.vertex_alive.clone();
         for _ in 0..PASSES {
-            let mut moved = false;
-            for v in 0..self.positions.len() {
-                if !self.vertex_alive[v] {
-                    continue;
-                }
+            let mut moved = Vec::new();
+            let candidates: Vec<usize> = (0..active.len())
+                .filter(|&v| active[v] && self.vertex_alive[v])
+                .collect();
+            for v in candidates {
                 let Some(inward) = self.inward_normal(v) else {
                     continue;
                 };
                 let start = self.positions[v];
-                moved |= TRIES
-                    .iter()
-                    .any(|t| self.try_move(v, start + inward * (step * t)));
+                let mut directions = vec![inward];
+                if along_faces {
+                    // Along one face's inward normal instead: tilts the others.
+                    directions.extend(self.face_normals(v));
+                }
+                let moved_here = directions.iter().enumerate().any(|(k, &direction)| {
+                    let tries: &[f64] = if k == 0 { &TRIES } else { &FACE_TRIES };
+                    tries
+                        .iter()
+                        .any(|t| self.try_move(v, start + direction * (step * t)))
+                });
+                if moved_here {
+                    moved.push(v);
+                }
             }
-            if !moved {
+            if moved.is_empty() {
                 return;
             }
+            active.fill(false);
+            for v in moved {
+                active[v] = true;
+                for n in self.neighbours(v) {
+                    active[n] = true;
+                }
+            }
         }
+    }
+
+    fn face_normals(&self, v: usize) -> Vec<DVec3> {
+        self.vertex_triangles[v]
+            .iter()
+            .filter_map(|&t| {
+                let [p, q, r] = self.corners(t as usize);
+                (r - p).cross(q - p).try_normalize()
+            })
+            .collect()
     }
 
     fn inward_normal(&self, v: usize) -> Option<DVec3> {

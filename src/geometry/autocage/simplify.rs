@@ -143,7 +143,7 @@ pub(super) fn simplify(
             // collapses, and then let the cage move further from the mesh.
             if shrunk_at != Some(envelope.limit) {
                 shrunk_at = Some(envelope.limit);
-                state.shrink(2.0 * envelope.cell);
+                state.shrink(2.0 * envelope.cell, false);
                 heap = state.all_candidates(&envelope);
                 continue;
             }
@@ -193,7 +193,7 @@ pub(super) fn simplify(
     if !progress(0.9) {
         return None;
     }
-    state.shrink(2.0 * envelope.cell);
+    state.shrink(2.0 * envelope.cell, true);
     Some(state.finish(envelope.limit))
 }
 
