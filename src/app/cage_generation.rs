@@ -334,7 +334,7 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         "parts of the mesh closer than about {} ({:.1}% of the diagonal) may share one part of the cage{}",
         significant(stats.merge_distance()),
         percent(stats.merge_distance()),
-        if stats.merge_distance() > 3.0 * stats.cell_size {
+        if stats.merge_set_by_reach() {
             "; to reach the target the cage was allowed half that far from the mesh, and more vertices keep closer parts apart"
         } else if stats.cell_size_chosen
             && stats.cell_size > 1.05 * DEFAULT_CELL_SIZE * stats.mesh_diagonal

@@ -68,6 +68,8 @@ pub(super) fn gap_points(
 /// a gap the cage bridges.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GapReport {
+    /// Gaps up to this wide were looked for (in the mesh's units).
+    pub range: f64,
     pub points: usize,
     /// Gap points outside the cage (its patches, where it has quads).
     pub open: usize,
@@ -85,10 +87,11 @@ impl GapReport {
 
 /// Which gap points the finished cage leaves outside, classified as any point
 /// is against a cage (by its patches where it has quads).
-pub(super) fn report(points: &[GapPoint], cage: &Cage) -> GapReport {
+pub(super) fn report(points: &[GapPoint], range: f64, cage: &Cage) -> GapReport {
     let positions: Vec<DVec3> = points.iter().map(|g| g.position).collect();
     let classes = classify_points(cage, &positions).classes;
     let mut report = GapReport {
+        range,
         points: points.len(),
         ..GapReport::default()
     };

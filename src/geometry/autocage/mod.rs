@@ -117,6 +117,8 @@ pub struct CageStats {
     pub mesh_volume_from_voxels: bool,
     /// Smallest angle of any cage triangle, in degrees.
     pub min_angle_degrees: f64,
+    /// The clearance asked for (or the default), in the mesh's units.
+    pub clearance: f64,
     /// Voxel size and grid used.
     pub cell_size: f64,
     /// Whether the voxel size was chosen by the generator rather than asked for.
@@ -141,11 +143,25 @@ impl CageStats {
         (self.mesh_volume > 0.0).then(|| self.cage_volume / self.mesh_volume)
     }
 
-    /// Parts of the mesh closer than this may share one part of the cage: about
-    /// three voxels, or twice the reach (a cage that may stand that far from
-    /// both sides of a gap may cross it).
+    /// Parts of the mesh closer than this may share one part of the cage:
+    /// those the voxels may join (the clearance and a voxel on each side, at
+    /// least three voxels), or twice the reach when the cage was allowed to
+    /// stand further off the mesh than the gaps that keep gap points (a cage
+    /// that may stand that far from both sides of a gap may cross it).
     pub fn merge_distance(&self) -> f64 {
-        (3.0 * self.cell_size).max(2.0 * (self.reach + self.cell_size))
+        let voxels = (3.0 * self.cell_size)
+            .max(2.0 * ((self.clearance / self.cell_size).ceil() + 1.0) * self.cell_size);
+        if self.merge_set_by_reach() {
+            voxels.max(2.0 * (self.reach + self.cell_size))
+        } else {
+            voxels
+        }
+    }
+
+    /// Whether the cage stood off the mesh by more than half the widest gap
+    /// the gap points keep open, so that wider gaps may have been bridged.
+    pub fn merge_set_by_reach(&self) -> bool {
+        2.0 * (self.reach + self.cell_size) > self.gaps.range
     }
 
     /// Whether the vertex count is within ±15 % of the target.
@@ -289,8 +305,12 @@ pub fn generate_cage(
     let target = options.target_vertices;
     let mesh_points = points::PointTree::new(measure::surface_samples(mesh, 0.5 * clearance));
     // Gaps wider than the cage's two clearances can be kept open; those
-    // narrower than the widest reach could be bridged.
-    let gap_widths = (2.0 * clearance, 2.0 * (clearance + MAX_REACH * diagonal));
+    // narrower than twice the first try's reach (and its few voxels past the
+    // clearance) could be bridged.
+    let gap_widths = (
+        2.0 * clearance,
+        2.0 * (clearance + 1.25 * MAX_REACH * diagonal),
+    );
     let gap_points = gaps::gap_points(mesh, &tree, 2.0 * clearance, gap_widths);
     let context = Context {
         mesh,
@@ -360,12 +380,14 @@ pub fn generate_cage(
     let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
     let request = Request {
         target_vertices: target,
+        clearance,
         quads: options.quads.then_some((&mesh_points, clearance)),
         cell_size_chosen: chosen,
         cell_size_asked: plan.cell_size_asked,
         centre: plan.centre,
         volume,
         gap_points: &gap_points,
+        gap_range: gap_widths.1,
     };
     finish(mesh, best, &request, started, progress)
 }
@@ -391,6 +413,7 @@ enum MeshVolume {
 /// What was asked, and what finishing needs besides the attempt.
 struct Request<'a> {
     target_vertices: usize,
+    clearance: f64,
     /// With quads: the mesh's surface samples and the clearance they keep.
     quads: Option<(&'a points::PointTree, f64)>,
     cell_size_chosen: bool,
@@ -400,6 +423,8 @@ struct Request<'a> {
     volume: MeshVolume,
     /// Every gap point found, to report which the cage keeps outside.
     gap_points: &'a [gaps::GapPoint],
+    /// The widest gap that gap points were sought across.
+    gap_range: f64,
 }
 
 /// A closed voxel surface around the mesh, at least `clearance` from it.
@@ -547,7 +572,7 @@ fn finish(
             first,
         });
     }
-    let gaps = gaps::report(request.gap_points, &cage);
+    let gaps = gaps::report(request.gap_points, request.gap_range, &cage);
     let (mesh_volume, mesh_volume_from_voxels) = match request.volume {
         MeshVolume::Closed(volume) => (volume, false),
         MeshVolume::Winding(volume) => (volume, true),
@@ -566,6 +591,7 @@ fn finish(
         mesh_volume,
         mesh_volume_from_voxels,
         min_angle_degrees: measure::min_angle_degrees(&cage),
+        clearance: request.clearance,
         cell_size: cell,
         cell_size_chosen: request.cell_size_chosen,
         cell_size_asked: request.cell_size_asked,
