@@ -552,7 +552,9 @@ fn finish(
     let (cage, report) = match request.quads {
         Some((samples, clearance)) => {
             let triangles = &simplified.triangles;
-            pairing::quad_cage(simplified.positions, triangles, samples, clearance)
+            let gaps =
+                points::PointTree::new(request.gap_points.iter().map(|g| g.position).collect());
+            pairing::quad_cage(simplified.positions, triangles, (samples, &gaps), clearance)
         }
         None => Cage::new(TriMesh {
             triangle_faces: (0..simplified.triangles.len() as u32).collect(),

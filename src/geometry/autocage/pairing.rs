@@ -27,6 +27,10 @@ const MAX_SKEW_DEGREES: f64 = 50.0;
 /// Quads that a failed validation names are split again at most this often.
 const MAX_RETRIES: usize = 8;
 
+/// The mesh's surface samples, which keep the clearance, and the gap points,
+/// which stay outside.
+pub(super) type Points<'a> = (&'a PointTree, &'a PointTree);
+
 /// A pair of triangles sharing an edge, as the quad they would make.
 struct Candidate {
     triangles: [usize; 2],
@@ -39,7 +43,7 @@ struct Candidate {
 fn pair(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
-    samples: &PointTree,
+    points: Points,
     clearance: f64,
     kept_apart: &HashSet<usize>,
 ) -> Vec<Vec<u32>> {
@@ -54,7 +58,7 @@ fn pair(
         .into_values()
         .filter_map(|faces| match faces[..] {
             [first, second] if !kept_apart.contains(&first) && !kept_apart.contains(&second) => {
-                candidate(positions, triangles, [first, second], samples, clearance)
+                candidate(positions, triangles, [first, second], points, clearance)
             }
             _ => None,
         })
@@ -88,7 +92,7 @@ fn candidate(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     pair: [usize; 2],
-    samples: &PointTree,
+    (samples, gaps): Points,
     clearance: f64,
 ) -> Option<Candidate> {
     let [first, second] = pair.map(|t| triangles[t]);
@@ -133,6 +137,11 @@ fn candidate(
     if !valley && samples.any_within(&faces, clearance + deviation) {
         return None;
     }
+    // Across a valley the patch bulges out by up to δ: into a gap, unless no
+    // gap point is that near.
+    if valley && gaps.any_within(&faces, deviation) {
+        return None;
+    }
     Some(Candidate {
         triangles: pair,
         corners,
@@ -145,13 +154,13 @@ fn candidate(
 pub(super) fn quad_cage(
     positions: Vec<DVec3>,
     triangles: &[[u32; 3]],
-    samples: &PointTree,
+    points: Points,
     clearance: f64,
 ) -> Result<(Cage, CageReport), CageError> {
     let mut kept_apart = HashSet::new();
     let mut last_error = None;
     for _ in 0..=MAX_RETRIES {
-        let polygons = pair(&positions, triangles, samples, clearance, &kept_apart);
+        let polygons = pair(&positions, triangles, points, clearance, &kept_apart);
         match Cage::new(triangulate_faces(&polygons, &positions)) {
             Ok(result) => return Ok(result),
             Err(error) => {
@@ -184,7 +193,7 @@ pub(super) fn quad_cage(
     }
     // Every quad named so far is split; the triangles alone passed before.
     let all: HashSet<usize> = (0..triangles.len()).collect();
-    let polygons = pair(&positions, triangles, samples, clearance, &all);
+    let polygons = pair(&positions, triangles, points, clearance, &all);
     Cage::new(triangulate_faces(&polygons, &positions)).map_err(|e| last_error.unwrap_or(e))
 }
 
@@ -253,4 +262,30 @@ fn surface_distance(cage: &Cage, p: DVec3, bound: f64) -> f64 {
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles across a valley (d 0.2 above the plane of a b c): their
+    /// patch stands up to δ = 0.05 above them, at the centre. A gap point
+    /// under that bulge keeps them two triangles; one further off does not.
+    #[test]
+    fn a_valley_pair_whose_patch_would_cover_a_gap_point_stays_two_triangles() {
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.2),
+        ];
+        let triangles = [[0, 1, 2], [1, 0, 3]];
+        let pair_with = |gap_points: Vec<DVec3>| {
+            let (samples, gaps) = (PointTree::new(Vec::new()), PointTree::new(gap_points));
+            candidate(&positions, &triangles, [0, 1], (&samples, &gaps), 0.01).is_some()
+        };
+        assert!(pair_with(Vec::new()));
+        assert!(pair_with(vec![DVec3::new(0.5, 0.5, 0.5)]));
+        assert!(!pair_with(vec![DVec3::new(0.5, 0.5, 0.03)]));
+    }
 }
