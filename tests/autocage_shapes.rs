@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::measure::signed_volume;
 use common::shapes::{self, Shape};
 use common::winding_number;
 use glam::DVec3;
@@ -13,14 +14,7 @@ use pmvc::geometry::autocage::{generate_cage, CageOptions, GeneratedCage, DEFAUL
 use pmvc::geometry::Cage;
 
 fn cage_volume(cage: &Cage) -> f64 {
-    cage.triangles()
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| cage.positions()[i as usize]);
-            a.dot(b.cross(c))
-        })
-        .sum::<f64>()
-        / 6.0
+    signed_volume(cage.positions(), cage.triangles())
 }
 
 fn inside(cage: &Cage, p: DVec3) -> bool {
@@ -74,17 +68,7 @@ fn the_shapes_are_what_the_tests_take_them_for() {
     // The triangles' own volume agrees with the shape's (the chords cut
     // the curved parts a little; the hand's fingers overlap its palm, which the
     // shape's volume counts once and the triangles twice).
-    let signed = |shape: &Shape| {
-        let m = &shape.mesh;
-        m.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| m.positions[i as usize]);
-                a.dot(b.cross(c))
-            })
-            .sum::<f64>()
-            / 6.0
-    };
+    let signed = |shape: &Shape| signed_volume(&shape.mesh.positions, &shape.mesh.triangles);
     let knot = shapes::torus_knot();
     assert!((signed(&knot) / knot.volume - 1.0).abs() < 0.02);
     let plate = shapes::thin_plate();

@@ -5,6 +5,8 @@
 pub mod editor;
 pub mod gltf_reader;
 #[allow(dead_code)]
+pub mod measure;
+#[allow(dead_code)]
 pub mod shapes;
 
 use pmvc::geometry::{procedural, Cage};
