@@ -13,24 +13,17 @@ const MIN_ANGLE_DEGREES: f64 = 3.0;
 const MAX_TURN_COSINE: f64 = 0.0;
 
 impl State<'_> {
-    /// Whether a mesh point near the collapse lies between the old faces and
-    /// the new ones, and so would end up outside the cage.
-    pub(super) fn uncovers_mesh_points(&self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
+    /// Whether a point that must keep its side lies between the old faces and
+    /// the new ones: a mesh point, which would end up outside the cage, or a
+    /// gap point, which would end up inside.
+    pub(super) fn moves_points_across(&self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
         // The old and new faces bound the swept region; a ray from a point
         // crosses them an odd number of times exactly when it is inside.
         let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
-        self.mesh_points.any_enclosed(&faces, |q, faces| {
+        let swept = |q: DVec3, faces: &[[DVec3; 3]]| {
             faces.iter().filter(|t| ray_hits_triangle(q, **t)).count() % 2 == 1
-        })
-    }
-
-    /// Whether a gap point lies between the old faces and the new ones, and
-    /// so would end up inside the cage.
-    pub(super) fn covers_gap_points(&self, old: &[[DVec3; 3]], new: &[[DVec3; 3]]) -> bool {
-        let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
-        self.gap_points.any_enclosed(&faces, |q, faces| {
-            faces.iter().filter(|t| ray_hits_triangle(q, **t)).count() % 2 == 1
-        })
+        };
+        self.mesh_points.any_enclosed(&faces, swept) || self.gap_points.any_enclosed(&faces, swept)
     }
 
     /// The edge's two ends share exactly the two vertices opposite it, and

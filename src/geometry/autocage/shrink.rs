@@ -98,8 +98,7 @@ impl State<'_> {
         let accepted = self.shapes_are_good(&replaced, (v, usize::MAX), (old, old))
             && !self.crosses_anything(&replaced, &sorted_star)
             && !self.sweeps_over_vertices(v, v, old, &sorted_star, &new_corners)
-            && !self.uncovers_mesh_points(&old_corners, &new_corners)
-            && !self.covers_gap_points(&old_corners, &new_corners)
+            && !self.moves_points_across(&old_corners, &new_corners)
             && !self.near_mesh_points(&new_corners, self.clearance);
         if !accepted {
             self.positions[v] = old;

@@ -476,8 +476,7 @@ impl<'a> State<'a> {
         new_corners.iter().all(|&f| envelope.allows_triangle(f))
             && !self.crosses_anything(replaced, star)
             && !self.sweeps_over_vertices(a, b, position, star, old_corners)
-            && !self.uncovers_mesh_points(old_corners, &new_corners)
-            && !self.covers_gap_points(old_corners, &new_corners)
+            && !self.moves_points_across(old_corners, &new_corners)
             && !self.near_mesh_points(&new_corners, self.clearance)
     }
 
