@@ -231,3 +231,22 @@ fn two_blobs_apart_and_close() {
         "{gaps:?}"
     );
 }
+
+/// Gap points are looked for along each face's outward normal, outward being
+/// the side that gives the mesh a positive volume: the same blobs turned
+/// inside out find the same gaps and keep them open.
+#[test]
+fn a_mesh_turned_inside_out_finds_the_same_gaps() {
+    let apart = shapes::two_blobs(0.4);
+    let mut inside_out = apart.clone();
+    for t in &mut inside_out.mesh.triangles {
+        t.swap(1, 2);
+    }
+    assert!(signed_volume(&inside_out.mesh.positions, &inside_out.mesh.triangles) < 0.0);
+    let (generated, _) = generate("two blobs 8 % apart", &apart, 120);
+    let (turned, _) = generate("the same, inside out", &inside_out, 120);
+    assert!(generated.stats.gaps.points > 0);
+    assert_eq!(turned.stats.gaps.points, generated.stats.gaps.points);
+    assert_eq!(turned.stats.shells, 2);
+    assert_eq!(turned.stats.gaps.closed(), 0);
+}

@@ -7,6 +7,7 @@ use pmvc::geometry::TriMesh;
 use std::f64::consts::PI;
 
 /// A mesh and what is known about it independently of its triangles.
+#[derive(Clone)]
 pub struct Shape {
     pub mesh: TriMesh,
     /// The volume of the solid the triangles approximate (to within the

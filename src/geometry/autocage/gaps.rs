@@ -1,13 +1,20 @@
 //! Gaps between parts of the mesh, found on its surface: from points on each
-//! face, a ray along the face's normal (either way) that meets the mesh again
+//! face, a ray along the face's outward normal that meets the mesh again
 //! within a few clearances, through empty space, crosses a gap, and the point
-//! midway is a *gap point*. The simplification and the tightening keep every
-//! gap point outside the cage that is outside the voxels they start from, so
-//! a cage that keeps a gap open in its voxels keeps it open to the end: the
-//! mirror of the mesh's samples, which must stay inside.
+//! midway is a *gap point*. Only the outward ray is cast: the inward one meets
+//! the far side of the solid, which is no gap. (On four shared models the
+//! inward rays were half the casts, found no gap point, and asked for 23–99.7 %
+//! of the winding numbers.) A part of the mesh facing inward, against the
+//! rest, finds its gaps from the other side of each gap.
+//!
+//! The simplification and the tightening keep every gap point outside the
+//! cage that is outside the voxels they start from, so a cage that keeps a gap
+//! open in its voxels keeps it open to the end: the mirror of the mesh's
+//! samples, which must stay inside.
 
 use super::plan::lattice_divisions;
 use super::winding::TriangleTree;
+use crate::geometry::cage::signed_volume;
 use crate::geometry::{classify_points, Cage, PointClass, TriMesh};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -20,7 +27,8 @@ pub(super) struct GapPoint {
 }
 
 /// Gap points across gaps from `widths.0` to `widths.1` wide, from points
-/// about `spacing` apart on every face. Their number is at most the faces'
+/// about `spacing` apart on every face. Outward is the side that makes the
+/// mesh's signed volume positive. Their number is at most the faces'
 /// lattice points at that spacing, which [`super::plan`] bounds (it checks the
 /// count at half this spacing).
 pub(super) fn gap_points(
@@ -30,11 +38,16 @@ pub(super) fn gap_points(
     (narrowest, widest): (f64, f64),
 ) -> Vec<GapPoint> {
     let start_offset = 1e-9 * mesh.diagonal();
+    let outward = if signed_volume(&mesh.positions, &mesh.triangles) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
     mesh.triangles
         .par_iter()
         .flat_map_iter(|t| {
             let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            let normal = (b - a).cross(c - a).normalize_or_zero();
+            let d = outward * (b - a).cross(c - a).normalize_or_zero();
             let n = lattice_divisions([a, b, c], spacing).max(1.0) as usize;
             let third = 1.0 / 3.0;
             let starts = (0..n).flat_map(move |i| {
@@ -43,20 +56,18 @@ pub(super) fn gap_points(
                     a + (b - a) * u + (c - a) * v
                 })
             });
-            starts.flat_map(move |p| {
-                [normal, -normal].into_iter().filter_map(move |d| {
-                    if d == DVec3::ZERO {
-                        return None;
-                    }
-                    let width = start_offset + tree.first_hit(p + d * start_offset, d, widest)?;
-                    let position = p + d * (0.5 * width);
-                    // Through the solid (the far side of a finger) is no gap.
-                    // Midway between two surfaces, not beside a third (the
-                    // palm at a finger's foot).
-                    let medial = || !tree.is_within(position, 0.45 * width);
-                    (width >= narrowest && medial() && tree.winding_number(position).abs() < 0.5)
-                        .then_some(GapPoint { position, width })
-                })
+            starts.filter_map(move |p| {
+                if d == DVec3::ZERO {
+                    return None;
+                }
+                let width = start_offset + tree.first_hit(p + d * start_offset, d, widest)?;
+                let position = p + d * (0.5 * width);
+                // Midway between two surfaces, not beside a third (the palm at
+                // a finger's foot); and outside the mesh, where a face facing
+                // the wrong way or a hole let the ray into the solid.
+                let medial = || !tree.is_within(position, 0.45 * width);
+                (width >= narrowest && medial() && tree.winding_number(position).abs() < 0.5)
+                    .then_some(GapPoint { position, width })
             })
         })
         .collect()
