@@ -250,3 +250,27 @@ fn a_mesh_turned_inside_out_finds_the_same_gaps() {
     assert_eq!(turned.stats.shells, 2);
     assert_eq!(turned.stats.gaps.closed(), 0);
 }
+
+/// The report lists the gap points the cage bridges, where the mesh is: two
+/// blobs 2 % apart, far from the origin (the generator works about the mesh's
+/// centre), give points inside the cage, between the blobs.
+#[test]
+fn the_bridged_gap_points_are_reported_where_the_mesh_is() {
+    let offset = DVec3::new(40.0, -15.0, 7.0);
+    let mut close = shapes::two_blobs(0.1);
+    for p in &mut close.mesh.positions {
+        *p += offset;
+    }
+    let (generated, _) = generate("two blobs 2 % apart, moved", &close, 120);
+    let gaps = &generated.stats.gaps;
+    assert!(gaps.closed() > 0);
+    assert_eq!(gaps.bridged.len(), gaps.closed());
+    for &p in &gaps.bridged {
+        assert!(inside(&generated.cage, p), "{p} is not inside the cage");
+        // Between the blobs (centred at ±1.05 along x): outside both, and
+        // near the plane midway.
+        let winding = winding_number(&close.mesh.positions, &close.mesh.triangles, p);
+        assert!(winding.abs() < 0.5, "{p} is inside the mesh");
+        assert!((p.x - offset.x).abs() < 0.5, "{p} is not between the blobs");
+    }
+}

@@ -40,6 +40,14 @@ fn run_until_generated(harness: &mut Harness<'static, EditorApp>) {
     harness.run_steps(3);
 }
 
+/// File > Generate cage… with `target` vertices, waiting for the proposal.
+fn propose_cage(harness: &mut Harness<'static, EditorApp>, target: usize) {
+    choose_in_file_menu(harness, "Generate cage…");
+    harness.state_mut().cage_generation_mut().target_vertices = target;
+    click_button(harness, "Generate");
+    run_until_generated(harness);
+}
+
 fn cage_positions(app: &EditorApp) -> Vec<DVec3> {
     app.document().cage().positions().to_vec()
 }
@@ -283,10 +291,7 @@ fn the_voxel_size_box_sets_the_voxels_the_proposal_is_made_from() {
 fn a_generated_cage_binds_and_its_handles_drag_the_mesh() {
     let Some(mut harness) = editor() else { return };
     run_until_bound(&mut harness);
-    choose_in_file_menu(&mut harness, "Generate cage…");
-    harness.state_mut().cage_generation_mut().target_vertices = 24;
-    click_button(&mut harness, "Generate");
-    run_until_generated(&mut harness);
+    propose_cage(&mut harness, 24);
     click_button(&mut harness, "Use this cage");
     run_until_bound(&mut harness);
     let method = harness.state().active_method();
@@ -425,4 +430,33 @@ fn the_quads_box_proposes_a_cage_with_quads_that_binds_as_patches() {
     let method = harness.state().active_method();
     let bound = document.bound(method).expect("bound");
     assert_eq!(bound.options.quads, pmvc::coords::QuadSplit::None);
+}
+
+/// A proposal that bridges gaps says so in the window, with the key to the
+/// orange dots that mark them in the view; the points it marks are inside the
+/// proposed cage.
+#[test]
+fn a_proposal_that_bridges_gaps_marks_them() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    // Few vertices: the comb's prongs share one part of the cage.
+    propose_cage(&mut harness, 16);
+    let (bridged, cage) = {
+        let proposal = harness
+            .state()
+            .cage_generation()
+            .proposal()
+            .expect("a proposal once generated");
+        let gaps = &proposal.generated.stats.gaps;
+        assert!(gaps.closed() > 0, "{gaps:?}");
+        (gaps.bridged.clone(), proposal.generated.cage.clone())
+    };
+    let classes = classify_points(&cage, &bridged).classes;
+    assert!(classes
+        .iter()
+        .all(|c| !matches!(c, pmvc::geometry::PointClass::Outside)));
+    harness.get_by_label_contains(&format!(
+        "Orange dots in the view: the {} points midway across the gaps this cage bridges",
+        bridged.len()
+    ));
 }

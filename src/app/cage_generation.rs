@@ -19,6 +19,35 @@ use std::sync::Arc;
 /// The proposed cage's colour in the viewport and its stats' heading.
 pub const PROPOSAL_GREEN: egui::Color32 = egui::Color32::from_rgb(80, 220, 110);
 
+/// The dots on the points midway across the gaps a proposed cage bridges.
+pub const BRIDGED_GAP_ORANGE: egui::Color32 = egui::Color32::from_rgb(255, 150, 40);
+
+/// At most this many of them are drawn (every k-th), so that a cage bridging
+/// tens of thousands keeps the frame quick; the window says which.
+pub const MAX_BRIDGED_DOTS: usize = 4096;
+
+/// Draw every this-many-th bridged gap point.
+pub fn bridged_dot_stride(bridged: usize) -> usize {
+    bridged.div_ceil(MAX_BRIDGED_DOTS).max(1)
+}
+
+/// The window's key to the dots, or `None` when the cage bridges no gap.
+pub fn bridged_legend(stats: &CageStats) -> Option<String> {
+    let bridged = stats.gaps.bridged.len();
+    if bridged == 0 {
+        return None;
+    }
+    let stride = bridged_dot_stride(bridged);
+    let which = if stride == 1 {
+        format!("the {bridged} points")
+    } else {
+        format!("one in {stride} of the {bridged} points")
+    };
+    Some(format!(
+        "Orange dots in the view: {which} midway across the gaps this cage bridges"
+    ))
+}
+
 /// The target a first generation offers when the cage says nothing better.
 pub const DEFAULT_TARGET_VERTICES: usize = 64;
 
@@ -461,6 +490,21 @@ mod tests {
         assert_eq!(significant(123456.7), "123457");
         assert_eq!(significant(3.2e9), "3.200e9");
         assert_eq!(significant(0.0), "0");
+    }
+
+    #[test]
+    fn at_most_the_cap_of_bridged_gap_points_is_drawn_and_the_key_says_which() {
+        assert_eq!(bridged_dot_stride(0), 1);
+        assert_eq!(bridged_dot_stride(MAX_BRIDGED_DOTS), 1);
+        assert_eq!(bridged_dot_stride(MAX_BRIDGED_DOTS + 1), 2);
+        // SpikyBox's 8-vertex cage bridges 21,280: one in 6 drawn, 3,547 dots.
+        assert_eq!(bridged_dot_stride(21_280), 6);
+        assert!(21_280usize.div_ceil(6) <= MAX_BRIDGED_DOTS);
+        let mut stats = CageStats::default();
+        assert_eq!(bridged_legend(&stats), None);
+        stats.gaps.bridged = vec![DVec3::ZERO; 21_280];
+        let legend = bridged_legend(&stats).expect("a key");
+        assert!(legend.contains("one in 6 of the 21280 points"), "{legend}");
     }
 
     #[test]

@@ -280,6 +280,10 @@ pub(super) fn generate_cage<'py>(
     report.set_item("gap_points_open", stats.gaps.open)?;
     report.set_item("narrowest_open_gap", stats.gaps.narrowest_open)?;
     report.set_item("widest_closed_gap", stats.gaps.widest_closed)?;
+    report.set_item(
+        "bridged_gap_points",
+        positions_array(py, &stats.gaps.bridged)?,
+    )?;
     report.set_item("grid", stats.grid.to_vec())?;
     report.set_item("surface_vertices", stats.surface_vertices)?;
     report.set_item("seconds", stats.seconds)?;

@@ -151,6 +151,17 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert calls[0] == 0 and calls[-1] == 1000 and calls == sorted(calls)
 
 
+def test_generate_cage_reports_where_it_bridges_gaps(comb_points):
+    _, faces = pmvc.load_mesh(pmvc_assets() / "comb_mesh.obj")
+    # Few vertices: the comb's prongs share one part of the cage.
+    cage, report = pmvc.generate_cage(comb_points, faces, target=16)
+    bridged = report["bridged_gap_points"]
+    closed = report["gap_points"] - report["gap_points_open"]
+    assert closed > 0
+    assert bridged.dtype == np.float64 and bridged.shape == (closed, 3)
+    assert (pmvc.classify(bridged, cage) != pmvc.OUTSIDE).all()
+
+
 def test_generate_cage_with_quads_keeps_them_in_the_cage(comb_points):
     _, faces = pmvc.load_mesh(pmvc_assets() / "comb_mesh.obj")
     cage, report = pmvc.generate_cage(comb_points, faces, target=60, quads=True)

@@ -4,7 +4,9 @@
 //! again. The proposal is drawn over the mesh (green) until then.
 
 use crate::app::actions::{Action, CageRequest};
-use crate::app::cage_generation::{stats_lines, CageGeneration, PROPOSAL_GREEN};
+use crate::app::cage_generation::{
+    bridged_legend, stats_lines, CageGeneration, BRIDGED_GAP_ORANGE, PROPOSAL_GREEN,
+};
 use crate::app::ctx::PanelContext;
 use crate::geometry::autocage::{MAX_TARGET_VERTICES, MIN_TARGET_VERTICES};
 
@@ -92,6 +94,9 @@ fn contents(
         ui.colored_label(PROPOSAL_GREEN, "Proposed cage (green in the view):");
         for line in stats_lines(&proposal.generated.stats, !cx.shown().hide_timings) {
             ui.label(line);
+        }
+        if let Some(legend) = bridged_legend(&proposal.generated.stats) {
+            ui.colored_label(BRIDGED_GAP_ORANGE, legend);
         }
         ui.horizontal(|ui| {
             if ui.button("Use this cage").clicked() {

@@ -9,7 +9,7 @@ mod picking;
 
 pub use modal::{handles_without_partner, pose_transformed, transform_selection, TransformKind};
 
-use super::cage_generation::{Proposal, PROPOSAL_GREEN};
+use super::cage_generation::{bridged_dot_stride, Proposal, BRIDGED_GAP_ORANGE, PROPOSAL_GREEN};
 use super::compare::{HoverReadout, Pane};
 use super::views::{ViewportContext, Views};
 use super::widgets::draw_colour_bar;
@@ -439,6 +439,12 @@ impl Views {
                 (screen.get(*a as usize), screen.get(*b as usize))
             {
                 painter.line_segment([*from, *to], stroke);
+            }
+        }
+        let bridged = &proposal.generated.stats.gaps.bridged;
+        for point in bridged.iter().step_by(bridged_dot_stride(bridged.len())) {
+            if let Some(at) = projection.project_world(*point) {
+                painter.circle_filled(Pos2::new(at.x, at.y), 2.5, BRIDGED_GAP_ORANGE);
             }
         }
     }

@@ -88,6 +88,9 @@ pub struct GapReport {
     /// one inside, in the mesh's units.
     pub narrowest_open: Option<f64>,
     pub widest_closed: Option<f64>,
+    /// The gap points inside the cage, in the mesh's coordinates: where it
+    /// bridges a gap, for a view to show.
+    pub bridged: Vec<DVec3>,
 }
 
 impl GapReport {
@@ -114,6 +117,7 @@ pub(super) fn report(points: &[GapPoint], range: f64, cage: &Cage) -> GapReport 
             report.narrowest_open = narrowest(report.narrowest_open);
         } else {
             report.widest_closed = widest(report.widest_closed);
+            report.bridged.push(point.position);
         }
     }
     report

@@ -94,7 +94,7 @@ pub struct GeneratedCage {
 }
 
 /// Measured properties of a generated cage. Distances are in the mesh's units.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CageStats {
     pub vertices: usize,
     pub triangles: usize,
@@ -499,7 +499,10 @@ fn finish(
             first,
         });
     }
-    let gaps = gaps::report(request.gap_points, request.gap_range, &cage);
+    let mut gaps = gaps::report(request.gap_points, request.gap_range, &cage);
+    for point in &mut gaps.bridged {
+        *point += request.centre;
+    }
     let (mesh_volume, mesh_volume_from_voxels) = match request.volume {
         MeshVolume::Closed(volume) => (volume, false),
         MeshVolume::Winding(volume) => (volume, true),
