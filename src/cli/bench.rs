@@ -124,8 +124,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         None => None,
     };
     let threads = rayon::current_num_threads();
+    let plural = if threads == 1 { "" } else { "s" };
     let mut backends = vec![Timed {
-        name: format!("cpu ({threads} threads)"),
+        name: format!("cpu ({threads} thread{plural})"),
         backend: Backend::Cpu,
         pmvc_kernel: None,
     }];
@@ -159,8 +160,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         Err(error) => format!("none ({error})"),
     };
     warn_line!(
-        "pmvc bench: {threads} CPU threads, GPU adapter: {adapter}, {} runs per row",
-        args.runs
+        "pmvc bench: {threads} CPU thread{plural} (RAYON_NUM_THREADS sets them), GPU adapter: {adapter}, {} run{} per row",
+        args.runs,
+        if args.runs == 1 { "" } else { "s" }
     );
     let wanted = |name: &str| args.scenes.is_empty() || args.scenes.iter().any(|s| s == name);
 

@@ -43,8 +43,6 @@ mod quad_tests;
 mod raster;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod timing_tests;
 
 use super::cubemap::TexelTable;
 use super::cubemap::TEXEL_LANES;
