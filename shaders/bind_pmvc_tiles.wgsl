@@ -65,15 +65,16 @@ struct Setup {
 }
 
 // Triangle t's edge functions on the face with `axes`. One function for the test
-// and the sums, so both see the same values.
-fn setup_of(t: u32, x: vec3<f32>, axes: mat3x3<f32>) -> Setup {
+// and the sums, so both see the same values. The sums (`bounded` false) take
+// triangles that were hit, so they skip the face test and the bounds.
+fn setup_of(t: u32, x: vec3<f32>, axes: mat3x3<f32>, bounded: bool) -> Setup {
     var setup: Setup;
     setup.range = vec4<u32>(0u);
     // The corners are loaded once for the face test and the set-up.
     let a = cage_positions[topology[3u * t]].xyz - x;
     let b = cage_positions[topology[3u * t + 1u]].xyz - x;
     let c = cage_positions[topology[3u * t + 2u]].xyz - x;
-    if (planes_outside(a, axes) & planes_outside(b, axes) & planes_outside(c, axes)) != 0u {
+    if bounded && (planes_outside(a, axes) & planes_outside(b, axes) & planes_outside(c, axes)) != 0u {
         return setup;
     }
     let e0 = cross(b, c);
@@ -87,7 +88,9 @@ fn setup_of(t: u32, x: vec3<f32>, axes: mat3x3<f32>) -> Setup {
     setup.along_up = s * vec3(dot(tri.e0, axes[1]), dot(tri.e1, axes[1]), dot(tri.e2, axes[1]));
     setup.along_normal = s * vec3(dot(tri.e0, axes[2]), dot(tri.e1, axes[2]), dot(tri.e2, axes[2]));
     setup.inverse_det = 1.0 / abs(tri.det);
-    setup.range = texel_range(tri, axes);
+    if bounded {
+        setup.range = texel_range(tri, axes);
+    }
     return setup;
 }
 
@@ -132,7 +135,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         atomicStore(&offered, 0u);
     }
     // The tile's first texel within a region.
-    let tile = vec2<u32>(lane % TILES_PER_ROW, lane / TILES_PER_ROW) * TILE;
+    let tile = tile_of(lane);
     // Uniform: set when a region's total is not finite (the CPU redoes the row).
     var overflow = false;
     workgroupBarrier();
@@ -142,18 +145,22 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         for (var region_j = 0u; region_j < resolution; region_j += REGION) {
             for (var region_i = 0u; region_i < resolution; region_i += REGION) {
                 let origin = vec2<u32>(region_i, region_j);
-                var nearest_q: array<f32, TILE_TEXELS>;
-                var nearest_t: array<u32, TILE_TEXELS>;
-                for (var k = 0u; k < TILE_TEXELS; k++) {
-                    nearest_q[k] = 0.0;
-                    nearest_t[k] = NO_TRIANGLE;
-                }
+                // The tile's texel centres: its columns' u, and each row's v.
+                let first = origin + tile;
+                let tile_u = vec4(texel_centre(first.x), texel_centre(first.x + 1u),
+                    texel_centre(first.x + 2u), texel_centre(first.x + 3u));
+                let tile_v = vec4(texel_centre(first.y), texel_centre(first.y + 1u),
+                    texel_centre(first.y + 2u), texel_centre(first.y + 3u));
+                // Per row of the tile, its four texels' nearest inverse depth (0:
+                // no hit yet) and triangle.
+                var row_q = array<vec4<f32>, TILE>();
+                var row_t = array<vec4<u32>, TILE>();
                 // 1 and 2, a chunk at a time.
                 var next = lane;
                 var chunk_start = workgroupUniformLoad(&offered);
                 loop {
                     while next < params.triangle_count {
-                        let setup = setup_of(next, x, axes);
+                        let setup = setup_of(next, x, axes, true);
                         let part = within_region(setup.range, origin);
                         if part.x >= part.y || part.z >= part.w {
                             next += WORKGROUP_SIZE;
@@ -180,23 +187,12 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                         let right = chunk_right[s].xyz;
                         let up = chunk_up[s];
                         let normal = chunk_normal[s].xyz;
-                        for (var tj = 0u; tj < TILE; tj++) {
-                            let j = tile.y + tj;
-                            if j < part.z || j >= part.w {
-                                continue;
-                            }
-                            let v = texel_centre(origin.y + j);
-                            for (var ti = 0u; ti < TILE; ti++) {
-                                let e = edges(right, up.xyz, normal, texel_centre(origin.x + tile.x + ti), v);
-                                if min(min(e.x, e.y), e.z) >= 0.0 {
-                                    let q = (e.x + e.y + e.z) * up.w;
-                                    let k = tj * TILE + ti;
-                                    if q > 0.0 && (q > nearest_q[k] || (q == nearest_q[k] && ids.x < nearest_t[k])) {
-                                        nearest_q[k] = q;
-                                        nearest_t[k] = ids.x;
-                                    }
-                                }
-                            }
+                        // A loop of constant length the compiler unrolls, so the rows
+                        // are indexed by constants and stay in registers.
+                        for (var r = 0u; r < TILE; r++) {
+                            let kept = nearest_of_row(row_q[r], row_t[r], ids.x, right, up, normal, tile_u, tile_v[r]);
+                            row_q[r] = kept.q;
+                            row_t[r] = kept.t;
                         }
                     }
                     workgroupBarrier();
@@ -207,6 +203,15 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 }
 
                 // 3. The region's total, then its shares per vertex in fixed point.
+                // Copied out in a loop the compiler unrolls, so that the rows
+                // above are never indexed at run time, which would move them to
+                // memory.
+                var nearest_q: array<f32, TILE_TEXELS>;
+                var nearest_t: array<u32, TILE_TEXELS>;
+                for (var k = 0u; k < TILE_TEXELS; k++) {
+                    nearest_q[k] = row_q[k / TILE][k % TILE];
+                    nearest_t[k] = select(NO_TRIANGLE, row_t[k / TILE][k % TILE], nearest_q[k] > 0.0);
+                }
                 var total = 0.0;
                 var lane_missed = 0u;
                 for (var k = 0u; k < TILE_TEXELS; k++) {
@@ -244,7 +249,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                             }
                             run_t = t;
                             run = vec3<u32>(0u);
-                            setup = setup_of(t, x, axes);
+                            setup = setup_of(t, x, axes, false);
                         }
                         let e = edges(setup.along_right, setup.along_up, setup.along_normal,
                             texel_centre(texel.x), texel_centre(texel.y));
@@ -277,6 +282,45 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let row_total = workgroup_sum(lane, total);
     let redo = atomicLoad(&missed) > params.max_missed || overflow;
     finish_row(point, lane, out_base, row_total, redo);
+}
+
+// The tile an invocation owns within a region: the invocation's bits
+// interleaved as x, y, x, y, x, y, so that each run of 4, 8, 16 or 32
+// invocations (a SIMD group on lavapipe or a GPU) covers a near-square block of
+// texels and a small triangle leaves whole groups idle, which then skip it. In
+// rows of 8 tiles a group spanned the region's width, and nearly every triangle
+// kept it busy.
+const_assert TILES_PER_ROW == 8u; // three bits of the index for each of x and y
+fn tile_of(lane: u32) -> vec2<u32> {
+    let x = (lane & 1u) | ((lane >> 1u) & 2u) | ((lane >> 2u) & 4u);
+    let y = ((lane >> 1u) & 1u) | ((lane >> 2u) & 2u) | ((lane >> 3u) & 4u);
+    return vec2<u32>(x, y) * TILE;
+}
+
+struct Nearest {
+    q: vec4<f32>,
+    t: vec4<u32>,
+}
+
+// One row of a tile against one triangle: four rays at once and no branches, as
+// software adapters run both sides of any branch their SIMD lanes disagree on
+// (on lavapipe the ray tests took about half as long as with a branch per
+// texel). Keeps the largest inverse depth and, at equal depth, the lowest index;
+// `q` starts at 0, so only hits in front (q > 0) are kept. Texels outside the
+// triangle's bounds are tested too: they lie a texel or more outside its
+// projection, so they miss.
+fn nearest_of_row(q: vec4<f32>, t: vec4<u32>, triangle: u32,
+    right: vec3<f32>, up: vec4<f32>, normal: vec3<f32>, u: vec4<f32>, v: f32) -> Nearest {
+    // Per texel exactly `edges`: fma(u, right, fma(v, up, normal)).
+    let at_v = fma(vec3(v), up.xyz, normal);
+    let e0 = fma(u, vec4(right.x), vec4(at_v.x));
+    let e1 = fma(u, vec4(right.y), vec4(at_v.y));
+    let e2 = fma(u, vec4(right.z), vec4(at_v.z));
+    let hit_q = (e0 + e1 + e2) * up.w;
+    let id = vec4(triangle);
+    let hit = min(min(e0, e1), e2) >= vec4(0.0);
+    let keep = hit & ((hit_q > q) | ((hit_q == q) & (id < t)));
+    return Nearest(select(q, hit_q, keep), select(t, id, keep));
 }
 
 fn add_run(t: u32, units: vec3<u32>) {

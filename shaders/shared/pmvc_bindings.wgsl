@@ -18,17 +18,23 @@
 @group(0) @binding(7) var<storage, read_write> status: array<u32>;
 
 var<workgroup> partial_totals: array<f32, WORKGROUP_SIZE>;
+var<workgroup> summed_totals: f32;
 
-// The sum of every invocation's `mine`, added in the same order in each, so all
-// get the same value. Called in uniform control flow.
+// The sum of every invocation's `mine`, in invocation order, the same value in
+// all. Called in uniform control flow. One invocation adds them up: when each
+// did, every invocation's loop read all 64 from workgroup memory, which cost
+// lavapipe more than the second barrier does.
 fn workgroup_sum(lane: u32, mine: f32) -> f32 {
     partial_totals[lane] = mine;
     workgroupBarrier();
-    var sum = 0.0;
-    for (var k = 0u; k < WORKGROUP_SIZE; k++) {
-        sum += partial_totals[k];
+    if lane == 0u {
+        var sum = 0.0;
+        for (var k = 0u; k < WORKGROUP_SIZE; k++) {
+            sum += partial_totals[k];
+        }
+        summed_totals = sum;
     }
-    return sum;
+    return workgroupUniformLoad(&summed_totals);
 }
 
 // Divide the point's row (at `out_base` in `weights`) by its total, or leave it
