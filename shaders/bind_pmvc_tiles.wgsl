@@ -138,6 +138,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let tile = tile_of(lane);
     // Uniform: set when a region's total is not finite (the CPU redoes the row).
     var overflow = false;
+    // Uniform: `offered` when the current chunk began. It carries over from one
+    // region to the next, where no barrier is needed to read it again.
+    var chunk_start = 0u;
     workgroupBarrier();
 
     for (var face = 0u; face < 6u; face++) {
@@ -157,7 +160,6 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 var row_t = array<vec4<u32>, TILE>();
                 // 1 and 2, a chunk at a time.
                 var next = lane;
-                var chunk_start = workgroupUniformLoad(&offered);
                 loop {
                     while next < params.triangle_count {
                         let setup = setup_of(next, x, axes, true);
@@ -195,11 +197,15 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                             row_t[r] = kept.t;
                         }
                     }
-                    workgroupBarrier();
-                    if offered_now - chunk_start <= CHUNK {
+                    let last_chunk = offered_now - chunk_start <= CHUNK;
+                    chunk_start = offered_now;
+                    if last_chunk {
+                        // The next chunk is written after the barriers of step 3.
                         break;
                     }
-                    chunk_start = offered_now;
+                    // Every invocation is done with this chunk before the next is
+                    // written.
+                    workgroupBarrier();
                 }
 
                 // 3. The region's total, then its shares per vertex in fixed point.
@@ -269,7 +275,8 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                         atomicStore(&vertex_units[v], 0u);
                     }
                 }
-                workgroupBarrier();
+                // No barrier: the next region adds to these sums only after its
+                // first chunk's barrier.
             }
         }
     }
