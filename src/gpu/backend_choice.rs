@@ -232,7 +232,8 @@ impl Patches {
 // sphere 1523 0.774 / 0.252, MVC Horse size 0.050 / 0.014), the H100 rows of
 // docs/benchmarks.md for PMVC 64², and the 2-core rows there for the CPU path
 // (Armadillo size PMVC 32² 0.465 s, MVC 0.199 s) and for lavapipe (Armadillo
-// size: PMVC 13.5× the CPU path's time, MVC 0.73×). Least-squares by eye over
+// size: PMVC by the tile kernel 16-20× the CPU path's time on 2026-11-28, the
+// band kernel about 40×; MVC 0.73×). Least-squares by eye over
 // those rows; each prediction is within about ±30% of them.
 // Green's GPU kernel has no measurement yet: taken as twice MVC's per triangle;
 // its CPU path costs about what MVC's does (docs/benchmarks.md, 2026-11-25).
@@ -249,7 +250,7 @@ const COSTS: [FamilyCosts; 3] = [
             per_texel: 0.000_22,
             per_triangle: 0.0025,
         },
-        software_vs_cpu: 13.5,
+        software_vs_cpu: 19.0,
         // `pmvc bench`, 2026-11-28 (docs/benchmarks.md): the 2-core machine's
         // CPU 2.2-3.6 (Ogre, FireHydrant, ManHead) and the H200 host's 16
         // threads 2.4-3.5 (the seven shared models); the H200's band kernel
