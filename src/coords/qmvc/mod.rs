@@ -27,8 +27,6 @@ mod convergence;
 pub(crate) mod reference;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod timing;
 
 use glam::DVec3;
 pub use quadrature::{Integral, Rule, RULE};
