@@ -313,7 +313,8 @@ struct Nearest {
 // software adapters run both sides of any branch their SIMD lanes disagree on
 // (on lavapipe the ray tests took about half as long as with a branch per
 // texel). Keeps the largest inverse depth and, at equal depth, the lowest index;
-// `q` starts at 0, so only hits in front (q > 0) are kept. Texels outside the
+// `q` and `t` start at 0, so only hits in front (q > 0) are kept: a hit at q = 0
+// ties and has no lower index than 0. Texels outside the
 // triangle's bounds are tested too: they lie a texel or more outside its
 // projection, so they miss.
 fn nearest_of_row(q: vec4<f32>, t: vec4<u32>, triangle: u32,
