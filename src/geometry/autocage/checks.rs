@@ -20,9 +20,9 @@ impl State<'_> {
         // The old and new faces bound the swept region; a ray from a point
         // crosses them an odd number of times exactly when it is inside.
         let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
-        let swept = |q: DVec3, faces: &[[DVec3; 3]]| {
-            faces.iter().filter(|t| ray_hits_triangle(q, **t)).count() % 2 == 1
-        };
+        let rays: Vec<RayFace> = faces.iter().map(|&f| RayFace::new(f)).collect();
+        let swept =
+            |q: DVec3, _: &[[DVec3; 3]]| rays.iter().filter(|t| t.hit_from(q)).count() % 2 == 1;
         self.mesh_points.any_enclosed(&faces, swept) || self.gap_points.any_enclosed(&faces, swept)
     }
 
@@ -157,25 +157,48 @@ impl State<'_> {
     }
 }
 
-/// Whether the ray from `origin` along a fixed direction (chosen to be parallel
-/// to no voxel face or edge) passes through the triangle (Möller and Trumbore).
-pub(super) fn ray_hits_triangle(origin: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
+/// A triangle, for whether the ray from a point along a fixed direction
+/// (chosen to be parallel to no voxel face or edge) passes through it (Möller
+/// and Trumbore). What does not depend on the ray's origin is computed once:
+/// a check asks it of every sample near the faces.
+pub(super) struct RayFace {
+    a: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    p: DVec3,
+    det: f64,
+}
+
+impl RayFace {
     const DIRECTION: DVec3 = DVec3::new(0.573_462_1, 0.612_345_7, 0.544_125_3);
-    let (e1, e2) = (b - a, c - a);
-    let p = DIRECTION.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-300 {
-        return false;
+
+    pub(super) fn new([a, b, c]: [DVec3; 3]) -> RayFace {
+        let (e1, e2) = (b - a, c - a);
+        let p = Self::DIRECTION.cross(e2);
+        RayFace {
+            a,
+            e1,
+            e2,
+            p,
+            det: e1.dot(p),
+        }
     }
-    let s = origin - a;
-    let u = s.dot(p) / det;
-    if !(0.0..=1.0).contains(&u) {
-        return false;
+
+    pub(super) fn hit_from(&self, origin: DVec3) -> bool {
+        let det = self.det;
+        if det.abs() < 1e-300 {
+            return false;
+        }
+        let s = origin - self.a;
+        let u = s.dot(self.p) / det;
+        if !(0.0..=1.0).contains(&u) {
+            return false;
+        }
+        let q = s.cross(self.e1);
+        let v = Self::DIRECTION.dot(q) / det;
+        if v < 0.0 || u + v > 1.0 {
+            return false;
+        }
+        self.e2.dot(q) / det > 0.0
     }
-    let q = s.cross(e1);
-    let v = DIRECTION.dot(q) / det;
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    e2.dot(q) / det > 0.0
 }

@@ -9,6 +9,8 @@ use glam::DVec3;
 
 /// Points per leaf: below this, testing each is cheaper than splitting.
 const LEAF_SIZE: usize = 16;
+/// Halves of at least this many points are built in parallel.
+const PARALLEL_POINTS: usize = 4096;
 
 struct Node {
     lo: DVec3,
@@ -42,10 +44,18 @@ pub(super) struct PointTree {
 
 impl PointTree {
     pub(super) fn new(mut points: Vec<DVec3>) -> PointTree {
-        let mut nodes = Vec::with_capacity(2 * points.len() / LEAF_SIZE + 1);
+        let placeholder = || Node {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            first: 0,
+            last: 0,
+            children: [0, 0],
+        };
+        let mut nodes: Vec<Node> = (0..node_count(points.len()))
+            .map(|_| placeholder())
+            .collect();
         if !points.is_empty() {
-            let count = points.len();
-            build(&mut points, 0, count, &mut nodes);
+            build(&mut points, 0, &mut nodes, 0);
         }
         PointTree { points, nodes }
     }
@@ -60,6 +70,7 @@ impl PointTree {
         let Some((lo, hi)) = bounds(faces) else {
             return false;
         };
+        let planes = planes(faces);
         self.search(
             0,
             &|node| node.overlaps(lo, hi),
@@ -69,7 +80,8 @@ impl PointTree {
                 let (centre, radius) = (node.centre(), node.radius());
                 if faces
                     .iter()
-                    .all(|f| distance_squared(centre, f) > radius * radius)
+                    .zip(&planes)
+                    .all(|(f, plane)| farther_than(centre, f, plane, radius))
                 {
                     Some(inside(centre, faces))
                 } else {
@@ -87,8 +99,13 @@ impl PointTree {
         };
         let pad = DVec3::splat(clearance);
         let (lo, hi) = (lo - pad, hi + pad);
-        let near =
-            |p: DVec3, reach: f64| faces.iter().any(|f| distance_squared(p, f) < reach * reach);
+        let planes = planes(faces);
+        let near = |p: DVec3, reach: f64| {
+            faces
+                .iter()
+                .zip(&planes)
+                .any(|(f, plane)| closer_than(p, f, plane, reach))
+        };
         self.search(
             0,
             &|node| node.overlaps(lo, hi),
@@ -125,30 +142,75 @@ impl PointTree {
     }
 }
 
-fn build(points: &mut [DVec3], first: usize, last: usize, nodes: &mut Vec<Node>) -> usize {
-    let slice = &mut points[first..last];
-    let (lo, hi) = slice
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(*p), hi.max(*p))
-        });
-    let index = nodes.len();
-    nodes.push(Node {
+/// Nodes of the tree over `count` points: its shape depends on the count
+/// alone (halves, down to leaves of at most [`LEAF_SIZE`]).
+fn node_count(count: usize) -> usize {
+    node_counts(count).0
+}
+
+/// The node counts for `n` and `n + 1` points: the halves of both are `n / 2`
+/// or one more, so each level needs only the pair below it.
+fn node_counts(n: usize) -> (usize, usize) {
+    let single = |count: usize| usize::from(count > 0);
+    if n < LEAF_SIZE {
+        return (single(n), 1);
+    }
+    if n == LEAF_SIZE {
+        // 17 points split into 8 and 9, a leaf each.
+        return (1, 3);
+    }
+    let (half, half_plus_one) = node_counts(n / 2);
+    if n.is_multiple_of(2) {
+        (1 + 2 * half, 1 + half + half_plus_one)
+    } else {
+        (1 + half + half_plus_one, 1 + 2 * half_plus_one)
+    }
+}
+
+/// Builds the subtree over `points` (which start at `first` in the whole
+/// list) into `nodes`, in depth-first order from `index`: the left child
+/// follows its parent and the right one follows the left subtree, so both
+/// halves are built at once into their own parts of the list.
+fn build(points: &mut [DVec3], first: usize, nodes: &mut [Node], index: usize) {
+    // Tight bounds choose the axis: bounds cut from the parent's made the
+    // simplification's queries half as slow again (FireHydrant).
+    let (lo, hi) = point_bounds(points);
+    let (node, below) = nodes.split_first_mut().expect("a node for every subtree");
+    *node = Node {
         lo,
         hi,
         first: first as u32,
-        last: last as u32,
+        last: (first + points.len()) as u32,
         children: [0, 0],
-    });
-    if slice.len() > LEAF_SIZE {
+    };
+    if points.len() > LEAF_SIZE {
         let axis = (hi - lo).max_position();
-        let middle = slice.len() / 2;
-        slice.select_nth_unstable_by(middle, |a, b| a[axis].total_cmp(&b[axis]));
-        let left = build(points, first, first + middle, nodes);
-        let right = build(points, first + middle, last, nodes);
-        nodes[index].children = [left as u32, right as u32];
+        let middle = points.len() / 2;
+        points.select_nth_unstable_by(middle, |a, b| a[axis].total_cmp(&b[axis]));
+        let left_nodes = node_count(middle);
+        let right_index = index + 1 + left_nodes;
+        node.children = [index + 1, right_index].map(|c| c as u32);
+        let (left_points, right_points) = points.split_at_mut(middle);
+        let (left, right) = below.split_at_mut(left_nodes);
+        // Small subtrees are built in turn: a task costs more than they do.
+        if middle >= PARALLEL_POINTS {
+            rayon::join(
+                || build(left_points, first, left, index + 1),
+                || build(right_points, first + middle, right, right_index),
+            );
+        } else {
+            build(left_points, first, left, index + 1);
+            build(right_points, first + middle, right, right_index);
+        }
     }
-    index
+}
+
+fn point_bounds(points: &[DVec3]) -> (DVec3, DVec3) {
+    points
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        })
 }
 
 fn bounds(faces: &[[DVec3; 3]]) -> Option<(DVec3, DVec3)> {
@@ -163,10 +225,40 @@ fn distance_squared(p: DVec3, [a, b, c]: &[DVec3; 3]) -> f64 {
         .distance_squared(p)
 }
 
+/// Each face's unit normal and offset; a zero normal for a degenerate face.
+fn planes(faces: &[[DVec3; 3]]) -> Vec<(DVec3, f64)> {
+    faces
+        .iter()
+        .map(|[a, b, c]| {
+            let normal = (*b - *a).cross(*c - *a).normalize_or_zero();
+            (normal, normal.dot(*a))
+        })
+        .collect()
+}
+
+/// Whether `p` is closer than `reach` to the face.
+fn closer_than(p: DVec3, face: &[DVec3; 3], plane: &(DVec3, f64), reach: f64) -> bool {
+    !plane_beyond(p, plane, reach) && distance_squared(p, face) < reach * reach
+}
+
+/// Whether `p` is farther than `reach` from the face.
+fn farther_than(p: DVec3, face: &[DVec3; 3], plane: &(DVec3, f64), reach: f64) -> bool {
+    plane_beyond(p, plane, reach) || distance_squared(p, face) > reach * reach
+}
+
+/// Whether `p` is farther than `reach` from the face's plane, and so from
+/// the face: one dot product where the closest point costs tens of
+/// operations, and most points a query visits are that far from the plane.
+/// The margin is far above rounding, so the test never changes an answer.
+fn plane_beyond(p: DVec3, &(normal, offset): &(DVec3, f64), reach: f64) -> bool {
+    let height = normal.dot(p) - offset;
+    height * height > reach * reach * (1.0 + 1e-9)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::autocage::checks::ray_hits_triangle;
+    use crate::geometry::autocage::checks::RayFace;
     use crate::geometry::procedural::SplitMix64;
 
     fn random_points(count: usize, random: &mut SplitMix64) -> Vec<DVec3> {
@@ -184,12 +276,39 @@ mod tests {
     }
 
     fn parity(p: DVec3, faces: &[[DVec3; 3]]) -> bool {
-        let crossings = faces.iter().filter(|f| ray_hits_triangle(p, **f)).count();
+        let crossings = faces
+            .iter()
+            .filter(|f| RayFace::new(**f).hit_from(p))
+            .count();
         crossings % 2 == 1
     }
 
     /// Whole subtrees are answered at once; the answers must be those of
     /// testing every point.
+    /// The closed form against the tree's definition, counted directly.
+    #[test]
+    fn node_counts_follow_the_halving() {
+        fn counted(count: usize) -> usize {
+            match count {
+                0 => 0,
+                1..=LEAF_SIZE => 1,
+                _ => 1 + counted(count / 2) + counted(count - count / 2),
+            }
+        }
+        for count in (0..2_000).chain([4_095, 4_096, 4_097, 65_537, 1_000_003]) {
+            assert_eq!(node_count(count), counted(count), "{count} points");
+        }
+        let tree = PointTree::new(random_points(100_000, &mut SplitMix64(3)));
+        assert_eq!(tree.nodes.len(), counted(100_000));
+        // Every point is in exactly one leaf, in order.
+        let mut next = 0;
+        for node in tree.nodes.iter().filter(|n| n.children[0] == 0) {
+            assert_eq!(node.first, next);
+            next = node.last;
+        }
+        assert_eq!(next, 100_000);
+    }
+
     #[test]
     fn answers_match_testing_every_point() {
         let mut random = SplitMix64(7);
