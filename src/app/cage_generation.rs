@@ -62,7 +62,7 @@ pub struct CageGeneration {
     pub target_vertices: usize,
     /// The user set the target: opening the window keeps it.
     pub(super) target_chosen: bool,
-    /// Whether to ask for a clearance (else the generator keeps 1/128 of the diagonal).
+    /// Whether to ask for a clearance (else the generator keeps `DEFAULT_CLEARANCE`).
     pub use_clearance: bool,
     /// The clearance, in % of the mesh's bounding-box diagonal.
     pub clearance_percent: f64,

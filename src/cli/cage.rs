@@ -22,7 +22,7 @@ pub struct CageArgs {
     #[arg(long, value_name = "C.obj")]
     pub out: PathBuf,
     /// The gap between the mesh and the cage, as a fraction of the mesh's
-    /// bounding-box diagonal (e.g. 0.02; default: 1/128, 0.0078125).
+    /// bounding-box diagonal (e.g. 0.02; default: 1/256, 0.00390625).
     #[arg(long, value_name = "FRACTION")]
     pub clearance: Option<f64>,
     /// The voxel size, as a fraction of the diagonal (default: chosen for N,

@@ -8,7 +8,9 @@ use crate::app::cage_generation::{
     bridged_legend, stats_lines, CageGeneration, BRIDGED_GAP_ORANGE, PROPOSAL_GREEN,
 };
 use crate::app::ctx::PanelContext;
-use crate::geometry::autocage::{MAX_TARGET_VERTICES, MIN_TARGET_VERTICES};
+use crate::geometry::autocage::{
+    DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
+};
 
 /// The window, while it is open: it owns its settings and job
 /// ([`CageGeneration`]) and sends what the user asks for.
@@ -66,14 +68,20 @@ fn contents(
                     optional_percent(
                         ui,
                         (&mut generation.use_clearance, "Clearance"),
-                        "The gap between the mesh and the cage; off: 0.78% of the diagonal",
+                        &format!(
+                            "The gap between the mesh and the cage; off: {:.2}% of the diagonal",
+                            100.0 * DEFAULT_CLEARANCE
+                        ),
                         &mut generation.clearance_percent,
                         (0.1, 49.0),
                     );
                     optional_percent(
                         ui,
                         (&mut generation.use_cell_size, "Voxel size"),
-                        "Off: chosen for the target, from 0.78% of the diagonal up. Larger voxels reach fewer vertices; parts closer than about three voxels merge",
+                        &format!(
+                            "Off: chosen for the target, from {:.2}% of the diagonal up. Larger voxels reach fewer vertices; parts closer than about three voxels merge",
+                            100.0 * DEFAULT_CELL_SIZE
+                        ),
                         &mut generation.cell_size_percent,
                         (0.2, 20.0),
                     );
