@@ -21,8 +21,7 @@ impl State<'_> {
         // crosses them an odd number of times exactly when it is inside.
         let faces: Vec<[DVec3; 3]> = old.iter().chain(new).copied().collect();
         let rays: Vec<RayFace> = faces.iter().map(|&f| RayFace::new(f)).collect();
-        let swept =
-            |q: DVec3, _: &[[DVec3; 3]]| rays.iter().filter(|t| t.hit_from(q)).count() % 2 == 1;
+        let swept = |q: DVec3| rays.iter().filter(|t| t.hit_from(q)).count() % 2 == 1;
         self.mesh_points.any_enclosed(&faces, swept) || self.gap_points.any_enclosed(&faces, swept)
     }
 
