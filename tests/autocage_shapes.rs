@@ -118,12 +118,13 @@ fn a_hand_keeps_every_gap_between_fingers_open() {
             generated.stats.gaps
         );
         assert!(generated.stats.gaps.points > 0);
-        // Within 1.3 of the hand's volume (measured 1.276 at N = 120 and
-        // 1.245 at 200); at the 1/128 clearance of before, 1.44 and 1.40,
-        // when the fingers alone set a floor of 1.28.
+        // Within 1.25 of the hand's volume (measured 1.197 at N = 120 and
+        // 1.178 at 200; 1.276 and 1.245 before the final polishing, and
+        // 1.44 and 1.40 at the 1/128 clearance of before, when the fingers
+        // alone set a floor of 1.28).
         let floor = tube_ratio_floor(0.5, DEFAULT_CLEARANCE * diagonal);
         assert!(
-            ratio > floor && ratio <= 1.3,
+            ratio > floor && ratio <= 1.25,
             "N = {target}: ratio {ratio}, floor {floor}"
         );
     }
@@ -133,14 +134,15 @@ fn a_hand_keeps_every_gap_between_fingers_open() {
 /// of dilation) and voxels (0.84 % here) the voxels already close part of each
 /// gap, and the cage cannot reopen it. The summary must say so: every test
 /// point found inside is within a gap the report counts as bridged. The cage
-/// is within 1.3 of the hand's volume all the same (measured 1.270).
+/// is within 1.25 of the hand's volume all the same (measured 1.178; 1.270
+/// before the final polishing).
 #[test]
 fn a_hand_whose_gaps_are_bridged_says_so() {
     let hand = shapes::hand(0.26);
     let (generated, ratio) = generate("hand, 3.1 % gaps", &hand, 200);
     let floor = tube_ratio_floor(0.5, DEFAULT_CLEARANCE * hand.mesh.diagonal());
     assert!(
-        ratio > floor && ratio <= 1.3,
+        ratio > floor && ratio <= 1.25,
         "ratio {ratio}, floor {floor}"
     );
     let bridged = gap_points_inside(&hand, &generated.cage);
@@ -154,7 +156,8 @@ fn a_hand_whose_gaps_are_bridged_says_so() {
         let widest = gaps.widest_closed.expect("a widest bridged gap");
         assert!(widest >= 0.9 * 0.26, "widest bridged gap {widest}");
     }
-    // Most of the length of each gap stays open.
+    // Most of the length of each gap stays open (6 of 21 inside, measured;
+    // 10 before the final polishing carved some back out).
     assert!(bridged.len() <= 10, "{} of 21 inside", bridged.len());
 }
 
@@ -174,13 +177,14 @@ fn a_torus_knot_keeps_its_strands_apart() {
         0
     );
     let floor = tube_ratio_floor(0.25, DEFAULT_CLEARANCE * knot.mesh.diagonal());
-    // Measured 1.88, against a floor of 1.30 for any cage at this clearance
-    // (2.28 against 1.63 at the 1/128 clearance of before, 2.36 without the
-    // final tightening along face normals, 2.48 without tightening when the
-    // collapses are stuck either).
+    // Measured 1.735, against a floor of 1.30 for any cage at this
+    // clearance (1.88 before the final polishing; 2.28 against 1.63 at the
+    // 1/128 clearance of before, 2.36 without the final tightening along
+    // face normals, 2.48 without tightening when the collapses are stuck
+    // either).
     assert!(floor > 1.29, "{floor}");
     assert!(
-        ratio >= floor && ratio < 1.95,
+        ratio >= floor && ratio < 1.8,
         "ratio {ratio}, floor {floor}"
     );
 }

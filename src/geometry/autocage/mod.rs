@@ -20,11 +20,13 @@
 //!    voxels left outside ([`gaps`]);
 //! 5. slide each vertex back inward as far as the same checks allow, keeping
 //!    the clearance from a dense sample of the mesh's surface ([`shrink`]),
-//!    whenever the collapses are stuck and at the end.
+//!    whenever the collapses are stuck and at the end;
+//! 6. polish: move vertices in any direction that lowers the enclosed
+//!    volume, and flip edges that do, under the same checks ([`polish`]).
 //!
 //! Step 4 keeps every surface it makes around the previous one, so the cage
 //! contains the voxels, which contain every point of the mesh's surface; each
-//! change in steps 4 and 5 is also refused when a sample of the mesh's surface
+//! change in steps 4 to 6 is also refused when a sample of the mesh's surface
 //! would fall between the old and the new faces. The result is still checked
 //! independently (winding number of every mesh vertex, and [`Cage::new`]'s
 //! validation, which includes self-intersection), and an error says so if a
@@ -38,6 +40,7 @@ mod measure;
 mod pairing;
 mod plan;
 mod points;
+mod polish;
 mod shrink;
 mod simplify;
 mod surface;

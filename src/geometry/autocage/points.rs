@@ -6,6 +6,7 @@
 
 use crate::geometry::closest_point_on_triangle;
 use glam::DVec3;
+use std::cell::Cell;
 
 /// Points per leaf: below this, testing each is cheaper than splitting.
 const LEAF_SIZE: usize = 16;
@@ -94,9 +95,12 @@ impl PointTree {
 
     /// Whether a point is closer than `clearance` to one of `faces`.
     pub(super) fn any_within(&self, faces: &[[DVec3; 3]], clearance: f64) -> bool {
-        let Some((lo, hi)) = bounds(faces) else {
-            return false;
-        };
+        self.first_within(faces, clearance).is_some()
+    }
+
+    /// A point closer than `clearance` to one of `faces`, if there is one.
+    pub(super) fn first_within(&self, faces: &[[DVec3; 3]], clearance: f64) -> Option<DVec3> {
+        let (lo, hi) = bounds(faces)?;
         let pad = DVec3::splat(clearance);
         let (lo, hi) = (lo - pad, hi + pad);
         let planes = planes(faces);
@@ -106,12 +110,20 @@ impl PointTree {
                 .zip(&planes)
                 .any(|(f, plane)| closer_than(p, f, plane, reach))
         };
+        let found = Cell::new(None);
         self.search(
             0,
             &|node| node.overlaps(lo, hi),
             &|node| (!near(node.centre(), node.radius() + clearance)).then_some(false),
-            &|p| near(p, clearance),
-        )
+            &|p| {
+                let hit = near(p, clearance);
+                if hit {
+                    found.set(Some(p));
+                }
+                hit
+            },
+        );
+        found.get()
     }
 
     /// Depth-first: `visit` prunes a node, `settle` answers for all of it when
@@ -236,6 +248,14 @@ fn planes(faces: &[[DVec3; 3]]) -> Vec<(DVec3, f64)> {
         .collect()
 }
 
+/// Whether `p` is closer than `clearance` to one of `faces`: for a few
+/// points known to be near, before a whole query.
+pub(super) fn point_within(p: DVec3, faces: &[[DVec3; 3]], clearance: f64) -> bool {
+    faces
+        .iter()
+        .any(|face| distance_squared(p, face) < clearance * clearance)
+}
+
 /// Whether `p` is closer than `reach` to the face.
 fn closer_than(p: DVec3, face: &[DVec3; 3], plane: &(DVec3, f64), reach: f64) -> bool {
     !plane_beyond(p, plane, reach) && distance_squared(p, face) < reach * reach
@@ -329,6 +349,11 @@ mod tests {
                     .any(|f| distance_squared(p, f) < clearance * clearance)
             });
             assert_eq!(tree.any_within(&faces, clearance), expected);
+            // The point it names is one of them, and near.
+            if let Some(p) = tree.first_within(&faces, clearance) {
+                assert!(points.contains(&p));
+                assert!(point_within(p, &faces, clearance));
+            }
         }
     }
 }

@@ -3,12 +3,15 @@
 //! clearance, so that the outward-only collapses' growth is taken back where
 //! the mesh leaves room.
 
+use super::points::point_within;
 use super::simplify::State;
 use glam::DVec3;
 
 /// Fractions of the step tried for each vertex, largest first.
 const TRIES: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0625];
 const PASSES: usize = 4;
+/// Points remembered per vertex as having held it at the clearance.
+const HELD_POINTS: usize = 4;
 /// Fewer for the faces' normals, each of which costs as much as the vertex's.
 const FACE_TRIES: [f64; 2] = [0.5, 0.125];
 
@@ -25,10 +28,7 @@ impl State<'_> {
         let mut active = self.vertex_alive.clone();
         for _ in 0..PASSES {
             let mut moved = Vec::new();
-            let candidates: Vec<usize> = (0..active.len())
-                .filter(|&v| active[v] && self.vertex_alive[v])
-                .collect();
-            for v in candidates {
+            for v in self.active_vertices(&active) {
                 let Some(inward) = self.inward_normal(v) else {
                     continue;
                 };
@@ -51,14 +51,25 @@ impl State<'_> {
             if moved.is_empty() {
                 return;
             }
-            active.fill(false);
-            for v in moved {
-                active[v] = true;
-                for n in self.neighbours(v) {
-                    active[n] = true;
-                }
+            self.activate_around(&mut active, &moved);
+        }
+    }
+
+    /// The next pass's vertices: those that moved and their neighbours.
+    pub(super) fn activate_around(&self, active: &mut [bool], moved: &[usize]) {
+        active.fill(false);
+        for &v in moved {
+            active[v] = true;
+            for n in self.neighbours(v) {
+                active[n] = true;
             }
         }
+    }
+
+    pub(super) fn active_vertices(&self, active: &[bool]) -> Vec<usize> {
+        (0..active.len())
+            .filter(|&v| active[v] && self.vertex_alive[v])
+            .collect()
     }
 
     fn face_normals(&self, v: usize) -> Vec<DVec3> {
@@ -83,7 +94,7 @@ impl State<'_> {
             .map(|n| -n)
     }
 
-    fn try_move(&mut self, v: usize, position: DVec3) -> bool {
+    pub(super) fn try_move(&mut self, v: usize, position: DVec3) -> bool {
         let star = self.vertex_triangles[v].clone();
         let replaced: Vec<(u32, [u32; 3])> = star
             .iter()
@@ -98,8 +109,8 @@ impl State<'_> {
         let accepted = self.shapes_are_good(&replaced, (v, usize::MAX), (old, old))
             && !self.crosses_anything(&replaced, &sorted_star)
             && !self.sweeps_over_vertices(v, v, old, &sorted_star, &new_corners)
-            && !self.moves_points_across(&old_corners, &new_corners)
-            && !self.near_mesh_points(&new_corners, self.clearance);
+            && !self.keeps_no_clearance(v, &new_corners)
+            && !self.moves_points_across(&old_corners, &new_corners);
         if !accepted {
             self.positions[v] = old;
             return false;
@@ -109,6 +120,25 @@ impl State<'_> {
                 .insert(*t, p.min(*q).min(*r), p.max(*q).max(*r));
         }
         self.vertex_hash.insert(v as u32, position, position);
+        true
+    }
+
+    /// Whether a mesh point is closer than the clearance to one of the faces
+    /// around `v`. The points that stopped `v` before are tried first: a
+    /// vertex held by a face resting at the clearance is tried in direction
+    /// after direction, and mostly the same point holds it.
+    fn keeps_no_clearance(&mut self, v: usize, faces: &[[DVec3; 3]]) -> bool {
+        let held = &mut self.holding_points[v];
+        if held.iter().any(|&p| point_within(p, faces, self.clearance)) {
+            return true;
+        }
+        let Some(point) = self.mesh_points.first_within(faces, self.clearance) else {
+            return false;
+        };
+        if held.len() == HELD_POINTS {
+            held.remove(0);
+        }
+        held.push(point);
         true
     }
 

@@ -83,6 +83,8 @@ pub(super) struct Simplified {
 }
 
 pub(super) struct State<'a> {
+    /// Per vertex, mesh points that kept it from moving (see `shrink`).
+    pub(super) holding_points: Vec<Vec<DVec3>>,
     pub(super) positions: Vec<DVec3>,
     pub(super) triangles: Vec<[u32; 3]>,
     pub(super) triangle_alive: Vec<bool>,
@@ -194,6 +196,7 @@ pub(super) fn simplify(
         return None;
     }
     state.shrink(2.0 * envelope.cell, true);
+    state.polish(0.25 * envelope.cell);
     Some(state.finish(envelope.limit))
 }
 
@@ -257,6 +260,7 @@ impl<'a> State<'a> {
             triangles,
             vertex_triangles,
             quadrics,
+            holding_points: vec![Vec::new(); count],
         };
         state.rebuild_hashes(2.0 * cell);
         state
