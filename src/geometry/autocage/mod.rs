@@ -22,7 +22,9 @@
 //!    the clearance from a dense sample of the mesh's surface ([`shrink`]),
 //!    whenever the collapses are stuck and at the end;
 //! 6. polish: move vertices in any direction that lowers the enclosed
-//!    volume, and flip edges that do, under the same checks ([`polish`]).
+//!    volume, and flip edges that do, under the same checks ([`polish`]);
+//! 7. for eight vertices, also tighten and polish the bounding box, and keep
+//!    the smaller cage ([`box_start`]).
 //!
 //! Step 4 keeps every surface it makes around the previous one, so the cage
 //! contains the voxels, which contain every point of the mesh's surface; each
@@ -32,6 +34,7 @@
 //! validation, which includes self-intersection), and an error says so if a
 //! check fails.
 
+mod box_start;
 mod checks;
 mod error;
 mod gaps;
@@ -308,9 +311,21 @@ pub fn generate_cage(
         let factor = ((reached as f64 / target as f64).sqrt() / 2.0).clamp(1.5, 3.0);
         cell = (cell * factor).min(coarsest);
     }
-    let Some(best) = best else {
+    let Some(mut best) = best else {
         return Err(AutoCageError::Cancelled);
     };
+    if box_start::box_fits(target) {
+        let goal = simplify::Goal {
+            target_vertices: target,
+            max_limit: 0,
+            clearance,
+            diagonal,
+        };
+        let boxed = box_start::boxed_cage(mesh, &mesh_points, &goal, best.cell);
+        if let Some(boxed) = boxed.filter(|b| box_start::is_smaller_and_valid(b, &best, mesh)) {
+            best.simplified = boxed;
+        }
+    }
     let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
     let request = Request {
         target_vertices: target,
