@@ -10,9 +10,9 @@ use super::points::PointTree;
 use super::simplify::{self, Goal, Simplified};
 use super::voxels::Envelope;
 use super::Attempt;
+use crate::geometry::cage::signed_volume;
 use crate::geometry::procedural::cube_cage;
 use crate::geometry::{Cage, TriMesh};
-use glam::DVec3;
 
 /// Targets a box's eight vertices are within 15 % of.
 pub(super) fn box_fits(target: usize) -> bool {
@@ -28,13 +28,10 @@ pub(super) fn boxed_cage(
     goal: &Goal,
     cell: f64,
 ) -> Option<Simplified> {
-    let (lo, hi) = mesh.positions.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    if !lo.is_finite() || !hi.is_finite() {
+    if mesh.positions.is_empty() {
         return None;
     }
+    let (lo, hi) = mesh.bounds();
     let (centre, half) = (0.5 * (lo + hi), 0.5 * (hi - lo) + 1.001 * goal.clearance);
     let unit = cube_cage(1.0);
     let positions = unit
@@ -68,7 +65,8 @@ pub(super) fn boxed_cage(
 /// cage around every mesh vertex (checked here as well as when the chosen
 /// cage is finished, so that a box that fails costs nothing).
 pub(super) fn is_smaller_and_valid(boxed: &Simplified, attempt: &Attempt, mesh: &TriMesh) -> bool {
-    if enclosed_volume(boxed) >= enclosed_volume(&attempt.simplified) {
+    let volume = |cage: &Simplified| signed_volume(&cage.positions, &cage.triangles);
+    if volume(boxed) >= volume(&attempt.simplified) {
         return false;
     }
     let cage = Cage::new(TriMesh {
@@ -77,16 +75,4 @@ pub(super) fn is_smaller_and_valid(boxed: &Simplified, attempt: &Attempt, mesh: 
         triangles: boxed.triangles.clone(),
     });
     cage.is_ok_and(|(cage, _)| enclosure(&cage, mesh).first_outside.is_none())
-}
-
-/// The volume a closed triangle surface encloses.
-fn enclosed_volume(cage: &Simplified) -> f64 {
-    let origin = cage.positions.first().copied().unwrap_or_default();
-    cage.triangles
-        .iter()
-        .map(|t| {
-            let [p, q, r] = t.map(|i| cage.positions[i as usize] - origin);
-            p.dot(q.cross(r)) / 6.0
-        })
-        .sum()
 }

@@ -8,6 +8,7 @@
 //! diagonal of a pair of faces the cage folds along.
 
 use super::simplify::State;
+use crate::geometry::cage::signed_volume;
 use crate::geometry::procedural::SplitMix64;
 use glam::DVec3;
 
@@ -25,8 +26,8 @@ impl State<'_> {
     /// it. A move starts with `smallest_step` and doubles while it passes.
     pub(super) fn polish(&mut self, smallest_step: f64) {
         let mut active = self.vertex_alive.clone();
+        let mut before = self.enclosed_volume();
         for pass in 0..MAX_PASSES {
-            let before = self.enclosed_volume();
             let mut moved = Vec::new();
             for v in self.active_vertices(&active) {
                 if self.polish_vertex(v, pass, smallest_step) {
@@ -39,21 +40,16 @@ impl State<'_> {
                 return;
             }
             self.activate_around(&mut active, &moved);
+            before = after;
         }
     }
 
     fn enclosed_volume(&self) -> f64 {
-        let Some(origin) = self.positions.iter().zip(&self.vertex_alive).find(|p| *p.1) else {
-            return 0.0;
-        };
-        let origin = *origin.0;
-        (0..self.triangles.len())
+        let alive: Vec<[u32; 3]> = (0..self.triangles.len())
             .filter(|&t| self.triangle_alive[t])
-            .map(|t| {
-                let [p, q, r] = self.corners(t).map(|x| x - origin);
-                p.dot(q.cross(r)) / 6.0
-            })
-            .sum()
+            .map(|t| self.triangles[t])
+            .collect();
+        signed_volume(&self.positions, &alive)
     }
 
     /// The enclosed volume is linear in one vertex's position (the others
