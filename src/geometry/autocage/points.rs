@@ -6,7 +6,6 @@
 
 use crate::geometry::closest_point_on_triangle;
 use glam::DVec3;
-use std::cell::Cell;
 
 /// Points per leaf: below this, testing each is cheaper than splitting.
 const LEAF_SIZE: usize = 16;
@@ -102,28 +101,46 @@ impl PointTree {
     pub(super) fn first_within(&self, faces: &[[DVec3; 3]], clearance: f64) -> Option<DVec3> {
         let (lo, hi) = bounds(faces)?;
         let pad = DVec3::splat(clearance);
-        let (lo, hi) = (lo - pad, hi + pad);
-        let planes = planes(faces);
-        let near = |p: DVec3, reach: f64| {
-            faces
-                .iter()
-                .zip(&planes)
-                .any(|(f, plane)| closer_than(p, f, plane, reach))
+        let query = NearQuery {
+            faces,
+            planes: planes(faces),
+            clearance,
+            lo: lo - pad,
+            hi: hi + pad,
         };
-        let found = Cell::new(None);
-        self.search(
-            0,
-            &|node| node.overlaps(lo, hi),
-            &|node| (!near(node.centre(), node.radius() + clearance)).then_some(false),
-            &|p| {
-                let hit = near(p, clearance);
-                if hit {
-                    found.set(Some(p));
-                }
-                hit
-            },
-        );
-        found.get()
+        // Each subtree tests only the faces near it: a face at the clearance
+        // from the mesh keeps the search going down to the leaves under it,
+        // but the other faces around a vertex are far from most of those.
+        // More faces than a set holds (rare) are asked a set at a time.
+        if faces.len() > FaceSet::BITS as usize {
+            return faces
+                .chunks(FaceSet::BITS as usize)
+                .find_map(|chunk| self.first_within(chunk, clearance));
+        }
+        let all = FaceSet::MAX >> (FaceSet::BITS as usize - faces.len());
+        self.first_near(0, &query, all)
+    }
+
+    /// `first_within` below node `index`, for the faces in `candidates`.
+    fn first_near(&self, index: usize, query: &NearQuery, candidates: FaceSet) -> Option<DVec3> {
+        let node = self.nodes.get(index)?;
+        if !node.overlaps(query.lo, query.hi) {
+            return None;
+        }
+        let (centre, reach) = (node.centre(), node.radius() + query.clearance);
+        let near = query.near(centre, reach, candidates);
+        if near == 0 {
+            return None;
+        }
+        if node.children[0] == 0 {
+            return self.points[node.first as usize..node.last as usize]
+                .iter()
+                .copied()
+                .find(|&p| query.near(p, query.clearance, near) != 0);
+        }
+        let [left, right] = node.children.map(|c| c as usize);
+        self.first_near(left, query, near)
+            .or_else(|| self.first_near(right, query, near))
     }
 
     /// Depth-first: `visit` prunes a node, `settle` answers for all of it when
@@ -214,6 +231,35 @@ fn build(points: &mut [DVec3], first: usize, nodes: &mut [Node], index: usize) {
             build(left_points, first, left, index + 1);
             build(right_points, first + middle, right, right_index);
         }
+    }
+}
+
+/// A set of faces of one query, by index.
+type FaceSet = u64;
+
+/// The faces and clearance of one `first_within` query.
+struct NearQuery<'a> {
+    faces: &'a [[DVec3; 3]],
+    planes: Vec<(DVec3, f64)>,
+    clearance: f64,
+    /// The faces' bounds grown by the clearance.
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl NearQuery<'_> {
+    /// Those of `candidates` closer than `reach` to `p`.
+    fn near(&self, p: DVec3, reach: f64, candidates: FaceSet) -> FaceSet {
+        let mut near = 0;
+        let mut left = candidates;
+        while left != 0 {
+            let i = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if closer_than(p, &self.faces[i], &self.planes[i], reach) {
+                near |= 1 << i;
+            }
+        }
+        near
     }
 }
 
@@ -355,5 +401,46 @@ mod tests {
                 assert!(point_within(p, &faces, clearance));
             }
         }
+    }
+
+    /// Queries of many faces, some far apart, and more than one face set
+    /// holds: each face is tested only near it, and the answers must still
+    /// be those of testing every point.
+    #[test]
+    fn many_faces_match_testing_every_point() {
+        let mut random = SplitMix64(13);
+        let points = random_points(5_000, &mut random);
+        let tree = PointTree::new(points.clone());
+        let mut answers = [0; 2];
+        for count in [2, 40, 64, 65, 150] {
+            for _ in 0..20 {
+                let faces: Vec<[DVec3; 3]> = (0..count)
+                    .map(|_| {
+                        // Most faces lie away from the points, so that any
+                        // one of them, the last too, can decide the answer.
+                        let away = if random.unit() < 0.9 { 3.0 } else { 0.0 };
+                        let centre = random_points(1, &mut random)[0] + DVec3::splat(away);
+                        let c = random_points(3, &mut random);
+                        [c[0], c[1], c[2]].map(|c| centre + (c - DVec3::splat(0.5)) * 0.1)
+                    })
+                    .collect();
+                let clearance = 0.02 * random.unit();
+                let expected = points.iter().any(|&p| {
+                    faces
+                        .iter()
+                        .any(|f| distance_squared(p, f) < clearance * clearance)
+                });
+                assert_eq!(
+                    tree.any_within(&faces, clearance),
+                    expected,
+                    "{count} faces"
+                );
+                answers[usize::from(expected)] += 1;
+            }
+        }
+        assert!(
+            answers.iter().all(|&n| n > 10),
+            "both answers asked: {answers:?}"
+        );
     }
 }

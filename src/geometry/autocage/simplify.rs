@@ -75,6 +75,46 @@ impl PartialOrd for Candidate {
     }
 }
 
+/// The volume the surface gains when an edge (a, b) collapses to a point:
+/// the progressive hull's cost (Sander et al. 2000), which keeps it tight.
+/// What does not depend on the point is summed once per edge.
+struct AddedVolume {
+    before: f64,
+    /// The faces that stay, with a or b marked to be replaced by the point.
+    kept: Vec<[Option<DVec3>; 3]>,
+}
+
+impl AddedVolume {
+    fn new(state: &State, a: usize, b: usize, star: &[u32]) -> AddedVolume {
+        let volume = |[p, q, r]: [DVec3; 3]| p.dot(q.cross(r));
+        let (a32, b32) = (a as u32, b as u32);
+        AddedVolume {
+            before: star
+                .iter()
+                .map(|&t| volume(state.corners(t as usize)))
+                .sum(),
+            kept: star
+                .iter()
+                .map(|&t| state.triangles[t as usize])
+                .filter(|tri| !(tri.contains(&a32) && tri.contains(&b32)))
+                .map(|tri| tri.map(|i| (i != a32 && i != b32).then(|| state.positions[i as usize])))
+                .collect(),
+        }
+    }
+
+    fn at(&self, position: DVec3) -> f64 {
+        let after: f64 = self
+            .kept
+            .iter()
+            .map(|tri| {
+                let [p, q, r] = tri.map(|corner| corner.unwrap_or(position));
+                p.dot(q.cross(r))
+            })
+            .sum();
+        (after - self.before) / 6.0
+    }
+}
+
 pub(super) struct Simplified {
     pub positions: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
@@ -311,6 +351,7 @@ impl<'a> State<'a> {
     /// docs/cages.md: cages 20–40 % smaller than ordered by quadric error).
     fn positions(&self, a: usize, b: usize) -> Vec<(f64, DVec3)> {
         let star = self.star(a, b);
+        let cost = AddedVolume::new(self, a, b, &star);
         let planes: Vec<(DVec3, DVec3)> = star
             .iter()
             .filter_map(|&t| {
@@ -350,30 +391,11 @@ impl<'a> State<'a> {
                     push = push.max(-distance / rate);
                 }
                 let position = start + mean * push;
-                Some((self.added_volume(a, b, &star, position), position))
+                Some((cost.at(position), position))
             })
             .collect();
         found.sort_by(|x, y| x.0.total_cmp(&y.0));
         found
-    }
-
-    /// Volume the surface gains when (a, b) collapses to `position`: the
-    /// progressive hull's cost (Sander et al. 2000), which keeps it tight.
-    fn added_volume(&self, a: usize, b: usize, star: &[u32], position: DVec3) -> f64 {
-        let volume = |[p, q, r]: [DVec3; 3]| p.dot(q.cross(r));
-        let before: f64 = star.iter().map(|&t| volume(self.corners(t as usize))).sum();
-        let after: f64 = star
-            .iter()
-            .map(|&t| self.triangles[t as usize])
-            .filter(|tri| !(tri.contains(&(a as u32)) && tri.contains(&(b as u32))))
-            .map(|tri| {
-                volume(tri.map(|i| match i as usize {
-                    i if i == a || i == b => position,
-                    i => self.positions[i],
-                }))
-            })
-            .sum();
-        (after - before) / 6.0
     }
 
     /// Collapse edge (a, b) into `a` at `position` if every check passes.
@@ -546,5 +568,56 @@ impl<'a> State<'a> {
             triangles,
             envelope_limit,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::cage::signed_volume;
+    use crate::geometry::procedural::{icosphere, SplitMix64};
+
+    /// Each place's cost is the change of the whole surface's volume when
+    /// the edge collapses there, measured over the whole surface instead of
+    /// the star, from another origin.
+    #[test]
+    fn collapse_costs_are_the_volume_they_add() {
+        let sphere = icosphere(1.0, 1);
+        let mut random = SplitMix64(11);
+        let positions: Vec<DVec3> = (sphere.positions().iter())
+            .map(|p| *p * (0.8 + 0.4 * random.unit()) + DVec3::new(3.0, -2.0, 1.0))
+            .collect();
+        let triangles = sphere.triangles().to_vec();
+        let none = PointTree::new(Vec::new());
+        let goal = Goal {
+            target_vertices: 4,
+            max_limit: 0,
+            clearance: 0.01,
+            diagonal: 2.0,
+        };
+        let state = State::new(
+            positions.clone(),
+            triangles.clone(),
+            0.1,
+            (&none, &none),
+            &goal,
+        );
+        let before = signed_volume(&positions, &triangles);
+        let mut checked = 0;
+        for &[i, j, _] in &triangles {
+            let (a, b) = (i.min(j), i.max(j));
+            for (cost, place) in state.positions(a as usize, b as usize) {
+                let mut moved = positions.clone();
+                moved[a as usize] = place;
+                let after: Vec<[u32; 3]> = (triangles.iter())
+                    .filter(|t| !(t.contains(&a) && t.contains(&b)))
+                    .map(|t| t.map(|k| if k == b { a } else { k }))
+                    .collect();
+                let change = signed_volume(&moved, &after) - before;
+                assert!((cost - change).abs() < 1e-9, "{cost} against {change}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 100);
     }
 }
