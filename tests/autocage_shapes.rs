@@ -291,3 +291,41 @@ fn the_bridged_gap_points_are_reported_where_the_mesh_is() {
         assert!((p.x - offset.x).abs() < 0.5, "{p} is not between the blobs");
     }
 }
+
+/// A long block turned 45° about y: its bounding box is three times its
+/// volume, but eight vertices can hold it with the clearance on every side,
+/// the block grown by the clearance, which the prism along y finds (its
+/// outline seen along y is a turned rectangle). The voxels and the bounding
+/// box cannot turn their corners to it.
+#[test]
+fn a_turned_block_gets_a_turned_box_at_eight_vertices() {
+    let half = DVec3::new(1.5, 2.0, 0.4);
+    let cube = pmvc::geometry::procedural::cube_cage(1.0);
+    let fine = pmvc::geometry::subdivide_midpoint(&cube, cube.positions()).unwrap();
+    let turn = glam::DQuat::from_rotation_y(std::f64::consts::FRAC_PI_4);
+    let positions: Vec<DVec3> = fine
+        .cage
+        .positions()
+        .iter()
+        .map(|p| turn * (*p * half) + DVec3::new(10.0, -4.0, 2.0))
+        .collect();
+    let block = Shape {
+        mesh: pmvc::geometry::TriMesh {
+            positions,
+            triangles: fine.cage.triangles().to_vec(),
+            triangle_faces: (0..fine.cage.triangles().len() as u32).collect(),
+        },
+        volume: 8.0 * half.x * half.y * half.z,
+        gap_points: Vec::new(),
+    };
+    let (generated, ratio) = generate("turned block", &block, 8);
+    assert_eq!(generated.cage.vertex_count(), 8);
+    let clearance = DEFAULT_CLEARANCE * block.mesh.diagonal();
+    let grown = 2.0 * (half + DVec3::splat(clearance));
+    let snug = grown.x * grown.y * grown.z / block.volume;
+    // Measured 1.007 times the grown block; 1.84 times without the prisms.
+    assert!(
+        ratio <= 1.05 * snug,
+        "volume ratio {ratio}, grown block {snug}"
+    );
+}

@@ -23,8 +23,10 @@
 //!    whenever the collapses are stuck and at the end;
 //! 6. polish: move vertices in any direction that lowers the enclosed
 //!    volume, and flip edges that do, under the same checks ([`polish`]);
-//! 7. for eight vertices, also tighten and polish the bounding box, and keep
-//!    the smaller cage ([`box_start`]).
+//! 7. for eight vertices, also tighten and polish the bounding box, and for
+//!    targets up to 32 a prism along each axis (the mesh's outline seen
+//!    along it, extruded); keep the smallest valid cage that bridges no gap
+//!    the simplification kept open ([`starts`]).
 //!
 //! Step 4 keeps every surface it makes around the previous one, so the cage
 //! contains the voxels, which contain every point of the mesh's surface; each
@@ -34,7 +36,6 @@
 //! validation, which includes self-intersection), and an error says so if a
 //! check fails.
 
-mod box_start;
 mod checks;
 mod error;
 mod gaps;
@@ -46,6 +47,7 @@ mod points;
 mod polish;
 mod shrink;
 mod simplify;
+mod starts;
 mod surface;
 mod voxels;
 mod winding;
@@ -314,18 +316,13 @@ pub fn generate_cage(
     let Some(mut best) = best else {
         return Err(AutoCageError::Cancelled);
     };
-    if box_start::box_fits(target) {
-        let goal = simplify::Goal {
-            target_vertices: target,
-            max_limit: 0,
-            clearance,
-            diagonal,
-        };
-        let boxed = box_start::boxed_cage(mesh, &mesh_points, &goal, best.cell);
-        if let Some(boxed) = boxed.filter(|b| box_start::is_smaller_and_valid(b, &best, mesh)) {
-            best.simplified = boxed;
-        }
-    }
+    let goal = simplify::Goal {
+        target_vertices: target,
+        max_limit: 0,
+        clearance,
+        diagonal,
+    };
+    starts::replace_if_better(&mut best, (mesh, &mesh_points, &gap_points), &goal);
     let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
     let request = Request {
         target_vertices: target,
