@@ -90,10 +90,18 @@ pub(crate) fn triangles_cross(
         }
         // Proper crossings of an edge through the other triangle. Edges through a
         // shared vertex touch the other triangle there, which is not a crossing.
-        _ => (0..3).any(|k| {
-            segment_crosses(p[k], p[(k + 1) % 3], q, volume_tolerance)
-                || segment_crosses(q[k], q[(k + 1) % 3], p, volume_tolerance)
-        }),
+        // Each corner's side of the other triangle's plane is computed once
+        // (it was twice, once per edge): most pairs the checks ask about
+        // have no edge between corners strictly on opposite sides.
+        _ => {
+            let p_sides = p.map(|corner| orient(q[0], q[1], q[2], corner));
+            let q_sides = q.map(|corner| orient(p[0], p[1], p[2], corner));
+            (0..3).any(|k| {
+                let l = (k + 1) % 3;
+                segment_crosses((p[k], p[l]), (p_sides[k], p_sides[l]), q, volume_tolerance)
+                    || segment_crosses((q[k], q[l]), (q_sides[k], q_sides[l]), p, volume_tolerance)
+            })
+        }
     }
 }
 
@@ -103,10 +111,15 @@ fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
 }
 
 /// The open segment (p, q) passes through the interior of `triangle`: its ends
-/// are strictly on opposite sides of the plane and it passes strictly inside all
-/// three edges.
-fn segment_crosses(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3], tolerance: f64) -> bool {
-    let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
+/// are strictly on opposite sides of the plane (`sp` and `sq`, their
+/// `orient` against the triangle) and it passes strictly inside all three
+/// edges.
+fn segment_crosses(
+    (p, q): (DVec3, DVec3),
+    (sp, sq): (f64, f64),
+    [a, b, c]: [DVec3; 3],
+    tolerance: f64,
+) -> bool {
     if !((sp > tolerance && sq < -tolerance) || (sp < -tolerance && sq > tolerance)) {
         return false;
     }

@@ -19,6 +19,7 @@ use crate::geometry::cage::signed_volume;
 use crate::geometry::procedural::cube_cage;
 use crate::geometry::{classify_points, Cage, PointClass, TriMesh};
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 /// Replace the attempt's cage with the smallest of the starts that fit the
 /// target, when that is smaller and valid ([`is_smaller_and_valid`]).
@@ -28,11 +29,16 @@ pub(super) fn replace_if_better(
     goal: &Goal,
 ) {
     let target = goal.target_vertices;
-    let boxed = box_fits(target)
-        .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
-        .flatten();
     let to_beat = signed_volume(&best.simplified.positions, &best.simplified.triangles);
-    let prisms = prism_cages(mesh, mesh_points, goal, (best.cell, to_beat));
+    // Each start is tightened on its own, so they share the cores.
+    let (boxed, prisms) = rayon::join(
+        || {
+            box_fits(target)
+                .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
+                .flatten()
+        },
+        || prism_cages(mesh, mesh_points, goal, (best.cell, to_beat)),
+    );
     let gaps: Vec<DVec3> = gap_points.iter().map(|g| g.position).collect();
     for start in boxed.into_iter().chain(prisms) {
         if is_smaller_and_valid(&start, best, mesh, &gaps) {
@@ -101,6 +107,7 @@ fn prism_cages(
         return Vec::new();
     }
     (0..3)
+        .into_par_iter()
         .filter_map(|axis| {
             let prism = prism(mesh, axis, target / 2, SPARE * goal.clearance)?;
             // A view with fewer corners (a box seen along an edge) would
