@@ -10,7 +10,9 @@ use common::measure::signed_volume;
 use common::shapes::{self, Shape};
 use common::winding_number;
 use glam::DVec3;
-use pmvc::geometry::autocage::{generate_cage, CageOptions, GeneratedCage, DEFAULT_CLEARANCE};
+use pmvc::geometry::autocage::{
+    generate_cage, CageOptions, CageStart, GeneratedCage, DEFAULT_CLEARANCE,
+};
 use pmvc::geometry::Cage;
 
 fn cage_volume(cage: &Cage) -> f64 {
@@ -320,6 +322,21 @@ fn a_turned_block_gets_a_turned_box_at_eight_vertices() {
     };
     let (generated, ratio) = generate("turned block", &block, 8);
     assert_eq!(generated.cage.vertex_count(), 8);
+    // The summary says where the cage came from, and what the voxel size was for.
+    assert_eq!(generated.stats.start, CageStart::Prism { axis: 1 });
+    let lines = pmvc::app::cage_generation::stats_lines(&generated.stats, false);
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("started from: the prism along y")),
+        "{lines:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("voxel size: ") && l.contains("replaced by the prism along y")),
+        "{lines:?}"
+    );
     let clearance = DEFAULT_CLEARANCE * block.mesh.diagonal();
     let grown = 2.0 * (half + DVec3::splat(clearance));
     let snug = grown.x * grown.y * grown.z / block.volume;

@@ -6,8 +6,8 @@
 //! mesh changes meanwhile (undo, another file), the proposal is dropped.
 
 use crate::geometry::autocage::{
-    generate_cage, AutoCageError, CageOptions, CageStats, GeneratedCage, DEFAULT_CELL_SIZE,
-    DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
+    generate_cage, AutoCageError, CageOptions, CageStart, CageStats, GeneratedCage,
+    DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use crate::geometry::{Cage, TriMesh};
 use crate::render::scene_gpu::unique_edges;
@@ -306,6 +306,12 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         stats.shells,
         if stats.shells == 1 { "" } else { "s" }
     )];
+    if stats.start != CageStart::Voxels {
+        lines.push(format!(
+            "started from: the {}, tightened and polished; it encloses less than the cage from the voxels",
+            stats.start.name()
+        ));
+    }
     if !stats.target_reached() {
         let (low, high) = target_range(stats.target_vertices);
         lines.push(format!(
@@ -354,8 +360,15 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
             significant(asked)
         ),
     };
+    let replaced = match stats.start {
+        CageStart::Voxels => String::new(),
+        start => format!(
+            "; the cage from these voxels was replaced by the {}",
+            start.name()
+        ),
+    };
     lines.push(format!(
-        "voxel size: {} ({:.2}% of the mesh diagonal, {how})",
+        "voxel size: {} ({:.2}% of the mesh diagonal, {how}{replaced})",
         significant(stats.cell_size),
         percent(stats.cell_size),
     ));

@@ -142,6 +142,8 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert isinstance(cage, pmvc.Cage)
     assert report["vertices"] == len(cage.vertices) and report["outside_vertices"] == 0
     assert report["target_vertices"] == 60
+    # Second starts (a box, prisms) run only up to 32 vertices.
+    assert report["start"] == "voxels"
     # The gap report's keys, as pmvc cage's "gaps between parts" line has them
     # (their meaning is tested in tests/autocage_shapes.rs).
     assert isinstance(report["gap_points"], int) and isinstance(report["gap_points_open"], int)

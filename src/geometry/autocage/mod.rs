@@ -9,15 +9,12 @@
 //!    well-composed, so that its boundary is a manifold ([`voxels`]);
 //! 3. take the boundary faces of the voxels as a closed quad surface
 //!    ([`surface`]);
-//! 4. simplify it with edge collapses that only ever move the surface outward
-//!    (progressive hulls: the new vertex lies on or outside the plane of every
-//!    face around the collapsed edge), and that are refused when they would make
-//!    the cage cross itself, swallow another part, fold or make a sliver
-//!    ([`simplify`]), and that stay within an envelope of the mesh (cells at
-//!    most a few voxels away, widened step by step only when no collapse is
-//!    left), so that parts a few voxels apart are not bridged, and that would
-//!    cover a point midway across a gap between parts of the mesh that the
-//!    voxels left outside ([`gaps`]);
+//! 4. simplify it with edge collapses that only move the surface outward
+//!    (progressive hulls), refused when they would make the cage cross
+//!    itself, swallow another part, fold or make a sliver ([`simplify`]),
+//!    leave an envelope of the mesh (a few voxels, widened only when no
+//!    collapse is left), or cover a point midway across a gap between parts
+//!    that the voxels left outside ([`gaps`]);
 //! 5. slide each vertex back inward as far as the same checks allow, keeping
 //!    the clearance from a dense sample of the mesh's surface ([`shrink`]),
 //!    whenever the collapses are stuck and at the end;
@@ -58,6 +55,7 @@ use error::{MAX_CELL_SIZE, MAX_CLEARANCE};
 pub use gaps::GapReport;
 use glam::DVec3;
 pub use plan::{plan_cage, CagePlan, MAX_GRID_CELLS, MAX_SURFACE_SAMPLES};
+pub use starts::CageStart;
 use std::time::Instant;
 use winding::TriangleTree;
 
@@ -143,6 +141,8 @@ pub struct CageStats {
     pub surface_vertices: usize,
     /// The gaps between parts of the mesh, and which the cage keeps open.
     pub gaps: GapReport,
+    /// Where the cage's shape came from (a second start replaces the voxels').
+    pub start: CageStart,
     pub seconds: f64,
 }
 
@@ -390,6 +390,7 @@ struct Attempt {
     grid: [usize; 3],
     surface_vertices: usize,
     winding_volume: f64,
+    start: CageStart,
 }
 
 impl Context<'_> {
@@ -475,6 +476,7 @@ fn simplify_surface(
         grid,
         surface_vertices,
         winding_volume,
+        start: CageStart::Voxels,
     })
 }
 
@@ -492,6 +494,7 @@ fn finish(
         cell,
         grid,
         surface_vertices,
+        start,
         ..
     } = attempt;
     let reach = f64::from(simplified.envelope_limit) * cell;
@@ -550,6 +553,7 @@ fn finish(
         grid,
         surface_vertices,
         gaps,
+        start,
         seconds: started.elapsed().as_secs_f64(),
     };
     // Validated where it was built; a translation changes neither its

@@ -21,6 +21,32 @@ use crate::geometry::{classify_points, Cage, PointClass, TriMesh};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+/// Where a generated cage's shape came from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CageStart {
+    /// The voxel surface around the mesh, simplified.
+    #[default]
+    Voxels,
+    /// The mesh's bounding box grown by the clearance.
+    BoundingBox,
+    /// A prism along an axis (0 for x, 1 for y, 2 for z) over the mesh's
+    /// outline seen along it.
+    Prism { axis: usize },
+}
+
+impl CageStart {
+    /// Its name in the summary and in Python's report.
+    pub fn name(self) -> &'static str {
+        match self {
+            CageStart::Voxels => "voxels",
+            CageStart::BoundingBox => "bounding box",
+            CageStart::Prism { axis: 0 } => "prism along x",
+            CageStart::Prism { axis: 1 } => "prism along y",
+            CageStart::Prism { .. } => "prism along z",
+        }
+    }
+}
+
 /// Replace the attempt's cage with the smallest of the starts that fit the
 /// target, when that is smaller and valid ([`is_smaller_and_valid`]).
 pub(super) fn replace_if_better(
@@ -36,13 +62,15 @@ pub(super) fn replace_if_better(
             box_fits(target)
                 .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
                 .flatten()
+                .map(|cage| (CageStart::BoundingBox, cage))
         },
         || prism_cages(mesh, mesh_points, goal, (best.cell, to_beat)),
     );
     let gaps: Vec<DVec3> = gap_points.iter().map(|g| g.position).collect();
-    for start in boxed.into_iter().chain(prisms) {
+    for (kind, start) in boxed.into_iter().chain(prisms) {
         if is_smaller_and_valid(&start, best, mesh, &gaps) {
             best.simplified = start;
+            best.start = kind;
         }
     }
 }
@@ -101,7 +129,7 @@ fn prism_cages(
     mesh_points: &PointTree,
     goal: &Goal,
     (cell, to_beat): (f64, f64),
-) -> Vec<Simplified> {
+) -> Vec<(CageStart, Simplified)> {
     let target = goal.target_vertices;
     if !(8..=MAX_PRISM_TARGET).contains(&target) || mesh.positions.is_empty() {
         return Vec::new();
@@ -115,7 +143,8 @@ fn prism_cages(
             let reached = prism.0.len() as f64;
             ((reached - target as f64).abs() <= 0.15 * target as f64).then_some(())?;
             (signed_volume(&prism.0, &prism.1) <= HOPELESS * to_beat).then_some(())?;
-            tighten(mesh, mesh_points, goal, cell, prism)
+            let tightened = tighten(mesh, mesh_points, goal, cell, prism)?;
+            Some((CageStart::Prism { axis }, tightened))
         })
         .collect()
 }
@@ -497,6 +526,7 @@ mod tests {
             grid: [1, 1, 1],
             surface_vertices: 0,
             winding_volume: 0.0,
+            start: CageStart::Voxels,
         };
         let one_box = simplified(box_around(DVec3::ZERO, DVec3::new(2.6, 0.6, 0.6)));
         assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, &[]));
