@@ -25,15 +25,14 @@
 //!    along it, extruded); keep the smallest valid cage that bridges no gap
 //!    the simplification kept open ([`starts`]).
 //!
-//! Step 4 keeps every surface it makes around the previous one, so the cage
-//! contains the voxels, which contain every point of the mesh's surface; each
-//! change in steps 4 to 6 is also refused when a sample of the mesh's surface
-//! would fall between the old and the new faces. The result is still checked
-//! independently (winding number of every mesh vertex, and [`Cage::new`]'s
-//! validation, which includes self-intersection), and an error says so if a
-//! check fails.
+//! Step 4 keeps every surface around the previous one, so the cage contains
+//! the voxels, which contain the mesh's surface; each change in steps 4 to 6
+//! is refused when a surface sample would fall between the old and new faces.
+//! The result is still checked independently (winding number of every mesh
+//! vertex, and [`Cage::new`]'s validation, self-intersection included).
 
 mod checks;
+mod cost;
 mod error;
 mod gaps;
 mod guard;
