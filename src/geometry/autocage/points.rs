@@ -99,15 +99,6 @@ impl PointTree {
 
     /// A point closer than `clearance` to one of `faces`, if there is one.
     pub(super) fn first_within(&self, faces: &[[DVec3; 3]], clearance: f64) -> Option<DVec3> {
-        let (lo, hi) = bounds(faces)?;
-        let pad = DVec3::splat(clearance);
-        let query = NearQuery {
-            faces,
-            planes: planes(faces),
-            clearance,
-            lo: lo - pad,
-            hi: hi + pad,
-        };
         // Each subtree tests only the faces near it: a face at the clearance
         // from the mesh keeps the search going down to the leaves under it,
         // but the other faces around a vertex are far from most of those.
@@ -117,6 +108,15 @@ impl PointTree {
                 .chunks(FaceSet::BITS as usize)
                 .find_map(|chunk| self.first_within(chunk, clearance));
         }
+        let (lo, hi) = bounds(faces)?;
+        let pad = DVec3::splat(clearance);
+        let query = NearQuery {
+            faces,
+            planes: planes(faces),
+            clearance,
+            lo: lo - pad,
+            hi: hi + pad,
+        };
         let all = FaceSet::MAX >> (FaceSet::BITS as usize - faces.len());
         self.first_near(0, &query, all)
     }

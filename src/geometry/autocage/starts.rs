@@ -67,10 +67,13 @@ pub(super) fn replace_if_better(
         || prism_cages(mesh, mesh_points, goal, (best.cell, to_beat)),
     );
     let gaps: Vec<DVec3> = gap_points.iter().map(|g| g.position).collect();
+    // Which gap points the cage kept so far leaves outside, once asked.
+    let mut kept_open = None;
     for (kind, start) in boxed.into_iter().chain(prisms) {
-        if is_smaller_and_valid(&start, best, mesh, &gaps) {
+        if let Some(open) = is_smaller_and_valid(&start, best, mesh, (&gaps, &mut kept_open)) {
             best.simplified = start;
             best.start = kind;
+            kept_open = Some(open);
         }
     }
 }
@@ -154,49 +157,47 @@ fn prism_cages(
 /// attempt's cage keeps outside: a start begins across every gap, and may
 /// close only those the simplification could not keep open at this target.
 /// (Checked here as well as when the chosen cage is finished, so that a
-/// start that fails costs nothing.)
+/// start that fails costs nothing.) `kept_open` holds, once asked, which
+/// gap points the attempt's cage leaves outside. Returns which `start`
+/// leaves outside when it passes.
 fn is_smaller_and_valid(
     start: &Simplified,
     attempt: &Attempt,
     mesh: &TriMesh,
-    gap_points: &[DVec3],
-) -> bool {
+    (gap_points, kept_open): (&[DVec3], &mut Option<Vec<bool>>),
+) -> Option<Vec<bool>> {
     let volume = |cage: &Simplified| signed_volume(&cage.positions, &cage.triangles);
     if volume(start) >= volume(&attempt.simplified) {
-        return false;
+        return None;
     }
-    let as_cage = |cage: &Simplified| {
-        Cage::new(TriMesh {
-            triangle_faces: (0..cage.triangles.len() as u32).collect(),
-            positions: cage.positions.clone(),
-            triangles: cage.triangles.clone(),
-        })
-        .ok()
-        .map(|(cage, _)| cage)
-    };
-    let Some(cage) = as_cage(start) else {
-        return false;
-    };
+    let cage = as_cage(start)?;
     if enclosure(&cage, mesh).first_outside.is_some() {
-        return false;
+        return None;
     }
-    if gap_points.is_empty() {
-        return true;
-    }
-    let Some(before) = as_cage(&attempt.simplified) else {
-        return true;
-    };
-    let open = |cage: &Cage| {
+    let open = |cage: &Cage| -> Vec<bool> {
         let classes = classify_points(cage, gap_points).classes;
         classes
             .into_iter()
             .map(|c| matches!(c, PointClass::Outside))
-            .collect::<Vec<bool>>()
+            .collect()
     };
-    open(&before)
-        .into_iter()
-        .zip(open(&cage))
-        .all(|(was_open, stays_open)| stays_open || !was_open)
+    let was_open = kept_open.get_or_insert_with(|| match as_cage(&attempt.simplified) {
+        Some(before) => open(&before),
+        None => vec![false; gap_points.len()],
+    });
+    let stays_open = open(&cage);
+    (was_open.iter().zip(&stays_open))
+        .all(|(&was, &stays)| stays || !was)
+        .then_some(stays_open)
+}
+
+fn as_cage(cage: &Simplified) -> Option<Cage> {
+    let mesh = TriMesh {
+        triangle_faces: (0..cage.triangles.len() as u32).collect(),
+        positions: cage.positions.clone(),
+        triangles: cage.triangles.clone(),
+    };
+    Cage::new(mesh).ok().map(|(cage, _)| cage)
 }
 
 /// A closed start at the target already, tightened and polished.
@@ -529,16 +530,12 @@ mod tests {
             start: CageStart::Voxels,
         };
         let one_box = simplified(box_around(DVec3::ZERO, DVec3::new(2.6, 0.6, 0.6)));
-        assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, &[]));
+        assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, (&[], &mut None)).is_some());
         let between = [DVec3::ZERO];
-        assert!(!is_smaller_and_valid(&one_box, &attempt, &mesh, &between));
+        assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, (&between, &mut None)).is_none());
         // A gap point the loose boxes cover too does not hold the start back.
         let inside_both = [DVec3::new(2.0, 0.55, 0.0)];
-        assert!(is_smaller_and_valid(
-            &one_box,
-            &attempt,
-            &mesh,
-            &inside_both
-        ));
+        let accepted = is_smaller_and_valid(&one_box, &attempt, &mesh, (&inside_both, &mut None));
+        assert!(accepted.is_some());
     }
 }
