@@ -346,3 +346,59 @@ fn a_turned_block_gets_a_turned_box_at_eight_vertices() {
         "volume ratio {ratio}, grown block {snug}"
     );
 }
+
+/// A beam whose cross-section is an L (arms 3 long and 1 wide, area 5),
+/// 8 long along x: twelve vertices can hold it as the L grown by the
+/// clearance, extruded, which the prism over its traced outline finds. The
+/// convex outline cannot go under the L's hull (area 7).
+#[test]
+fn an_l_beam_gets_an_l_shaped_prism_at_twelve_vertices() {
+    let profile = [
+        (0.0, 0.0),
+        (3.0, 0.0),
+        (3.0, 1.0),
+        (1.0, 1.0),
+        (1.0, 3.0),
+        (0.0, 3.0),
+    ];
+    let (length, offset) = (8.0, DVec3::new(-20.0, 5.0, 7.0));
+    let mut positions = Vec::new();
+    for x in [0.0, length] {
+        positions.extend(profile.iter().map(|&(y, z)| DVec3::new(x, y, z) + offset));
+    }
+    // Sides as quads split in two; each end as four triangles.
+    let mut triangles = Vec::new();
+    for i in 0..6u32 {
+        let j = (i + 1) % 6;
+        triangles.extend([[i, j, j + 6], [i, j + 6, i + 6]]);
+    }
+    for [a, b, c] in [[0u32, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]] {
+        triangles.extend([[a, c, b], [a + 6, b + 6, c + 6]]);
+    }
+    let coarse = pmvc::geometry::TriMesh {
+        positions,
+        triangle_faces: (0..triangles.len() as u32).collect(),
+        triangles,
+    };
+    let (mut cage, _) = Cage::new(coarse).expect("the L beam is closed and outward");
+    for _ in 0..3 {
+        cage = pmvc::geometry::subdivide_midpoint(&cage, cage.positions())
+            .unwrap()
+            .cage;
+    }
+    let beam = Shape {
+        mesh: pmvc::geometry::TriMesh {
+            positions: cage.positions().to_vec(),
+            triangles: cage.triangles().to_vec(),
+            triangle_faces: (0..cage.triangles().len() as u32).collect(),
+        },
+        volume: 5.0 * length,
+        gap_points: Vec::new(),
+    };
+    let (generated, ratio) = generate("L beam", &beam, 12);
+    assert_eq!(generated.stats.start, CageStart::Prism { axis: 0 });
+    let c = DEFAULT_CLEARANCE * beam.mesh.diagonal();
+    let grown_l = 2.0 * (3.0 + 2.0 * c) * (1.0 + 2.0 * c) - (1.0 + 2.0 * c).powi(2);
+    let snug = grown_l * (length + 2.0 * c) / beam.volume;
+    assert!(ratio <= 1.05 * snug, "volume ratio {ratio}, grown L {snug}");
+}

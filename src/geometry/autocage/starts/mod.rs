@@ -9,17 +9,22 @@
 //!   axis, grown by the clearance and cut down to half the target's corners,
 //!   extruded over the mesh's extent.
 
-use super::gaps::GapPoint;
-use super::measure::enclosure;
-use super::points::PointTree;
-use super::simplify::{self, Goal, Simplified};
-use super::voxels::Envelope;
-use super::Attempt;
+use crate::geometry::autocage::gaps::GapPoint;
+use crate::geometry::autocage::measure::enclosure;
+use crate::geometry::autocage::points::PointTree;
+use crate::geometry::autocage::simplify::{self, Goal, Simplified};
+use crate::geometry::autocage::voxels::Envelope;
+use crate::geometry::autocage::Attempt;
 use crate::geometry::cage::signed_volume;
 use crate::geometry::procedural::cube_cage;
 use crate::geometry::{classify_points, Cage, PointClass, TriMesh};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+
+mod outline;
+#[cfg(test)]
+mod polygon_checks;
+mod profile;
 
 /// Where a generated cage's shape came from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -236,7 +241,9 @@ fn plane_axes(axis: usize) -> (usize, usize) {
 
 /// The prism along `axis` over a polygon of at most `corners` corners
 /// around the mesh's view along it, everything `margin` or more from the
-/// mesh. Vertices 0..n are the lower cap's, n..2n the upper's.
+/// mesh: the smaller of its convex hull's cut and its traced outline's,
+/// which follows a concave view (a bench's side). Vertices 0..n are the
+/// lower cap's, n..2n the upper's.
 fn prism(
     mesh: &TriMesh,
     axis: usize,
@@ -244,12 +251,37 @@ fn prism(
     margin: f64,
 ) -> Option<(Vec<DVec3>, Vec<[u32; 3]>)> {
     let (u, w) = plane_axes(axis);
-    let seen: Vec<DVec2> = mesh
-        .positions
+    let seen = |p: &DVec3| DVec2::new(p[u], p[w]);
+    let convex = fewer_corners(
+        grown(
+            &convex_hull(mesh.positions.iter().map(seen).collect()),
+            margin,
+        )?,
+        corners,
+    );
+    let view: Vec<[DVec2; 3]> = mesh
+        .triangles
         .iter()
-        .map(|p| DVec2::new(p[u], p[w]))
+        .map(|t| t.map(|i| seen(&mesh.positions[i as usize])))
         .collect();
-    let outline = fewer_corners(grown(&convex_hull(seen), margin)?, corners)?;
+    let concave = outline::traced_outline(&view, margin)
+        .and_then(|traced| profile::fewer_corners_holding(traced, corners))
+        .filter(|concave| {
+            convex
+                .as_ref()
+                .is_none_or(|convex| area(concave) < area(convex))
+        });
+    let (outline, cap) = match concave {
+        Some(concave) => {
+            let cap = profile::cap_triangles(&concave)?;
+            (concave, cap)
+        }
+        None => {
+            let convex = convex?;
+            let cap = strip(convex.len());
+            (convex, cap)
+        }
+    };
     let (lo, hi) = mesh.bounds();
     let (bottom, top) = (lo[axis] - margin, hi[axis] + margin);
     let n = outline.len();
@@ -268,12 +300,19 @@ fn prism(
         triangles.push([i, j, n32 + j]);
         triangles.push([i, n32 + j, n32 + i]);
     }
-    // Caps as strips, which keep their triangles wider than fans do.
-    for [a, b, c] in strip(n) {
+    for [a, b, c] in cap {
         triangles.push([n32 + a, n32 + b, n32 + c]);
         triangles.push([a, c, b]);
     }
     Some((positions, triangles))
+}
+
+/// A polygon's area, positive when counter-clockwise.
+fn area(polygon: &[DVec2]) -> f64 {
+    let n = polygon.len();
+    0.5 * (0..n)
+        .map(|i| polygon[i].perp_dot(polygon[(i + 1) % n]))
+        .sum::<f64>()
 }
 
 /// Andrew's monotone chain: the hull's corners, counter-clockwise, without
@@ -369,7 +408,7 @@ fn fewer_corners(mut polygon: Vec<DVec2>, corners: usize) -> Option<Vec<DVec2>> 
 }
 
 /// A counter-clockwise triangulation of a convex n-gon zig-zagging between
-/// its two ends.
+/// its two ends, which keeps its triangles wider than a fan does.
 fn strip(n: usize) -> Vec<[u32; 3]> {
     let (mut low, mut high) = (0u32, n as u32 - 1);
     let mut triangles = Vec::with_capacity(n - 2);
@@ -391,14 +430,6 @@ fn strip(n: usize) -> Vec<[u32; 3]> {
 mod tests {
     use super::*;
     use crate::geometry::procedural::{icosphere, SplitMix64};
-
-    fn area(polygon: &[DVec2]) -> f64 {
-        let n = polygon.len();
-        (0..n)
-            .map(|i| polygon[i].perp_dot(polygon[(i + 1) % n]))
-            .sum::<f64>()
-            / 2.0
-    }
 
     /// Signed distance of `p` inside each edge of a counter-clockwise polygon.
     fn inside_by(polygon: &[DVec2], p: DVec2) -> f64 {

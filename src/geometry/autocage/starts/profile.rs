@@ -1,0 +1,342 @@
+//! A prism's profile cut down to a few corners while it keeps holding what
+//! it held, and its caps' triangles. Two steps only ever add area to a
+//! simple counter-clockwise polygon: a reflex corner is filled by the
+//! chord across it, and an edge between two convex corners is cut off by
+//! extending its neighbours until they meet. The step that adds the least
+//! area and keeps the polygon simple goes first (greedy, like
+//! [`super::starts`]' cut of a convex outline, which only has the second).
+
+use glam::DVec2;
+
+/// One step that removes a corner.
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    /// Corner `i` is reflex: the chord from its neighbour before to its
+    /// neighbour after replaces it.
+    Fill(usize),
+    /// Corners `i` and `i + 1` are replaced by where the edges before and
+    /// after them, extended, meet.
+    Cut(usize, DVec2),
+}
+
+/// `polygon` (simple, counter-clockwise) with at most `corners` corners,
+/// holding it; None when no step that keeps it simple is left first.
+pub(super) fn fewer_corners_holding(mut polygon: Vec<DVec2>, corners: usize) -> Option<Vec<DVec2>> {
+    if corners < 3 {
+        return None;
+    }
+    while polygon.len() > corners {
+        let n = polygon.len();
+        if n <= 3 {
+            return None;
+        }
+        let mut steps: Vec<(f64, Step)> = (0..n)
+            .flat_map(|i| [fill(&polygon, i), cut(&polygon, i)])
+            .flatten()
+            .collect();
+        // Least added area first; a step that would make the polygon touch
+        // itself is passed over.
+        steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let step = steps
+            .into_iter()
+            .map(|(_, step)| step)
+            .find(|step| keeps_simple(&polygon, *step))?;
+        match step {
+            Step::Fill(i) => {
+                polygon.remove(i);
+            }
+            Step::Cut(i, corner) => {
+                polygon[i] = corner;
+                polygon.remove((i + 1) % n);
+            }
+        }
+    }
+    Some(polygon)
+}
+
+/// Corners `i - 1`, `i`, `i + 1` and `i + 2`, wrapping.
+fn around(polygon: &[DVec2], i: usize) -> [DVec2; 4] {
+    let n = polygon.len();
+    [n - 1, 0, 1, 2].map(|k| polygon[(i + k) % n])
+}
+
+fn fill(polygon: &[DVec2], i: usize) -> Option<(f64, Step)> {
+    let [before, here, after, _] = around(polygon, i);
+    let turn = (here - before).perp_dot(after - here);
+    (turn < 0.0).then_some((-0.5 * turn, Step::Fill(i)))
+}
+
+fn cut(polygon: &[DVec2], i: usize) -> Option<(f64, Step)> {
+    let [before, a, b, after] = around(polygon, i);
+    let (d, e) = (a - before, b - after);
+    let denominator = d.perp_dot(e);
+    if denominator.abs() <= 1e-12 * d.length() * e.length() {
+        return None;
+    }
+    let corner = a + d * ((b - a).perp_dot(e) / denominator);
+    // Ahead of both ends, and outside the edge it replaces.
+    let outside = (b - a).perp_dot(corner - a);
+    ((corner - a).dot(d) > 0.0 && (corner - b).dot(e) > 0.0 && outside < 0.0)
+        .then_some((-0.5 * outside, Step::Cut(i, corner)))
+}
+
+/// Whether the polygon stays simple after `step`: the triangle it adds
+/// holds no other corner, and its new edges cross no edge they do not
+/// share a corner with.
+fn keeps_simple(polygon: &[DVec2], step: Step) -> bool {
+    let n = polygon.len();
+    let at = |k: usize| polygon[k % n];
+    // The triangle added, the new edges, the corners whose edges change,
+    // and the corners the triangle may hold (its own, or on the lines
+    // extended).
+    let (triangle, new_edges, changed, spared) = match step {
+        Step::Fill(i) => {
+            let [p, q, r] = [i + n - 1, i, i + 1].map(|k| k % n);
+            let triangle = [at(p), at(q), at(r)];
+            (triangle, vec![(at(p), at(r))], vec![p, q, r], vec![p, q, r])
+        }
+        Step::Cut(i, corner) => {
+            let [p, a, b, q] = [i + n - 1, i, i + 1, i + 2].map(|k| k % n);
+            let triangle = [at(a), corner, at(b)];
+            let new_edges = vec![(at(a), corner), (corner, at(b))];
+            (triangle, new_edges, vec![a, b], vec![p, a, b, q])
+        }
+    };
+    let corner_inside = (0..n)
+        .filter(|k| !spared.contains(k))
+        .any(|k| in_closed_triangle(polygon[k], triangle));
+    let crossed = (0..n)
+        .filter(|&k| !changed.contains(&k) && !changed.contains(&((k + 1) % n)))
+        .any(|k| {
+            let edge = (polygon[k], at(k + 1));
+            new_edges.iter().any(|&new| segments_meet(new, edge))
+        });
+    !corner_inside && !crossed
+}
+
+fn orientation(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+fn in_closed_triangle(p: DVec2, [a, b, c]: [DVec2; 3]) -> bool {
+    let s = [
+        orientation(a, b, p),
+        orientation(b, c, p),
+        orientation(c, a, p),
+    ];
+    s.iter().all(|&x| x >= 0.0) || s.iter().all(|&x| x <= 0.0)
+}
+
+/// Whether two closed segments share a point.
+fn segments_meet((a, b): (DVec2, DVec2), (c, d): (DVec2, DVec2)) -> bool {
+    let [o1, o2, o3, o4] = [
+        orientation(a, b, c),
+        orientation(a, b, d),
+        orientation(c, d, a),
+        orientation(c, d, b),
+    ];
+    let on = |p: DVec2, q: DVec2, r: DVec2| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return true;
+    }
+    (o1 == 0.0 && on(a, b, c))
+        || (o2 == 0.0 && on(a, b, d))
+        || (o3 == 0.0 && on(c, d, a))
+        || (o4 == 0.0 && on(c, d, b))
+}
+
+/// The triangles of a simple counter-clockwise polygon, each
+/// counter-clockwise: ear clipping that clips, each time, the ear whose
+/// smallest angle is largest, so that the caps keep wide triangles.
+pub(super) fn cap_triangles(polygon: &[DVec2]) -> Option<Vec<[u32; 3]>> {
+    let mut left: Vec<usize> = (0..polygon.len()).collect();
+    let mut triangles = Vec::with_capacity(polygon.len().saturating_sub(2));
+    while left.len() > 3 {
+        let m = left.len();
+        let ear = (0..m)
+            .filter_map(|k| {
+                let [a, b, c] = [left[(k + m - 1) % m], left[k], left[(k + 1) % m]];
+                let corners = [polygon[a], polygon[b], polygon[c]];
+                if orientation(corners[0], corners[1], corners[2]) <= 0.0 {
+                    return None;
+                }
+                let blocked = left
+                    .iter()
+                    .filter(|&&o| o != a && o != b && o != c)
+                    .any(|&o| in_closed_triangle(polygon[o], corners));
+                (!blocked).then(|| (smallest_angle(corners), k))
+            })
+            .max_by(|x, y| x.0.total_cmp(&y.0))?
+            .1;
+        let [a, b, c] = [left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]];
+        triangles.push([a as u32, b as u32, c as u32]);
+        left.remove(ear);
+    }
+    if let [a, b, c] = left[..] {
+        triangles.push([a as u32, b as u32, c as u32]);
+    }
+    Some(triangles)
+}
+
+fn smallest_angle([a, b, c]: [DVec2; 3]) -> f64 {
+    let angle = |p: DVec2, q: DVec2, r: DVec2| (q - p).angle_to(r - p).abs();
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::polygon_checks::{area, boundary_distance, contains, is_simple};
+    use super::*;
+    use crate::geometry::procedural::SplitMix64;
+
+    fn polygon(corners: &[(f64, f64)]) -> Vec<DVec2> {
+        corners.iter().map(|&(x, y)| DVec2::new(x, y)).collect()
+    }
+
+    /// A comb: a spine along the bottom and `teeth` teeth upward, each as
+    /// wide as the gap after it.
+    fn comb(teeth: usize) -> Vec<DVec2> {
+        let mut corners = vec![(0.0, 0.0), (2.0 * teeth as f64 - 1.0, 0.0)];
+        for k in (0..teeth).rev() {
+            let x = 2.0 * k as f64;
+            corners.extend([(x + 1.0, 3.0), (x, 3.0)]);
+            if k > 0 {
+                corners.extend([(x, 1.0), (x - 1.0, 1.0)]);
+            }
+        }
+        // The spine's right end rises into the last tooth.
+        corners[1].0 = 2.0 * teeth as f64 - 1.0;
+        polygon(&corners)
+    }
+
+    /// A star-shaped polygon of random radii.
+    fn star(corners: usize, seed: u64) -> Vec<DVec2> {
+        let mut random = SplitMix64(seed);
+        (0..corners)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / corners as f64;
+                DVec2::new(angle.cos(), angle.sin()) * (0.3 + random.unit())
+            })
+            .collect()
+    }
+
+    /// A random simple polygon, wiggling every way: random points joined
+    /// in random order, then untangled by reversing the path between any
+    /// two edges that cross (2-opt, which shortens the loop each time).
+    fn tangle(corners: usize, seed: u64) -> Vec<DVec2> {
+        let mut random = SplitMix64(seed);
+        let mut points: Vec<DVec2> = (0..corners)
+            .map(|_| DVec2::new(random.unit(), random.unit()))
+            .collect();
+        let crosses = |a: DVec2, b: DVec2, c: DVec2, d: DVec2| {
+            let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+            side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0
+        };
+        'untangle: loop {
+            let n = points.len();
+            for i in 0..n {
+                for j in i + 2..n {
+                    let (a, b, c, d) = (points[i], points[i + 1], points[j], points[(j + 1) % n]);
+                    if (j + 1) % n != i && crosses(a, b, c, d) {
+                        points[i + 1..=j].reverse();
+                        continue 'untangle;
+                    }
+                }
+            }
+            break;
+        }
+        if area(&points) < 0.0 {
+            points.reverse();
+        }
+        points
+    }
+
+    fn holds(outer: &[DVec2], p: DVec2) -> bool {
+        contains(outer, p) || boundary_distance(outer, p) <= 1e-9
+    }
+
+    #[test]
+    fn cut_down_profiles_hold_the_original_and_stay_simple() {
+        let shapes = [
+            comb(5),
+            star(60, 1),
+            star(200, 2),
+            tangle(40, 3),
+            tangle(80, 4),
+        ];
+        for (s, shape) in shapes.iter().enumerate() {
+            assert!(is_simple(shape) && area(shape) > 0.0, "shape {s}");
+            for corners in [3, 4, 6, 9, 12] {
+                let cut = fewer_corners_holding(shape.clone(), corners)
+                    .unwrap_or_else(|| panic!("shape {s} at {corners}"));
+                assert!(cut.len() <= corners, "shape {s}: {} corners", cut.len());
+                assert!(is_simple(&cut), "shape {s} at {corners} crosses itself");
+                assert!(area(&cut) > 0.0);
+                for &p in shape {
+                    assert!(holds(&cut, p), "shape {s} at {corners} leaves {p} out");
+                }
+                // Edge midpoints too: a corner held is not an edge held.
+                for (i, &p) in shape.iter().enumerate() {
+                    let q = shape[(i + 1) % shape.len()];
+                    assert!(holds(&cut, 0.5 * (p + q)), "shape {s} at {corners}");
+                }
+            }
+        }
+    }
+
+    /// An L (area 5) with its five convex corners chamfered is cut back to
+    /// the L at six corners; a convex cut could not go under its hull (7).
+    #[test]
+    fn a_chamfered_l_is_cut_back_to_the_l() {
+        let l = [
+            (0.0, 0.0),
+            (3.0, 0.0),
+            (3.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 3.0),
+            (0.0, 3.0),
+        ];
+        let chamfer = 0.05;
+        let n = l.len();
+        let mut corners = Vec::new();
+        for i in 0..n {
+            let p = DVec2::from(l[i]);
+            if i == 3 {
+                // The reflex corner stays.
+                corners.push(p);
+                continue;
+            }
+            let (before, after) = (DVec2::from(l[(i + n - 1) % n]), DVec2::from(l[(i + 1) % n]));
+            corners.push(p + (before - p).normalize() * chamfer);
+            corners.push(p + (after - p).normalize() * chamfer);
+        }
+        let cut = fewer_corners_holding(corners, 6).unwrap();
+        assert_eq!(cut.len(), 6);
+        assert!(area(&cut) <= 5.0 + 1e-9, "area {}", area(&cut));
+        assert!(is_simple(&cut));
+        for p in polygon(&l) {
+            assert!(holds(&cut, p));
+        }
+    }
+
+    /// Each cap triangle turns counter-clockwise and lies inside, and their
+    /// areas add up to the profile's.
+    #[test]
+    fn caps_cover_the_profile_once() {
+        for shape in [comb(4), star(12, 4), star(16, 5)] {
+            let triangles = cap_triangles(&shape).unwrap();
+            assert_eq!(triangles.len(), shape.len() - 2);
+            let mut total = 0.0;
+            for t in &triangles {
+                let [a, b, c] = t.map(|i| shape[i as usize]);
+                let twice = (b - a).perp_dot(c - a);
+                assert!(twice > 0.0, "{t:?} turns clockwise");
+                assert!(contains(&shape, (a + b + c) / 3.0), "{t:?} is outside");
+                total += 0.5 * twice;
+            }
+            assert!((total - area(&shape)).abs() <= 1e-9 * area(&shape));
+        }
+    }
+}
