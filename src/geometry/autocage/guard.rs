@@ -11,6 +11,8 @@ use std::hash::{BuildHasherDefault, Hasher};
 pub(super) struct SpatialHash {
     cell: f64,
     cells: HashMap<[i32; 3], Vec<u32>, BuildHasherDefault<CellHasher>>,
+    /// Entries filed, stale ones included.
+    entries: usize,
 }
 
 impl SpatialHash {
@@ -18,11 +20,16 @@ impl SpatialHash {
         SpatialHash {
             cell,
             cells: HashMap::default(),
+            entries: 0,
         }
     }
 
     pub(super) fn cell_size(&self) -> f64 {
         self.cell
+    }
+
+    pub(super) fn entries(&self) -> usize {
+        self.entries
     }
 
     fn key(&self, p: DVec3) -> [i32; 3] {
@@ -35,6 +42,7 @@ impl SpatialHash {
             for y in a[1]..=b[1] {
                 for x in a[0]..=b[0] {
                     self.cells.entry([x, y, z]).or_default().push(item);
+                    self.entries += 1;
                 }
             }
         }

@@ -209,6 +209,7 @@ impl State<'_> {
         for i in [a, b, c, d] {
             self.versions[i] += 1;
         }
+        self.refile_if_crowded();
         Some([a, b, c, d])
     }
 }

@@ -120,6 +120,7 @@ impl State<'_> {
                 .insert(*t, p.min(*q).min(*r), p.max(*q).max(*r));
         }
         self.vertex_hash.insert(v as u32, position, position);
+        self.refile_if_crowded();
         true
     }
 

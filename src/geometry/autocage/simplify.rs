@@ -64,6 +64,8 @@ pub(super) struct State<'a> {
     pub(super) triangle_hash: SpatialHash,
     pub(super) vertex_hash: SpatialHash,
     pub(super) triangles_at_rebuild: usize,
+    /// The triangle hash's entries when it was last built.
+    pub(super) entries_at_rebuild: usize,
     pub(super) seen_triangles: Vec<u32>,
     pub(super) seen_vertices: Vec<u32>,
     /// Points of the mesh (vertices and face centres) that must stay inside.
@@ -215,6 +217,7 @@ impl<'a> State<'a> {
             triangle_hash: SpatialHash::new(2.0 * cell),
             vertex_hash: SpatialHash::new(2.0 * cell),
             triangles_at_rebuild: triangles.len(),
+            entries_at_rebuild: 0,
             seen_triangles: vec![0; triangles.len()],
             seen_vertices: vec![0; count],
             mesh_points,
@@ -229,7 +232,10 @@ impl<'a> State<'a> {
             quadrics,
             holding_points: vec![Vec::new(); count],
         };
-        state.rebuild_hashes(2.0 * cell);
+        // A start of a few large faces (a box, a prism) is filed in cells
+        // as large as its edges.
+        let size = state.mean_edge_length().max(2.0 * cell);
+        state.rebuild_hashes(size);
         state
     }
 
@@ -421,6 +427,21 @@ impl<'a> State<'a> {
             }
         }
         self.triangles_at_rebuild = self.alive_triangles;
+        self.entries_at_rebuild = self.triangle_hash.entries();
+    }
+
+    /// Rebuilds the hashes once the entries of moved faces outnumber the
+    /// live ones several times: on a coarse cage, where each move files a
+    /// few large faces again, queries spent a fifth of a run walking stale
+    /// entries (a torus knot at N = 32). A rebuild walks every face there
+    /// has been, so it waits for as many new entries as that.
+    pub(super) fn refile_if_crowded(&mut self) {
+        let entries = self.triangle_hash.entries();
+        let added = entries - self.entries_at_rebuild;
+        if entries > 4 * self.entries_at_rebuild.max(1024) && added > self.triangles.len() {
+            let size = self.mean_edge_length().max(self.triangle_hash.cell_size());
+            self.rebuild_hashes(size);
+        }
     }
 
     fn finish(self, envelope_limit: u16) -> Simplified {
