@@ -337,6 +337,15 @@ fn a_turned_block_gets_a_turned_box_at_eight_vertices() {
             .any(|l| l.starts_with("voxel size: ") && l.contains("replaced by the prism along y")),
         "{lines:?}"
     );
+    // A prism begins around every part: no distance below which parts may
+    // merge is claimed for it.
+    assert_eq!(generated.stats.merge_distance(), f64::INFINITY);
+    assert!(
+        lines.iter().any(|l| l.starts_with(
+            "parts of the mesh at any distance may share one part of the cage: the prism along y"
+        )),
+        "{lines:?}"
+    );
     let clearance = DEFAULT_CLEARANCE * block.mesh.diagonal();
     let grown = 2.0 * (half + DVec3::splat(clearance));
     let snug = grown.x * grown.y * grown.z / block.volume;

@@ -372,7 +372,26 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         significant(stats.cell_size),
         percent(stats.cell_size),
     ));
-    lines.push(format!(
+    lines.push(merge_line(stats));
+    lines.push(gap_line(stats));
+    if show_time {
+        lines.push(format!("time: {:.2} s", stats.seconds));
+    }
+    lines
+}
+
+/// Below what distance parts of the mesh may share one part of the cage. A
+/// start (a box, a prism) begins around every part, so for it the distance
+/// says nothing; which gaps it keeps open is the gap line's to say.
+fn merge_line(stats: &CageStats) -> String {
+    let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
+    if stats.start != CageStart::Voxels {
+        return format!(
+            "parts of the mesh at any distance may share one part of the cage: the {} began around them all, and was kept as it leaves outside every gap point that the cage from the voxels left outside",
+            stats.start.name()
+        );
+    }
+    format!(
         "parts of the mesh closer than about {} ({:.1}% of the diagonal) may share one part of the cage{}",
         significant(stats.merge_distance()),
         percent(stats.merge_distance()),
@@ -385,12 +404,7 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         } else {
             ""
         }
-    ));
-    lines.push(gap_line(stats));
-    if show_time {
-        lines.push(format!("time: {:.2} s", stats.seconds));
-    }
-    lines
+    )
 }
 
 /// Which gaps between parts of the mesh the cage keeps open, measured at

@@ -144,6 +144,9 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert report["target_vertices"] == 60
     # Second starts (a box, prisms) run only up to 32 vertices.
     assert report["start"] == "voxels"
+    # From the voxels, a distance below which parts may merge (infinite only
+    # for a box or prism, which begins around every part).
+    assert 0 < report["merge_distance"] < float("inf")
     # The gap report's keys, as pmvc cage's "gaps between parts" line has them
     # (their meaning is tested in tests/autocage_shapes.rs).
     assert isinstance(report["gap_points"], int) and isinstance(report["gap_points_open"], int)
@@ -160,6 +163,8 @@ def test_generate_cage_reports_where_it_bridges_gaps(comb_points):
     bridged = report["bridged_gap_points"]
     closed = report["gap_points"] - report["gap_points_open"]
     assert closed > 0
+    # The summary never claims to keep apart what the cage joined.
+    assert report["merge_distance"] >= report["widest_closed_gap"]
     assert bridged.dtype == np.float64 and bridged.shape == (closed, 3)
     assert (pmvc.classify(bridged, cage) != pmvc.OUTSIDE).all()
 

@@ -125,15 +125,13 @@ pub struct CageStats {
     pub min_angle_degrees: f64,
     /// The clearance asked for (or the default), in the mesh's units.
     pub clearance: f64,
-    /// Voxel size and grid used.
+    /// Voxel size and grid used, and whether the generator chose the size.
     pub cell_size: f64,
-    /// Whether the voxel size was chosen by the generator rather than asked for.
     pub cell_size_chosen: bool,
     /// The voxel size asked for, when it was finer than the grid allows
     /// (1/512 of the longest side) and was coarsened to `cell_size`.
     pub cell_size_asked: Option<f64>,
-    /// How far from the mesh's voxels the cage was allowed to go in the end
-    /// (the envelope, widened when no collapse was left).
+    /// How far off the mesh's voxels the envelope let the cage go at last.
     pub reach: f64,
     pub grid: [usize; 3],
     /// Vertices of the voxel surface before simplification.
@@ -152,11 +150,14 @@ impl CageStats {
     }
 
     /// Parts of the mesh closer than this may share one part of the cage:
-    /// those the voxels may join (the clearance and a voxel on each side, at
-    /// least three voxels), or twice the reach when the cage was allowed to
-    /// stand further off the mesh than the gaps that keep gap points (a cage
-    /// that may stand that far from both sides of a gap may cross it).
+    /// those the voxels may join (the clearance and a voxel on each side,
+    /// at least three voxels), or twice the reach when that is more than
+    /// the gaps that keep gap points (a cage that far from both sides of a
+    /// gap may cross it); any, from a start (it begins around every part).
     pub fn merge_distance(&self) -> f64 {
+        if self.start != CageStart::Voxels {
+            return f64::INFINITY;
+        }
         let voxels = (3.0 * self.cell_size)
             .max(2.0 * ((self.clearance / self.cell_size).ceil() + 1.0) * self.cell_size);
         if self.merge_set_by_reach() {
