@@ -437,6 +437,22 @@ fn a_progress_callback_returning_false_cancels() {
     }
 }
 
+/// A cancel asked for once the tries are done (during the second starts or
+/// the checks at the end) gives no cage: before, the callback's answer was
+/// not read after the tries, and a cage came back.
+#[test]
+fn a_cancel_after_the_tries_gives_no_cage() {
+    let options = CageOptions::new(16);
+    for last in [0.95, 0.97, 1.0] {
+        let result = generate_cage(&torus(), &options, &|fraction| fraction < last);
+        assert_eq!(
+            result.err(),
+            Some(AutoCageError::Cancelled),
+            "cancelled from {last}"
+        );
+    }
+}
+
 #[test]
 fn the_same_input_gives_the_same_cage() {
     let comb = comb();

@@ -21,8 +21,8 @@
 //! 6. polish: move vertices in any direction that lowers the enclosed
 //!    volume, and flip edges that do, under the same checks ([`polish`]);
 //! 7. for eight vertices, also tighten and polish the bounding box, and for
-//!    targets up to 32 a prism along each axis (the mesh's outline seen
-//!    along it, extruded); keep the smallest valid cage that bridges no gap
+//!    targets up to 32 a prism along each axis (the mesh's convex or traced
+//!    outline seen along it, extruded); keep the smallest valid cage that bridges no gap
 //!    the simplification kept open ([`starts`]).
 //!
 //! Step 4 keeps every surface around the previous one, so the cage contains
@@ -185,28 +185,22 @@ impl CageStats {
 /// small for this much detail.
 pub const DEFAULT_CELL_SIZE: f64 = 1.0 / 128.0;
 /// Gap between the mesh and the cage when none is asked for, as a fraction of
-/// the diagonal. Half the finest voxel: at 1/128 a cage could not come within
-/// 1.3 of the volume of fingers or tubes (a cage standing c off a tube of
-/// radius r has at least ((r + c) / r)² of its volume), and the shared models'
-/// cages were 2 to 14 % larger than their artists' (docs/cages.md).
+/// the diagonal: half the finest voxel. At 1/128 no cage could come within 1.3
+/// of a tube's volume (it is at least ((r + c) / r)², docs/cages.md).
 pub const DEFAULT_CLEARANCE: f64 = 1.0 / 256.0;
-/// The coarsest voxel size chosen without being asked, as a fraction of the
-/// diagonal.
+/// The coarsest voxel size chosen unasked, as a fraction of the diagonal.
 const MAX_CHOSEN_CELL_SIZE: f64 = 1.0 / 12.0;
 /// Vertices of the voxel surface that the first try starts from at most: the
-/// simplification's time grows with it (Beast's 15,000 take about 2.5 s on two
-/// cores, the comb's 26,000 about 4 s).
+/// simplification's time grows with it (the comb's 26,000 took about 4 s).
 const MAX_SURFACE_VERTICES: f64 = 26_000.0;
-/// Mean cage edge, in voxels, that the simplification reaches reliably: the
-/// first try's voxels are at least a target-sized cage's mean edge divided by
-/// this (measured on the qmvc meshes, docs/cages.md).
+/// Mean cage edge, in voxels, that the simplification reaches reliably (the
+/// qmvc meshes): the first try's voxels are at least a cage's edge over this.
 const EDGE_CELLS: f64 = 16.0;
 /// How many coarser voxel sizes are tried when a cage misses its target.
 const RETRIES: usize = 3;
 
 /// How far past the clearance the envelope may widen on the first try, as a
-/// fraction of the diagonal, however coarse the voxels: the cage's slack from
-/// the mesh. Each retry raises it by half.
+/// fraction of the diagonal, however coarse the voxels; each retry adds half.
 const MAX_REACH: f64 = 0.08;
 /// Empty cells around the mesh's bounds: how far the cage may ever be from it.
 pub(super) const MARGIN_CELLS: usize = 12;
@@ -322,7 +316,11 @@ pub fn generate_cage(
         clearance,
         diagonal,
     };
+    // The tries end at 0.95 of the bar; a cancel during the starts is answered after them.
+    let step = |f: f32| progress(f).then_some(()).ok_or(AutoCageError::Cancelled);
+    step(0.95)?;
     starts::replace_if_better(&mut best, (mesh, &mesh_points, &gap_points), &goal);
+    step(0.97)?;
     let volume = closed_volume.map_or(MeshVolume::Winding(best.winding_volume), MeshVolume::Closed);
     let request = Request {
         target_vertices: target,
@@ -531,7 +529,9 @@ fn finish(
         MeshVolume::Closed(volume) => (volume, false),
         MeshVolume::Winding(volume) => (volume, true),
     };
-    progress(1.0);
+    if !progress(1.0) {
+        return Err(AutoCageError::Cancelled);
+    }
     let stats = CageStats {
         vertices: cage.vertex_count(),
         triangles: cage.triangle_count(),
