@@ -215,7 +215,13 @@ fn build(points: &mut [DVec3], first: usize, nodes: &mut [Node], index: usize) {
     if points.len() > LEAF_SIZE {
         let axis = (hi - lo).max_position();
         let middle = points.len() / 2;
-        points.select_nth_unstable_by(middle, |a, b| a[axis].total_cmp(&b[axis]));
+        // One comparison per axis: indexing by a runtime axis made this, the
+        // tree's costliest step, a quarter slower (FireHydrant's samples).
+        match axis {
+            0 => points.select_nth_unstable_by(middle, |a, b| a.x.total_cmp(&b.x)),
+            1 => points.select_nth_unstable_by(middle, |a, b| a.y.total_cmp(&b.y)),
+            _ => points.select_nth_unstable_by(middle, |a, b| a.z.total_cmp(&b.z)),
+        };
         let left_nodes = node_count(middle);
         let right_index = index + 1 + left_nodes;
         node.children = [index + 1, right_index].map(|c| c as u32);
