@@ -5,9 +5,10 @@
 //! them; an artist starts such a cage from a box, or from a profile drawn
 //! once and extruded along the model (a bench, a rail, a limb).
 //! - The mesh's bounding box, grown by the clearance (eight vertices).
-//! - Along each axis, a prism: the convex hull of the mesh seen along the
-//!   axis, grown by the clearance and cut down to half the target's corners,
-//!   extruded over the mesh's extent.
+//! - Along each axis, a prism: the mesh seen along the axis, its convex hull
+//!   or its traced (concave) outline ([`outline`]), grown by the clearance
+//!   and cut down to half the target's corners ([`profile`]), extruded over
+//!   the mesh's extent.
 
 use crate::geometry::autocage::gaps::GapPoint;
 use crate::geometry::autocage::measure::enclosure;
@@ -252,19 +253,17 @@ fn prism(
 ) -> Option<(Vec<DVec3>, Vec<[u32; 3]>)> {
     let (u, w) = plane_axes(axis);
     let seen = |p: &DVec3| DVec2::new(p[u], p[w]);
-    let convex = fewer_corners(
-        grown(
-            &convex_hull(mesh.positions.iter().map(seen).collect()),
-            margin,
-        )?,
-        corners,
-    );
-    let view: Vec<[DVec2; 3]> = mesh
+    let hull = grown(
+        &convex_hull(mesh.positions.iter().map(seen).collect()),
+        margin,
+    )?;
+    // A convex outline has no reflex corner, so only the edge cuts apply.
+    let convex = profile::fewer_corners_holding(hull, corners);
+    let view = mesh
         .triangles
         .iter()
-        .map(|t| t.map(|i| seen(&mesh.positions[i as usize])))
-        .collect();
-    let concave = outline::traced_outline(&view, margin)
+        .map(|t| t.map(|i| seen(&mesh.positions[i as usize])));
+    let concave = outline::traced_outline(view, margin)
         .and_then(|traced| profile::fewer_corners_holding(traced, corners))
         .filter(|concave| {
             convex
@@ -380,33 +379,6 @@ fn meet((p, d): (DVec2, DVec2), (q, e): (DVec2, DVec2)) -> Option<DVec2> {
     Some(p + d * ((q - p).perp_dot(e) / denominator))
 }
 
-/// A convex polygon cut down to `corners` corners that still holds it: an
-/// edge goes when its two neighbours, extended, meet beyond it, and the edge
-/// that adds the least area goes first (a greedy least-area enclosing
-/// polygon).
-fn fewer_corners(mut polygon: Vec<DVec2>, corners: usize) -> Option<Vec<DVec2>> {
-    if corners < 3 {
-        return None;
-    }
-    while polygon.len() > corners {
-        let n = polygon.len();
-        let removal = |i: usize| {
-            let [before, a, b, after] = [n - 1, 0, 1, 2].map(|k| polygon[(i + k) % n]);
-            let (d, e) = (a - before, b - after);
-            // The extended neighbours must meet ahead of both ends.
-            let corner = meet((a, d), (b, e))?;
-            ((corner - a).dot(d) > 0.0 && (corner - b).dot(e) > 0.0)
-                .then(|| (0.5 * (b - a).perp_dot(corner - a).abs(), corner))
-        };
-        let (i, (_, corner)) = (0..n)
-            .filter_map(|i| Some((i, removal(i)?)))
-            .min_by(|x, y| x.1 .0.total_cmp(&y.1 .0))?;
-        polygon[i] = corner;
-        polygon.remove((i + 1) % n);
-    }
-    Some(polygon)
-}
-
 /// A counter-clockwise triangulation of a convex n-gon zig-zagging between
 /// its two ends, which keeps its triangles wider than a fan does.
 fn strip(n: usize) -> Vec<[u32; 3]> {
@@ -476,7 +448,7 @@ mod tests {
         let points = circle(90, radius);
         let outline = grown(&convex_hull(points.clone()), margin).unwrap();
         for corners in [4, 6, 12] {
-            let polygon = fewer_corners(outline.clone(), corners).unwrap();
+            let polygon = profile::fewer_corners_holding(outline.clone(), corners).unwrap();
             assert_eq!(polygon.len(), corners);
             let least = points
                 .iter()

@@ -48,7 +48,10 @@ impl Raster {
 /// with its corners on a grid of about 1/256 of the view's longer side.
 /// None when the view is a point or a line, or when it falls apart into
 /// separate regions (one prism could not hold them all).
-pub(super) fn traced_outline(triangles: &[[DVec2; 3]], margin: f64) -> Option<Vec<DVec2>> {
+pub(super) fn traced_outline(
+    triangles: impl Iterator<Item = [DVec2; 3]> + Clone,
+    margin: f64,
+) -> Option<Vec<DVec2>> {
     let mut raster = covering_raster(triangles, margin)?;
     grow(&mut raster, margin);
     close_pinches(&mut raster);
@@ -60,10 +63,13 @@ pub(super) fn traced_outline(triangles: &[[DVec2; 3]], margin: f64) -> Option<Ve
 
 /// A raster over the triangles, padded for the margin, with every cell
 /// that any triangle touches filled.
-fn covering_raster(triangles: &[[DVec2; 3]], margin: f64) -> Option<Raster> {
-    let (lo, hi) = triangles.iter().flatten().fold(
+fn covering_raster(
+    triangles: impl Iterator<Item = [DVec2; 3]> + Clone,
+    margin: f64,
+) -> Option<Raster> {
+    let (lo, hi) = triangles.clone().flatten().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
     );
     let longest = (hi - lo).max_element();
     if !longest.is_finite() || longest <= 0.0 || !margin.is_finite() || margin < 0.0 {
@@ -83,7 +89,7 @@ fn covering_raster(triangles: &[[DVec2; 3]], margin: f64) -> Option<Raster> {
         filled: vec![false; width * height],
     };
     for triangle in triangles {
-        fill_covered(&mut raster, triangle);
+        fill_covered(&mut raster, &triangle);
     }
     Some(raster)
 }
@@ -311,7 +317,7 @@ mod tests {
             .iter()
             .flat_map(|&(lo, hi)| rectangle(lo, hi))
             .collect();
-        let outline = traced_outline(&triangles, margin).unwrap();
+        let outline = traced_outline(triangles.iter().copied(), margin).unwrap();
         assert!(is_simple(&outline));
         assert!(area(&outline) > 0.0, "counter-clockwise");
         for (lo, hi) in parts {
@@ -352,7 +358,7 @@ mod tests {
         .iter()
         .flat_map(|&(lo, hi)| rectangle(lo, hi))
         .collect();
-        let outline = traced_outline(&ring, 0.05).unwrap();
+        let outline = traced_outline(ring.iter().copied(), 0.05).unwrap();
         assert!(
             contains(&outline, DVec2::new(2.0, 2.0)),
             "the hole is filled"
@@ -366,9 +372,9 @@ mod tests {
         .iter()
         .flat_map(|&(lo, hi)| rectangle(lo, hi))
         .collect();
-        assert!(traced_outline(&apart, 0.05).is_none());
+        assert!(traced_outline(apart.iter().copied(), 0.05).is_none());
         // Close enough for the margins to meet, they are one region.
-        assert!(traced_outline(&apart, 2.6).is_some());
+        assert!(traced_outline(apart.iter().copied(), 2.6).is_some());
     }
 
     /// Tiny triangles scattered over a disc are each held with the margin,
@@ -385,7 +391,7 @@ mod tests {
                 [p, p + DVec2::new(1e-6, 0.0), p + DVec2::new(0.0, 1e-6)]
             })
             .collect();
-        let outline = traced_outline(&triangles, margin).unwrap();
+        let outline = traced_outline(triangles.iter().copied(), margin).unwrap();
         assert!(is_simple(&outline));
         let shallowest = triangles
             .iter()
@@ -427,7 +433,7 @@ mod tests {
     fn a_triangle_seen_edge_on_covers_its_segment() {
         let (a, b) = (DVec2::new(0.0, 0.0), DVec2::new(4.0, 3.0));
         let margin = 0.05;
-        let outline = traced_outline(&[[a, 0.5 * (a + b), b]], margin).unwrap();
+        let outline = traced_outline([[a, 0.5 * (a + b), b]].into_iter(), margin).unwrap();
         for k in 0..=10 {
             let p = a + (b - a) * (k as f64 / 10.0);
             assert!(depth(&outline, p) >= margin - 1e-12);

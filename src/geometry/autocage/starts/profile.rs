@@ -3,8 +3,8 @@
 //! simple counter-clockwise polygon: a reflex corner is filled by the
 //! chord across it, and an edge between two convex corners is cut off by
 //! extending its neighbours until they meet. The step that adds the least
-//! area and keeps the polygon simple goes first (greedy, like
-//! [`super::starts`]' cut of a convex outline, which only has the second).
+//! area and keeps the polygon simple goes first (greedy; a convex outline
+//! has only the second).
 
 use glam::DVec2;
 
@@ -69,11 +69,7 @@ fn fill(polygon: &[DVec2], i: usize) -> Option<(f64, Step)> {
 fn cut(polygon: &[DVec2], i: usize) -> Option<(f64, Step)> {
     let [before, a, b, after] = around(polygon, i);
     let (d, e) = (a - before, b - after);
-    let denominator = d.perp_dot(e);
-    if denominator.abs() <= 1e-12 * d.length() * e.length() {
-        return None;
-    }
-    let corner = a + d * ((b - a).perp_dot(e) / denominator);
+    let corner = super::meet((a, d), (b, e))?;
     // Ahead of both ends, and outside the edge it replaces.
     let outside = (b - a).perp_dot(corner - a);
     ((corner - a).dot(d) > 0.0 && (corner - b).dot(e) > 0.0 && outside < 0.0)
