@@ -53,23 +53,57 @@ pub(super) fn gap_points(
                 })
             });
             starts.flat_map(move |p| {
-                sides.iter().filter_map(move |&side| {
+                sides.iter().flat_map(move |&side| {
                     let d = side * normal;
                     if d == DVec3::ZERO {
-                        return None;
+                        return Vec::new();
                     }
-                    let width = start_offset + tree.first_hit(p + d * start_offset, d, widest)?;
+                    let Some(hit) = tree.first_hit(p + d * start_offset, d, widest) else {
+                        return Vec::new();
+                    };
+                    let width = start_offset + hit;
                     let position = p + d * (0.5 * width);
                     // Midway between two surfaces, not beside a third (the palm
                     // at a finger's foot); and outside the mesh, where a face
                     // facing the wrong way or a hole let the ray into the solid.
-                    let medial = || !tree.is_within(position, 0.45 * width);
-                    (width >= narrowest && medial() && tree.winding_number(position).abs() < 0.5)
-                        .then_some(GapPoint { position, width })
+                    let medial = |at: DVec3| !tree.is_within(at, 0.45 * width);
+                    let outside = |at: DVec3| tree.winding_number(at).abs() < 0.5;
+                    if width < narrowest || !medial(position) || !outside(position) {
+                        return Vec::new();
+                    }
+                    let mut found = vec![GapPoint { position, width }];
+                    found.extend(mouth_points(tree, position, d, width, |at| {
+                        medial(at) && outside(at)
+                    }));
+                    found
                 })
             })
         })
         .collect()
+}
+
+/// Points where the gap at `position` (across `direction`, `width` wide)
+/// opens out: a width from it along the gap's two other directions, where
+/// no wall lies within a width on either side and `keeps` holds (off the
+/// mesh, outside it). Past two fingertips, or in
+/// front of the gap between two fingers, a face joining them would cover
+/// no point midway between walls, yet join the parts all the same.
+fn mouth_points<'a>(
+    tree: &'a TriangleTree,
+    position: DVec3,
+    direction: DVec3,
+    width: f64,
+    keeps: impl Fn(DVec3) -> bool + 'a,
+) -> impl Iterator<Item = GapPoint> + 'a {
+    let (first, second) = direction.any_orthonormal_pair();
+    [first, -first, second, -second]
+        .into_iter()
+        .map(move |t| position + t * width)
+        .filter(move |&at| {
+            let walled = |d: DVec3| tree.first_hit(at, d, width).is_some();
+            !walled(direction) && !walled(-direction) && keeps(at)
+        })
+        .map(move |position| GapPoint { position, width })
 }
 
 /// Faces sampled to tell which way the normals point.

@@ -31,9 +31,11 @@
 //! The result is still checked independently (winding number of every mesh
 //! vertex, and [`Cage::new`]'s validation, self-intersection included).
 
+mod cell_choice;
 mod checks;
 mod cost;
 mod error;
+mod flat;
 mod gaps;
 mod guard;
 mod measure;
@@ -44,6 +46,7 @@ mod polish;
 mod shrink;
 mod simplify;
 mod starts;
+mod stats;
 mod surface;
 mod voxels;
 mod winding;
@@ -55,6 +58,7 @@ pub use gaps::GapReport;
 use glam::DVec3;
 pub use plan::{plan_cage, CagePlan, MAX_GRID_CELLS, MAX_SURFACE_SAMPLES};
 pub use starts::CageStart;
+pub use stats::{CageStats, GeneratedCage};
 use std::time::Instant;
 use winding::TriangleTree;
 
@@ -91,95 +95,6 @@ pub const MAX_TARGET_VERTICES: usize = 20_000;
 /// The fewest: a box.
 pub const MIN_TARGET_VERTICES: usize = 8;
 
-/// A generated cage and what was measured on it.
-#[derive(Clone, Debug)]
-pub struct GeneratedCage {
-    pub cage: Cage,
-    pub stats: CageStats,
-}
-
-/// Measured properties of a generated cage. Distances are in the mesh's units.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct CageStats {
-    pub vertices: usize,
-    pub triangles: usize,
-    /// Quads among the faces (with `quads` asked for); the rest are triangles.
-    pub quads: usize,
-    pub target_vertices: usize,
-    /// Connected parts of the cage (separate solids).
-    pub shells: usize,
-    /// Smallest distance from a mesh vertex to the cage surface.
-    pub min_clearance: f64,
-    /// The mesh's bounding-box diagonal, to state distances relative to it.
-    pub mesh_diagonal: f64,
-    /// Mesh vertices not strictly inside the cage (winding number below 0.5).
-    /// Always 0 for a returned cage; kept so reports can say so.
-    pub outside_vertices: usize,
-    pub cage_volume: f64,
-    /// The mesh's volume: its own when it is closed, otherwise the volume of the
-    /// voxels whose centre has a winding number over one half (0 for sheets
-    /// that enclose nothing).
-    pub mesh_volume: f64,
-    pub mesh_volume_from_voxels: bool,
-    /// Smallest angle of any cage triangle, in degrees.
-    pub min_angle_degrees: f64,
-    /// The clearance asked for (or the default), in the mesh's units.
-    pub clearance: f64,
-    /// Voxel size and grid used, and whether the generator chose the size.
-    pub cell_size: f64,
-    pub cell_size_chosen: bool,
-    /// The voxel size asked for, when it was finer than the grid allows
-    /// (1/512 of the longest side) and was coarsened to `cell_size`.
-    pub cell_size_asked: Option<f64>,
-    /// How far off the mesh's voxels the envelope let the cage go at last.
-    pub reach: f64,
-    pub grid: [usize; 3],
-    /// Vertices of the voxel surface before simplification.
-    pub surface_vertices: usize,
-    /// The gaps between parts of the mesh, and which the cage keeps open.
-    pub gaps: GapReport,
-    /// Where the cage's shape came from (a second start replaces the voxels').
-    pub start: CageStart,
-    pub seconds: f64,
-}
-
-impl CageStats {
-    /// Cage volume ÷ mesh volume; `None` when the mesh encloses no volume.
-    pub fn volume_ratio(&self) -> Option<f64> {
-        (self.mesh_volume > 0.0).then(|| self.cage_volume / self.mesh_volume)
-    }
-
-    /// Parts of the mesh closer than this may share one part of the cage:
-    /// those the voxels may join (the clearance and a voxel on each side,
-    /// at least three voxels), or twice the reach when that is more than
-    /// the gaps that keep gap points (a cage that far from both sides of a
-    /// gap may cross it); any, from a start (it begins around every part).
-    pub fn merge_distance(&self) -> f64 {
-        if self.start != CageStart::Voxels {
-            return f64::INFINITY;
-        }
-        let voxels = (3.0 * self.cell_size)
-            .max(2.0 * ((self.clearance / self.cell_size).ceil() + 1.0) * self.cell_size);
-        if self.merge_set_by_reach() {
-            voxels.max(2.0 * (self.reach + self.cell_size))
-        } else {
-            voxels
-        }
-    }
-
-    /// Whether the cage stood off the mesh by more than half the widest gap
-    /// the gap points keep open, so that wider gaps may have been bridged.
-    pub fn merge_set_by_reach(&self) -> bool {
-        2.0 * (self.reach + self.cell_size) > self.gaps.range
-    }
-
-    /// Whether the vertex count is within ±15 % of the target.
-    pub fn target_reached(&self) -> bool {
-        let target = self.target_vertices as f64;
-        (self.vertices as f64 - target).abs() <= 0.15 * target
-    }
-}
-
 /// Finest voxel size, as a fraction of the diagonal: parts about 2.5 % of the
 /// diagonal apart stay apart. Coarser voxels are chosen when the target is too
 /// small for this much detail.
@@ -190,12 +105,6 @@ pub const DEFAULT_CELL_SIZE: f64 = 1.0 / 128.0;
 pub const DEFAULT_CLEARANCE: f64 = 1.0 / 256.0;
 /// The coarsest voxel size chosen unasked, as a fraction of the diagonal.
 const MAX_CHOSEN_CELL_SIZE: f64 = 1.0 / 12.0;
-/// Vertices of the voxel surface that the first try starts from at most: the
-/// simplification's time grows with it (the comb's 26,000 took about 4 s).
-const MAX_SURFACE_VERTICES: f64 = 26_000.0;
-/// Mean cage edge, in voxels, that the simplification reaches reliably (the
-/// qmvc meshes): the first try's voxels are at least a cage's edge over this.
-const EDGE_CELLS: f64 = 16.0;
 /// How many coarser voxel sizes are tried when a cage misses its target.
 const RETRIES: usize = 3;
 
@@ -253,24 +162,26 @@ pub fn generate_cage(
         gap_points: &gap_points,
     };
 
-    let mut cell = plan.cell_size;
-    let mut surface = context.voxel_surface(cell, &|f| progress(0.05 * f))?;
     let chosen = options.cell_size.is_none();
     let coarsest = MAX_CHOSEN_CELL_SIZE * diagonal;
-    if chosen {
-        // A voxel surface has about one vertex per cell² of area, so its
-        // vertex count goes as the inverse square of the cell size.
-        let vertices = surface.surface.positions.len() as f64;
-        let for_time = (vertices / MAX_SURFACE_VERTICES).sqrt();
-        let for_target = (1.15 * vertices / target as f64).sqrt() / EDGE_CELLS;
-        let wanted = (cell * for_time.max(for_target)).min(coarsest);
-        if wanted > 1.05 * cell {
-            cell = wanted;
-            drop(surface);
-            surface = context.voxel_surface(cell, &|f| progress(0.05 + 0.05 * f))?;
-        }
-    }
-    let attempts = if chosen { 1 + RETRIES } else { 1 };
+    let (mut cell, surface, mut fallback) = if chosen {
+        let bounds = cell_choice::Bounds {
+            target,
+            clearance,
+            diagonal,
+            coarsest,
+        };
+        context.first_surface(plan.cell_size, &bounds, progress)?
+    } else {
+        let surface = context.voxel_surface(plan.cell_size, &|f| progress(0.1 * f))?;
+        (plan.cell_size, surface, None)
+    };
+    let attempts = if chosen {
+        1 + RETRIES + usize::from(fallback.is_some())
+    } else {
+        1
+    };
+    let mut widened = 0;
     let mut best: Option<Attempt> = None;
     let mut next_surface = Some(surface);
     for attempt in 0..attempts {
@@ -283,7 +194,7 @@ pub fn generate_cage(
             None => context.voxel_surface(cell, &|f| span(0.1 * f))?,
         };
         // Each retry may also stand further off the mesh.
-        let reach = MAX_REACH * diagonal * 1.5f64.powi(attempt as i32);
+        let reach = MAX_REACH * diagonal * 1.5f64.powi(widened);
         let cells = surface.clearance_cells;
         let goal = simplify::Goal {
             target_vertices: target,
@@ -303,9 +214,16 @@ pub fn generate_cage(
         if reached as f64 <= 1.15 * target as f64 || cell >= coarsest {
             break;
         }
+        // Voxels made finer to keep gaps open missed the target: the size
+        // chosen without the gaps is tried as it would have been first.
+        if let Some(plain) = fallback.take() {
+            cell = plain;
+            continue;
+        }
         // Larger steps when the target is far off.
         let factor = ((reached as f64 / target as f64).sqrt() / 2.0).clamp(1.5, 3.0);
         cell = (cell * factor).min(coarsest);
+        widened += 1;
     }
     let Some(mut best) = best else {
         return Err(AutoCageError::Cancelled);
@@ -379,6 +297,9 @@ struct VoxelSurface {
     winding_volume: f64,
     /// The gap points outside the voxels, which the cage keeps outside.
     gaps: Vec<DVec3>,
+    /// The widths of the gaps whose gap points the voxels cover, and leave outside.
+    bridged_widths: Vec<f64>,
+    open_widths: Vec<f64>,
 }
 
 /// The cage of one voxel size, before it is checked.
@@ -392,6 +313,58 @@ struct Attempt {
 }
 
 impl Context<'_> {
+    /// The voxel surface of the first try, at `cell` or a size chosen from
+    /// the one made there ([`cell_choice`]). Voxels finer than `cell`, made
+    /// to keep gaps open, are kept only when they leave more gap points
+    /// outside: a gap point may lie in a pocket that any voxels fill.
+    fn first_surface(
+        &self,
+        cell: f64,
+        bounds: &cell_choice::Bounds,
+        progress: &dyn Fn(f32) -> bool,
+    ) -> Result<(f64, VoxelSurface, Option<f64>), AutoCageError> {
+        let first = self.voxel_surface(cell, &|f| progress(0.05 * f))?;
+        let choice = cell_choice::first_try_cell(
+            &cell_choice::FirstSurface {
+                cell,
+                vertices: first.surface.positions.len(),
+                bridged_widths: &first.bridged_widths,
+                open_widths: &first.open_widths,
+            },
+            bounds,
+        );
+        let differs = |size: f64| size > 1.05 * cell || size < cell / 1.05;
+        let mesh = self.mesh;
+        let fits = |size: f64| {
+            let grid = plan::grid_dims(mesh, size, self.clearance);
+            size >= cell || plan::check_grid(mesh, grid, size, self.clearance, 0).is_ok()
+        };
+        let second = |size: f64| self.voxel_surface(size, &|f| progress(0.05 + 0.05 * f));
+        if choice.for_gaps < choice.wanted {
+            // Where these miss the target, the size chosen without the gaps.
+            let plain = (choice.for_gaps < choice.wanted / 1.05).then_some(choice.wanted);
+            if !differs(choice.for_gaps) {
+                return Ok((cell, first, plain));
+            }
+            if choice.for_gaps > cell {
+                return Ok((choice.for_gaps, second(choice.for_gaps)?, plain));
+            }
+            if fits(choice.for_gaps) {
+                let first_open = first.gaps.len();
+                drop(first);
+                let finer = second(choice.for_gaps)?;
+                if finer.gaps.len() > first_open {
+                    return Ok((choice.for_gaps, finer, plain));
+                }
+                return Ok((choice.wanted, second(choice.wanted)?, None));
+            }
+        }
+        if !differs(choice.wanted) {
+            return Ok((cell, first, None));
+        }
+        Ok((choice.wanted, second(choice.wanted)?, None))
+    }
+
     /// The voxel surface at voxel size `cell`, each allocation checked first.
     fn voxel_surface(
         &self,
@@ -424,12 +397,13 @@ impl Context<'_> {
         voxels::fill_cavities(&mut voxels);
         step(0.9)?;
         voxels::make_well_composed(&mut voxels);
-        let gaps = self
+        let (outside, covered): (Vec<&gaps::GapPoint>, Vec<_>) = self
             .gap_points
             .iter()
-            .map(|g| g.position)
-            .filter(|&p| voxels.is_outside(p))
-            .collect();
+            .partition(|g| voxels.is_outside(g.position));
+        let gaps = outside.iter().map(|g| g.position).collect();
+        let bridged_widths = covered.iter().map(|g| g.width).collect();
+        let open_widths: Vec<f64> = outside.iter().map(|g| g.width).collect();
         step(1.0)?;
         let faces = surface::boundary_face_count(&voxels);
         plan::check_surface(faces as u64, cell, mesh.diagonal())?;
@@ -439,6 +413,8 @@ impl Context<'_> {
             clearance_cells,
             winding_volume: winding_volume.unwrap_or(0.0),
             gaps,
+            bridged_widths,
+            open_widths,
         })
     }
 }

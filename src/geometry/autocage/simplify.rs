@@ -104,6 +104,8 @@ pub(super) fn simplify(
     let points = (mesh_points, gap_points);
     let mut state = State::new(positions, triangles, envelope.cell, points, goal);
     let start = state.alive_vertices;
+    // Flat patches and straight creases first, without the collapse order.
+    state.merge_keeping_surface(&envelope, goal.target_vertices);
     let mut heap = state.all_candidates(&envelope);
     let mut steps = 0usize;
     let target = goal.target_vertices;
@@ -278,7 +280,13 @@ impl<'a> State<'a> {
     }
 
     /// Collapse edge (a, b) into `a` at `position` if every check passes.
-    fn collapse(&mut self, a: usize, b: usize, position: DVec3, envelope: &Envelope) -> bool {
+    pub(super) fn collapse(
+        &mut self,
+        a: usize,
+        b: usize,
+        position: DVec3,
+        envelope: &Envelope,
+    ) -> bool {
         if !self.link_condition_holds(a, b) {
             return false;
         }
@@ -304,7 +312,10 @@ impl<'a> State<'a> {
         }
         // In a flat star, unflipped faces around a point of the same plane
         // cover exactly the region the old ones did: nothing else can change.
-        let flat = self.lies_in_plane_of(&old_corners, position);
+        // So do a vertex's faces moved onto a neighbour in their plane or
+        // along a straight crease ([`super::flat`]).
+        let flat = self.lies_in_plane_of(&old_corners, position)
+            || (position == old_a && self.moving_keeps_surface(b, a));
         let accepted = flat
             || self.passes_region_checks(
                 (a, b),
