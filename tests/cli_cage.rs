@@ -85,7 +85,7 @@ fn the_voxel_size_is_chosen_or_used_as_asked_and_reported() {
     assert!(text.contains("may share one part of the cage"), "{text}");
     // A box around five fingers bridges the gaps between them, and says so.
     assert!(
-        text.contains("points midway across them are inside the cage (bridged gaps up to"),
+        text.contains("points in them are inside the cage (bridged gaps up to"),
         "{text}"
     );
     let asked = pmvc(&[

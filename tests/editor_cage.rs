@@ -456,7 +456,7 @@ fn a_proposal_that_bridges_gaps_marks_them() {
         .iter()
         .all(|c| !matches!(c, pmvc::geometry::PointClass::Outside)));
     harness.get_by_label_contains(&format!(
-        "Orange dots in the view: the {} points midway across the gaps this cage bridges",
+        "Orange dots in the view: the {} points in the gaps this cage bridges",
         bridged.len()
     ));
 }

@@ -19,7 +19,7 @@ use std::sync::Arc;
 /// The proposed cage's colour in the viewport and its stats' heading.
 pub const PROPOSAL_GREEN: egui::Color32 = egui::Color32::from_rgb(80, 220, 110);
 
-/// The dots on the points midway across the gaps a proposed cage bridges.
+/// The dots on the points in the gaps a proposed cage bridges.
 pub const BRIDGED_GAP_ORANGE: egui::Color32 = egui::Color32::from_rgb(255, 150, 40);
 
 /// At most this many of them are drawn (every k-th), so that a cage bridging
@@ -44,7 +44,7 @@ pub fn bridged_legend(stats: &CageStats) -> Option<String> {
         format!("one in {stride} of the {bridged} points")
     };
     Some(format!(
-        "Orange dots in the view: {which} midway across the gaps this cage bridges"
+        "Orange dots in the view: {which} in the gaps this cage bridges"
     ))
 }
 
@@ -408,16 +408,16 @@ fn merge_line(stats: &CageStats) -> String {
 }
 
 /// Which gaps between parts of the mesh the cage keeps open, measured at
-/// points midway across them.
+/// points in them (midway across, and where they open out).
 fn gap_line(stats: &CageStats) -> String {
     let gaps = &stats.gaps;
     let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
     let width = |w: f64| format!("{} ({:.1}% of the diagonal)", significant(w), percent(w));
     match (gaps.points, gaps.closed(), gaps.widest_closed) {
         (0, _, _) => "gaps between parts: none narrow enough to be bridged".to_owned(),
-        (n, 0, _) => format!("gaps between parts: all open ({n} points midway across them stay outside)"),
+        (n, 0, _) => format!("gaps between parts: all open ({n} points in them stay outside)"),
         (n, closed, Some(widest)) => format!(
-            "gaps between parts: {closed} of {n} points midway across them are inside the cage (bridged gaps up to {} wide){}",
+            "gaps between parts: {closed} of {n} points in them are inside the cage (bridged gaps up to {} wide){}",
             width(widest),
             match gaps.narrowest_open {
                 Some(narrowest) => format!("; gaps from {} wide stay open where the cage keeps them", width(narrowest)),

@@ -14,6 +14,9 @@ const EDGE_CELLS: f64 = 16.0;
 /// collapses at little cost ([`super::flat`]).
 const MAX_SURFACE_VERTICES_FOR_GAPS: f64 = 80_000.0;
 const EDGE_CELLS_FOR_GAPS: f64 = 24.0;
+/// The least share of the points midway across gaps that the voxels chosen
+/// for the gaps must keep open, where the others would not, to be chosen.
+const MIN_SHARE_FOR_GAPS: f64 = 0.1;
 /// The finest voxels chosen to keep a gap open, as a fraction of the
 /// diagonal: gaps from four of them (1.6 %) wide.
 const FINEST_FOR_GAPS: f64 = 1.0 / 256.0;
@@ -22,9 +25,9 @@ const FINEST_FOR_GAPS: f64 = 1.0 / 256.0;
 pub(super) struct FirstSurface<'a> {
     pub cell: f64,
     pub vertices: usize,
-    /// Widths of the gaps whose gap points these voxels cover.
+    /// Widths of the gaps whose points midway these voxels cover.
     pub bridged_widths: &'a [f64],
-    /// Widths of those whose gap points they leave outside.
+    /// Widths of those whose points midway they leave outside.
     pub open_widths: &'a [f64],
 }
 
@@ -58,23 +61,41 @@ pub(super) fn first_try_cell(first: &FirstSurface, bounds: &Bounds) -> CellChoic
     let finest = FINEST_FOR_GAPS * bounds.diagonal;
     // A bridged gap needs the voxels that keep it; one kept open here is
     // kept by these voxels, but may be bridged by coarser ones.
-    let bridged = first
-        .bridged_widths
-        .iter()
-        .filter_map(|&w| keeping_cell(w, bounds.clearance));
-    let at_risk = first
-        .open_widths
-        .iter()
-        .filter_map(|&w| keeping_cell(w, bounds.clearance))
+    let keeping = |widths: &[f64]| -> Vec<f64> {
+        (widths.iter())
+            .filter_map(|&w| keeping_cell(w, bounds.clearance))
+            .filter(|&cell| cell >= finest)
+            .collect()
+    };
+    let bridged = keeping(first.bridged_widths);
+    let at_risk: Vec<f64> = (keeping(first.open_widths).into_iter())
         .filter(|&cell| cell < wanted)
-        .map(|cell| cell.max(first.cell));
-    let for_gaps = bridged
-        .chain(at_risk)
-        .filter(|&cell| cell >= finest)
-        .reduce(f64::min);
-    let for_gaps = for_gaps.map_or(wanted, |cell| {
-        wanted.min(cell.max(within(MAX_SURFACE_VERTICES_FOR_GAPS, EDGE_CELLS_FOR_GAPS)))
-    });
+        .map(|cell| cell.max(first.cell))
+        .collect();
+    let Some(narrowest) = bridged.iter().chain(&at_risk).copied().reduce(f64::min) else {
+        return CellChoice {
+            wanted,
+            for_gaps: wanted,
+        };
+    };
+    let for_gaps =
+        wanted.min(narrowest.max(within(MAX_SURFACE_VERTICES_FOR_GAPS, EDGE_CELLS_FOR_GAPS)));
+    // Worth a finer surface only when it keeps a share of the gaps open: a
+    // gap these voxels bridge stays bridged by voxels no finer, and a few
+    // points (a nozzle's rim) are rarely kept by the target anyway.
+    let finer = for_gaps < first.cell / 1.05;
+    let kept = at_risk.iter().filter(|&&cell| cell >= for_gaps).count()
+        + if finer {
+            bridged.iter().filter(|&&cell| cell >= for_gaps).count()
+        } else {
+            0
+        };
+    let points = first.bridged_widths.len() + first.open_widths.len();
+    let for_gaps = if kept as f64 >= MIN_SHARE_FOR_GAPS * points as f64 {
+        for_gaps
+    } else {
+        wanted
+    };
     CellChoice { wanted, for_gaps }
 }
 

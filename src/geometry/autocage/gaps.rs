@@ -25,6 +25,8 @@ use rayon::prelude::*;
 pub(super) struct GapPoint {
     pub position: DVec3,
     pub width: f64,
+    /// Where the gap opens out, not between its walls ([`mouth_points`]).
+    pub opening: bool,
 }
 
 /// Gap points across gaps from `widths.0` to `widths.1` wide, from points
@@ -71,7 +73,11 @@ pub(super) fn gap_points(
                     if width < narrowest || !medial(position) || !outside(position) {
                         return Vec::new();
                     }
-                    let mut found = vec![GapPoint { position, width }];
+                    let mut found = vec![GapPoint {
+                        position,
+                        width,
+                        opening: false,
+                    }];
                     found.extend(mouth_points(tree, position, d, width, |at| {
                         medial(at) && outside(at)
                     }));
@@ -103,7 +109,11 @@ fn mouth_points<'a>(
             let walled = |d: DVec3| tree.first_hit(at, d, width).is_some();
             !walled(direction) && !walled(-direction) && keeps(at)
         })
-        .map(move |position| GapPoint { position, width })
+        .map(move |position| GapPoint {
+            position,
+            width,
+            opening: true,
+        })
 }
 
 /// Faces sampled to tell which way the normals point.

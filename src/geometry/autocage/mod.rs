@@ -297,7 +297,7 @@ struct VoxelSurface {
     winding_volume: f64,
     /// The gap points outside the voxels, which the cage keeps outside.
     gaps: Vec<DVec3>,
-    /// The widths of the gaps whose gap points the voxels cover, and leave outside.
+    /// The widths of the gaps whose points midway the voxels cover, and leave outside.
     bridged_widths: Vec<f64>,
     open_widths: Vec<f64>,
 }
@@ -339,7 +339,10 @@ impl Context<'_> {
             let grid = plan::grid_dims(mesh, size, self.clearance);
             size >= cell || plan::check_grid(mesh, grid, size, self.clearance, 0).is_ok()
         };
-        let second = |size: f64| self.voxel_surface(size, &|f| progress(0.05 + 0.05 * f));
+        // A second voxel surface takes the bar from 0.05 to 0.1; a third,
+        // after finer voxels that opened nothing, its last part.
+        let second = |size: f64| self.voxel_surface(size, &|f| progress(0.05 + 0.03 * f));
+        let third = |size: f64| self.voxel_surface(size, &|f| progress(0.08 + 0.02 * f));
         if choice.for_gaps < choice.wanted {
             // Where these miss the target, the size chosen without the gaps.
             let plain = (choice.for_gaps < choice.wanted / 1.05).then_some(choice.wanted);
@@ -356,7 +359,7 @@ impl Context<'_> {
                 if finer.gaps.len() > first_open {
                     return Ok((choice.for_gaps, finer, plain));
                 }
-                return Ok((choice.wanted, second(choice.wanted)?, None));
+                return Ok((choice.wanted, third(choice.wanted)?, None));
             }
         }
         if !differs(choice.wanted) {
@@ -402,8 +405,14 @@ impl Context<'_> {
             .iter()
             .partition(|g| voxels.is_outside(g.position));
         let gaps = outside.iter().map(|g| g.position).collect();
-        let bridged_widths = covered.iter().map(|g| g.width).collect();
-        let open_widths: Vec<f64> = outside.iter().map(|g| g.width).collect();
+        // The voxel size is chosen for the gaps between walls.
+        let widths = |points: &[&gaps::GapPoint]| {
+            (points.iter())
+                .filter(|g| !g.opening)
+                .map(|g| g.width)
+                .collect()
+        };
+        let (bridged_widths, open_widths) = (widths(&covered), widths(&outside));
         step(1.0)?;
         let faces = surface::boundary_face_count(&voxels);
         plan::check_surface(faces as u64, cell, mesh.diagonal())?;

@@ -72,7 +72,14 @@ pub(super) fn replace_if_better(
         },
         || prism_cages(mesh, mesh_points, goal, (best.cell, to_beat)),
     );
-    let gaps: Vec<DVec3> = gap_points.iter().map(|g| g.position).collect();
+    // Between walls only: where a gap opens out, a coarse cage from the
+    // voxels (a spiky ball's nine vertices) leaves points outside that no
+    // part of the mesh is kept apart by, and a start bridging those bridges
+    // no gap the simplification kept open; the report still counts them.
+    let gaps: Vec<DVec3> = (gap_points.iter())
+        .filter(|g| !g.opening)
+        .map(|g| g.position)
+        .collect();
     // Which gap points the cage kept so far leaves outside, once asked.
     let mut kept_open = None;
     for (kind, start) in boxed.into_iter().chain(prisms) {
