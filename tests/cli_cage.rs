@@ -81,7 +81,10 @@ fn the_voxel_size_is_chosen_or_used_as_asked_and_reported() {
     let auto = generate(&comb_mesh(), "8", &chosen);
     assert!(auto.status.success(), "{}", stderr(&auto));
     let text = stdout(&auto);
-    assert!(text.contains("chosen for the target"), "{text}");
+    assert!(
+        text.contains("chosen for the target and the gaps"),
+        "{text}"
+    );
     assert!(text.contains("may share one part of the cage"), "{text}");
     // A box around five fingers bridges the gaps between them, and says so.
     assert!(

@@ -353,7 +353,7 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
     lines.push(format!("minimum angle: {:.1}°", stats.min_angle_degrees));
     let percent = |length: f64| 100.0 * length / stats.mesh_diagonal.max(f64::MIN_POSITIVE);
     let how = match (stats.cell_size_chosen, stats.cell_size_asked) {
-        (true, _) => "chosen for the target".to_owned(),
+        (true, _) => "chosen for the target and the gaps".to_owned(),
         (false, None) => "as asked".to_owned(),
         (false, Some(asked)) => format!(
             "coarsened from the {} asked, finer than the grid's 512 cells along the longest side allow",

@@ -9,7 +9,8 @@ use crate::app::cage_generation::{
 };
 use crate::app::ctx::PanelContext;
 use crate::geometry::autocage::{
-    DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
+    DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, FINEST_CELL_SIZE_FOR_GAPS, MAX_TARGET_VERTICES,
+    MIN_TARGET_VERTICES,
 };
 
 /// The window, while it is open: it owns its settings and job
@@ -79,8 +80,9 @@ fn contents(
                         ui,
                         (&mut generation.use_cell_size, "Voxel size"),
                         &format!(
-                            "Off: chosen for the target, from {:.2}% of the diagonal up. Larger voxels reach fewer vertices; parts closer than about three voxels merge",
-                            100.0 * DEFAULT_CELL_SIZE
+                            "Off: chosen for the target and the gaps, from {:.2}% of the diagonal up, or down to {:.2}% to keep gaps open. Larger voxels reach fewer vertices; parts closer than about three voxels merge",
+                            100.0 * DEFAULT_CELL_SIZE,
+                            100.0 * FINEST_CELL_SIZE_FOR_GAPS
                         ),
                         &mut generation.cell_size_percent,
                         (0.2, 20.0),

@@ -19,7 +19,7 @@ const EDGE_CELLS_FOR_GAPS: f64 = 24.0;
 const MIN_SHARE_FOR_GAPS: f64 = 0.1;
 /// The finest voxels chosen to keep a gap open, as a fraction of the
 /// diagonal: gaps from four of them (1.6 %) wide.
-const FINEST_FOR_GAPS: f64 = 1.0 / 256.0;
+pub const FINEST_CELL_SIZE_FOR_GAPS: f64 = 1.0 / 256.0;
 
 /// What the first voxel surface, at voxel size `cell`, says.
 pub(super) struct FirstSurface<'a> {
@@ -58,7 +58,7 @@ pub(super) fn first_try_cell(first: &FirstSurface, bounds: &Bounds) -> CellChoic
     let wanted = within(MAX_SURFACE_VERTICES, EDGE_CELLS)
         .max(first.cell)
         .min(bounds.coarsest);
-    let finest = FINEST_FOR_GAPS * bounds.diagonal;
+    let finest = FINEST_CELL_SIZE_FOR_GAPS * bounds.diagonal;
     // A bridged gap needs the voxels that keep it; one kept open here is
     // kept by these voxels, but may be bridged by coarser ones.
     let keeping = |widths: &[f64]| -> Vec<f64> {

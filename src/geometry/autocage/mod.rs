@@ -52,6 +52,7 @@ mod voxels;
 mod winding;
 
 use super::{Cage, TriMesh};
+pub use cell_choice::FINEST_CELL_SIZE_FOR_GAPS;
 pub use error::AutoCageError;
 use error::{MAX_CELL_SIZE, MAX_CLEARANCE};
 pub use gaps::GapReport;
