@@ -23,9 +23,8 @@ impl State<'_> {
                     return;
                 }
                 let mut choices: Vec<(f64, usize)> = self
-                    .neighbours(v)
+                    .neighbours_keeping_surface(v)
                     .into_iter()
-                    .filter(|&u| self.moving_keeps_surface(v, u))
                     .map(|u| (self.narrowest_angle_moving(v, u), u))
                     .collect();
                 // Widest narrowest angle first: fans of thin faces hold back later collapses.
@@ -55,18 +54,24 @@ impl State<'_> {
     }
 
     /// Whether moving `v` onto its neighbour `u` leaves the surface the same
-    /// set of points, as long as no face flips: `v`'s faces lie in one plane,
-    /// or in two that meet along a line through `v` on which `u` and `v`'s
-    /// one other neighbour there lie on either side of it. The faces then
-    /// become a fan from `u` over the same polygon in each plane.
+    /// set of points, as long as no face flips ([`Self::neighbours_keeping_surface`]).
     pub(super) fn moving_keeps_surface(&self, v: usize, u: usize) -> bool {
+        self.neighbours_keeping_surface(v).contains(&u)
+    }
+
+    /// The neighbours `v` may move onto, leaving the surface the same set of
+    /// points as long as no face flips: any, when `v`'s faces lie in one
+    /// plane; when they lie in two that meet along a line through `v`, its
+    /// two neighbours on that line, on either side of it. The faces then
+    /// become a fan from the neighbour over the same polygon in each plane.
+    fn neighbours_keeping_surface(&self, v: usize) -> Vec<usize> {
         let at = self.positions[v];
         let mut planes: Vec<DVec3> = Vec::with_capacity(2);
         for &t in &self.vertex_triangles[v] {
             let [p, q, r] = self.corners(t as usize);
             let normal = (q - p).cross(r - p).normalize_or_zero();
             if normal == DVec3::ZERO {
-                return false;
+                return Vec::new();
             }
             let in_plane = |n: DVec3| {
                 n.dot(normal) > 0.0
@@ -76,33 +81,29 @@ impl State<'_> {
             };
             if !planes.iter().any(|&n| in_plane(n)) {
                 if planes.len() == 2 || !in_plane(normal) {
-                    return false;
+                    return Vec::new();
                 }
                 planes.push(normal);
             }
         }
+        let neighbours = self.neighbours(v);
         let [first, second] = match planes[..] {
-            [_] => return true,
+            [_] => return neighbours,
             [first, second] => [first, second],
-            _ => return false,
+            _ => return Vec::new(),
         };
         if first.dot(second).abs() >= 1.0 - 1e-9 {
-            return false;
+            return Vec::new();
         }
         let on_line = |x: DVec3| {
             first.dot(x - at).abs() <= self.tolerance && second.dot(x - at).abs() <= self.tolerance
         };
-        let line: Vec<usize> = self
-            .neighbours(v)
-            .into_iter()
+        let line: Vec<usize> = (neighbours.into_iter())
             .filter(|&x| on_line(self.positions[x]))
             .collect();
         match line[..] {
-            [x, y] if x == u || y == u => {
-                let other = if x == u { y } else { x };
-                (self.positions[u] - at).dot(self.positions[other] - at) < 0.0
-            }
-            _ => false,
+            [x, y] if (self.positions[x] - at).dot(self.positions[y] - at) < 0.0 => line,
+            _ => Vec::new(),
         }
     }
 }
