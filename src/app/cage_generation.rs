@@ -6,7 +6,7 @@
 //! mesh changes meanwhile (undo, another file), the proposal is dropped.
 
 use crate::geometry::autocage::{
-    generate_cage, AutoCageError, CageOptions, CageStart, CageStats, GeneratedCage,
+    generate_cage, AutoCageError, CageOptions, CageStart, CageStats, GeneratedCage, StartReason,
     DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use crate::geometry::{Cage, TriMesh};
@@ -307,8 +307,14 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
         if stats.shells == 1 { "" } else { "s" }
     )];
     if stats.start != CageStart::Voxels {
+        let why = match stats.start_reason {
+            Some(StartReason::MoreGapsOpen) => {
+                "it keeps open gaps that the cage from the voxels bridged"
+            }
+            _ => "it encloses less than the cage from the voxels",
+        };
         lines.push(format!(
-            "started from: the {}, tightened and polished; it encloses less than the cage from the voxels",
+            "started from: the {}, tightened and polished; {why}",
             stats.start.name()
         ));
     }

@@ -275,6 +275,10 @@ pub(super) fn generate_cage<'py>(
     report.set_item("cell_size_chosen", stats.cell_size_chosen)?;
     report.set_item("cell_size_asked", stats.cell_size_asked)?;
     report.set_item("start", stats.start.name())?;
+    report.set_item(
+        "start_reason",
+        stats.start_reason.map(autocage::StartReason::name),
+    )?;
     report.set_item("merge_distance", stats.merge_distance())?;
     report.set_item("reach", stats.reach)?;
     report.set_item("gap_points", stats.gaps.points)?;

@@ -137,13 +137,13 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     _, faces = pmvc.load_mesh(pmvc_assets() / "comb_mesh.obj")
     calls = []
     cage, report = pmvc.generate_cage(
-        comb_points, faces, target=60, progress=lambda done, total: calls.append(done)
+        comb_points, faces, target=80, progress=lambda done, total: calls.append(done)
     )
     assert isinstance(cage, pmvc.Cage)
     assert report["vertices"] == len(cage.vertices) and report["outside_vertices"] == 0
-    assert report["target_vertices"] == 60
-    # Second starts (a box, prisms) run only up to 32 vertices.
-    assert report["start"] == "voxels"
+    assert report["target_vertices"] == 80
+    # Second starts (a box, prisms) run only up to 64 vertices.
+    assert report["start"] == "voxels" and report["start_reason"] is None
     # From the voxels, a distance below which parts may merge (infinite only
     # for a box or prism, which begins around every part).
     assert 0 < report["merge_distance"] < float("inf")
@@ -154,6 +154,18 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
         assert report[key] is None or report[key] > 0
     assert (pmvc.classify(comb_points, cage) == pmvc.INSIDE).all()
     assert calls[0] == 0 and calls[-1] == 1000 and calls == sorted(calls)
+
+
+def test_generate_cage_says_why_a_prism_replaced_the_voxels_cage(comb_points):
+    _, faces = pmvc.load_mesh(pmvc_assets() / "comb_mesh.obj")
+    # At the hand-made cage's 40 vertices, a prism over the comb's outline
+    # keeps the slots between its fingers.
+    cage, report = pmvc.generate_cage(comb_points, faces, target=40)
+    assert report["start"] == "prism along z"
+    assert report["start_reason"] in ("smaller", "more gaps open", "smaller and more gaps open")
+    assert report["gap_points_open"] == report["gap_points"] > 0
+    assert report["merge_distance"] == float("inf")
+    assert len(cage.vertices) == 40
 
 
 def test_generate_cage_reports_where_it_bridges_gaps(comb_points):

@@ -58,7 +58,7 @@ use error::{MAX_CELL_SIZE, MAX_CLEARANCE};
 pub use gaps::GapReport;
 use glam::DVec3;
 pub use plan::{plan_cage, CagePlan, MAX_GRID_CELLS, MAX_SURFACE_SAMPLES};
-pub use starts::CageStart;
+pub use starts::{CageStart, StartReason};
 pub use stats::{CageStats, GeneratedCage};
 use std::time::Instant;
 use winding::TriangleTree;
@@ -311,6 +311,8 @@ struct Attempt {
     surface_vertices: usize,
     winding_volume: f64,
     start: CageStart,
+    /// Why a start replaced the voxels' cage.
+    start_reason: Option<StartReason>,
 }
 
 impl Context<'_> {
@@ -461,6 +463,7 @@ fn simplify_surface(
         surface_vertices,
         winding_volume,
         start: CageStart::Voxels,
+        start_reason: None,
     })
 }
 
@@ -479,6 +482,7 @@ fn finish(
         grid,
         surface_vertices,
         start,
+        start_reason,
         ..
     } = attempt;
     let reach = f64::from(simplified.envelope_limit) * cell;
@@ -540,6 +544,7 @@ fn finish(
         surface_vertices,
         gaps,
         start,
+        start_reason,
         seconds: started.elapsed().as_secs_f64(),
     };
     // Validated where it was built; a translation changes neither its

@@ -1,6 +1,6 @@
 //! What a generated cage reports about itself.
 
-use super::{Cage, CageStart, GapReport};
+use super::{Cage, CageStart, GapReport, StartReason};
 
 /// A generated cage and what was measured on it.
 #[derive(Clone, Debug)]
@@ -51,6 +51,8 @@ pub struct CageStats {
     pub gaps: GapReport,
     /// Where the cage's shape came from (a second start replaces the voxels').
     pub start: CageStart,
+    /// Why the start replaced the voxels' cage; `None` for the voxels'.
+    pub start_reason: Option<StartReason>,
     pub seconds: f64,
 }
 

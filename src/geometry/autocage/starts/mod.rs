@@ -1,6 +1,9 @@
 //! Second starts for small targets, each tightened and polished like any
-//! other cage, and kept only when smaller and valid, so they never make a
-//! cage larger. The simplification's own coarse cages can end twisted, with
+//! other cage, and kept only when valid and either smaller or keeping open
+//! gaps that the simplification's cage bridged (a comb's or a hand's seen
+//! along the palm's normal): a start never bridges a gap that cage kept
+//! open, and is larger only to keep more open. The simplification's own
+//! coarse cages can end twisted, with
 //! corners well out, where moving one vertex at a time cannot straighten
 //! them; an artist starts such a cage from a box, or from a profile drawn
 //! once and extruded along the model (a bench, a rail, a limb).
@@ -11,17 +14,19 @@
 //!   the mesh's extent.
 
 use crate::geometry::autocage::gaps::GapPoint;
-use crate::geometry::autocage::measure::enclosure;
 use crate::geometry::autocage::points::PointTree;
 use crate::geometry::autocage::simplify::{self, Goal, Simplified};
 use crate::geometry::autocage::voxels::Envelope;
 use crate::geometry::autocage::Attempt;
 use crate::geometry::cage::signed_volume;
 use crate::geometry::procedural::cube_cage;
-use crate::geometry::{classify_points, Cage, PointClass, TriMesh};
+use crate::geometry::TriMesh;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+mod choice;
+pub use choice::StartReason;
+use choice::{is_better_and_valid, Standing};
 mod outline;
 #[cfg(test)]
 mod polygon_checks;
@@ -53,8 +58,9 @@ impl CageStart {
     }
 }
 
-/// Replace the attempt's cage with the smallest of the starts that fit the
-/// target, when that is smaller and valid ([`is_smaller_and_valid`]).
+/// Replace the attempt's cage with the best of the starts that fit the
+/// target: the one that keeps the most gaps open, then the smallest, when
+/// it is better and valid ([`is_better_and_valid`]).
 pub(super) fn replace_if_better(
     best: &mut Attempt,
     (mesh, mesh_points, gap_points): (&TriMesh, &PointTree, &[GapPoint]),
@@ -62,16 +68,6 @@ pub(super) fn replace_if_better(
 ) {
     let target = goal.target_vertices;
     let to_beat = signed_volume(&best.simplified.positions, &best.simplified.triangles);
-    // Each start is tightened on its own, so they share the cores.
-    let (boxed, prisms) = rayon::join(
-        || {
-            box_fits(target)
-                .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
-                .flatten()
-                .map(|cage| (CageStart::BoundingBox, cage))
-        },
-        || prism_cages(mesh, mesh_points, goal, (best.cell, to_beat)),
-    );
     // Between walls only: where a gap opens out, a coarse cage from the
     // voxels (a spiky ball's nine vertices) leaves points outside that no
     // part of the mesh is kept apart by, and a start bridging those bridges
@@ -80,15 +76,33 @@ pub(super) fn replace_if_better(
         .filter(|g| !g.opening)
         .map(|g| g.position)
         .collect();
-    // Which gap points the cage kept so far leaves outside, once asked.
-    let mut kept_open = None;
-    for (kind, start) in boxed.into_iter().chain(prisms) {
-        if let Some(open) = is_smaller_and_valid(&start, best, mesh, (&gaps, &mut kept_open)) {
+    // Each start is tightened on its own, so they share the cores.
+    let (boxed, prisms) = rayon::join(
+        || {
+            box_fits(target)
+                .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
+                .flatten()
+                .map(|cage| (CageStart::BoundingBox, cage))
+        },
+        || prism_cages(mesh, (mesh_points, &gaps), goal, (best.cell, to_beat)),
+    );
+    let starts: Vec<(CageStart, Simplified)> = boxed.into_iter().chain(prisms).collect();
+    if starts.is_empty() {
+        return;
+    }
+    let voxels = Standing::of(&best.simplified, &gaps);
+    let mut standing = voxels.clone();
+    for (kind, start) in starts {
+        if let Some(better) = is_better_and_valid(&start, &standing, mesh, &gaps) {
             best.simplified = start;
             best.start = kind;
-            kept_open = Some(open);
+            standing = better;
         }
     }
+    // Said against the voxels' cage, whichever start the winner beat last.
+    best.start_reason = (best.start != CageStart::Voxels)
+        .then(|| StartReason::between(&voxels, &standing))
+        .flatten();
 }
 
 /// Targets a box's eight vertices are within 15 % of.
@@ -96,8 +110,10 @@ fn box_fits(target: usize) -> bool {
     8.0 >= 0.85 * target as f64
 }
 
-/// Prisms are tried up to this target: each costs a polish of its own.
-const MAX_PRISM_TARGET: usize = 32;
+/// Prisms are tried up to this target: each costs a polish of its own. A
+/// hand of four fingers needs 32 corners (16 on each cap) to keep its gaps,
+/// the bundled comb 40.
+const MAX_PRISM_TARGET: usize = 64;
 
 /// A prism starting over this many times the cage it would replace is
 /// left untried.
@@ -142,7 +158,7 @@ fn box_around(centre: DVec3, half: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
 /// tightened: tightening took back at most 17 % of a prism (ManHead).
 fn prism_cages(
     mesh: &TriMesh,
-    mesh_points: &PointTree,
+    (mesh_points, gaps): (&PointTree, &[DVec3]),
     goal: &Goal,
     (cell, to_beat): (f64, f64),
 ) -> Vec<(CageStart, Simplified)> {
@@ -153,7 +169,7 @@ fn prism_cages(
     (0..3)
         .into_par_iter()
         .filter_map(|axis| {
-            let prism = prism(mesh, axis, target / 2, SPARE * goal.clearance)?;
+            let prism = prism(mesh, axis, (target / 2, SPARE * goal.clearance), gaps)?;
             // A view with fewer corners (a box seen along an edge) would
             // fall short of the target.
             let reached = prism.0.len() as f64;
@@ -163,54 +179,6 @@ fn prism_cages(
             Some((CageStart::Prism { axis }, tightened))
         })
         .collect()
-}
-
-/// Whether `start` encloses less than the attempt's cage, is a valid cage
-/// around every mesh vertex, and keeps outside every gap point that the
-/// attempt's cage keeps outside: a start begins across every gap, and may
-/// close only those the simplification could not keep open at this target.
-/// (Checked here as well as when the chosen cage is finished, so that a
-/// start that fails costs nothing.) `kept_open` holds, once asked, which
-/// gap points the attempt's cage leaves outside. Returns which `start`
-/// leaves outside when it passes.
-fn is_smaller_and_valid(
-    start: &Simplified,
-    attempt: &Attempt,
-    mesh: &TriMesh,
-    (gap_points, kept_open): (&[DVec3], &mut Option<Vec<bool>>),
-) -> Option<Vec<bool>> {
-    let volume = |cage: &Simplified| signed_volume(&cage.positions, &cage.triangles);
-    if volume(start) >= volume(&attempt.simplified) {
-        return None;
-    }
-    let cage = as_cage(start)?;
-    if enclosure(&cage, mesh).first_outside.is_some() {
-        return None;
-    }
-    let open = |cage: &Cage| -> Vec<bool> {
-        let classes = classify_points(cage, gap_points).classes;
-        classes
-            .into_iter()
-            .map(|c| matches!(c, PointClass::Outside))
-            .collect()
-    };
-    let was_open = kept_open.get_or_insert_with(|| match as_cage(&attempt.simplified) {
-        Some(before) => open(&before),
-        None => vec![false; gap_points.len()],
-    });
-    let stays_open = open(&cage);
-    (was_open.iter().zip(&stays_open))
-        .all(|(&was, &stays)| stays || !was)
-        .then_some(stays_open)
-}
-
-fn as_cage(cage: &Simplified) -> Option<Cage> {
-    let mesh = TriMesh {
-        triangle_faces: (0..cage.triangles.len() as u32).collect(),
-        positions: cage.positions.clone(),
-        triangles: cage.triangles.clone(),
-    };
-    Cage::new(mesh).ok().map(|(cage, _)| cage)
 }
 
 /// A closed start at the target already, tightened and polished.
@@ -249,14 +217,15 @@ fn plane_axes(axis: usize) -> (usize, usize) {
 
 /// The prism along `axis` over a polygon of at most `corners` corners
 /// around the mesh's view along it, everything `margin` or more from the
-/// mesh: the smaller of its convex hull's cut and its traced outline's,
-/// which follows a concave view (a bench's side). Vertices 0..n are the
-/// lower cap's, n..2n the upper's.
+/// mesh: of its convex hull's cut and its traced outline's, which follows a
+/// concave view (a bench's side, the slots between fingers), the one that
+/// leaves more of `gaps` outside seen along the axis, then the smaller.
+/// Vertices 0..n are the lower cap's, n..2n the upper's.
 fn prism(
     mesh: &TriMesh,
     axis: usize,
-    corners: usize,
-    margin: f64,
+    (corners, margin): (usize, f64),
+    gaps: &[DVec3],
 ) -> Option<(Vec<DVec3>, Vec<[u32; 3]>)> {
     let (u, w) = plane_axes(axis);
     let seen = |p: &DVec3| DVec2::new(p[u], p[w]);
@@ -264,19 +233,26 @@ fn prism(
         &convex_hull(mesh.positions.iter().map(seen).collect()),
         margin,
     )?;
+    let keep_out: Vec<DVec2> = gaps.iter().map(seen).collect();
     // A convex outline has no reflex corner, so only the edge cuts apply.
-    let convex = profile::fewer_corners_holding(hull, corners);
+    let convex = profile::fewer_corners_holding(hull, corners, &keep_out);
     let view = mesh
         .triangles
         .iter()
         .map(|t| t.map(|i| seen(&mesh.positions[i as usize])));
+    // The traced outline when it keeps more gaps open, or as many in less area.
+    let rank = |(polygon, kept_out): &(Vec<DVec2>, usize)| (*kept_out, -area(polygon));
     let concave = outline::traced_outline(view, margin)
-        .and_then(|traced| profile::fewer_corners_holding(traced, corners))
+        .and_then(|traced| profile::fewer_corners_holding(traced, corners, &keep_out))
         .filter(|concave| {
-            convex
-                .as_ref()
-                .is_none_or(|convex| area(concave) < area(convex))
-        });
+            convex.as_ref().is_none_or(|convex| {
+                rank(concave)
+                    .partial_cmp(&rank(convex))
+                    .is_some_and(|o| o.is_gt())
+            })
+        })
+        .map(|(polygon, _)| polygon);
+    let convex = convex.map(|(polygon, _)| polygon);
     let (outline, cap) = match concave {
         Some(concave) => {
             let cap = profile::cap_triangles(&concave)?;
@@ -408,7 +384,9 @@ fn strip(n: usize) -> Vec<[u32; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::autocage::measure::enclosure;
     use crate::geometry::procedural::{icosphere, SplitMix64};
+    use crate::geometry::Cage;
 
     /// Signed distance of `p` inside each edge of a counter-clockwise polygon.
     fn inside_by(polygon: &[DVec2], p: DVec2) -> f64 {
@@ -455,7 +433,9 @@ mod tests {
         let points = circle(90, radius);
         let outline = grown(&convex_hull(points.clone()), margin).unwrap();
         for corners in [4, 6, 12] {
-            let polygon = profile::fewer_corners_holding(outline.clone(), corners).unwrap();
+            let polygon = profile::fewer_corners_holding(outline.clone(), corners, &[])
+                .unwrap()
+                .0;
             assert_eq!(polygon.len(), corners);
             let least = points
                 .iter()
@@ -487,7 +467,7 @@ mod tests {
             triangle_faces: (0..sphere.triangles().len() as u32).collect(),
         };
         for axis in 0..3 {
-            let (positions, triangles) = prism(&mesh, axis, 7, 0.05).unwrap();
+            let (positions, triangles) = prism(&mesh, axis, (7, 0.05), &[]).unwrap();
             assert_eq!(positions.len(), 14);
             let (cage, report) = Cage::new(TriMesh {
                 triangle_faces: (0..triangles.len() as u32).collect(),
@@ -500,52 +480,5 @@ mod tests {
             assert!(enclosed.first_outside.is_none(), "axis {axis}");
             assert!(enclosed.min_clearance >= 0.05 * (1.0 - 1e-9), "axis {axis}");
         }
-    }
-
-    fn simplified((positions, triangles): (Vec<DVec3>, Vec<[u32; 3]>)) -> Simplified {
-        Simplified {
-            positions,
-            triangles,
-            envelope_limit: 0,
-        }
-    }
-
-    /// Two cubes apart, each in a loose box of its own, and one box around
-    /// both that encloses less: the one box is kept only when no gap point
-    /// between the cubes says the loose boxes kept that gap open.
-    #[test]
-    fn a_smaller_start_is_refused_when_it_bridges_a_gap_kept_open() {
-        let (left, right) = (DVec3::new(-2.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 0.0));
-        let cube = |centre| box_around(centre, DVec3::splat(0.5));
-        let join = |(mut p, mut t): (Vec<DVec3>, Vec<[u32; 3]>),
-                    (q, u): (Vec<DVec3>, Vec<[u32; 3]>)| {
-            let offset = p.len() as u32;
-            p.extend(q);
-            t.extend(u.into_iter().map(|tri| tri.map(|i| i + offset)));
-            (p, t)
-        };
-        let (positions, triangles) = join(cube(left), cube(right));
-        let mesh = TriMesh {
-            triangle_faces: (0..triangles.len() as u32).collect(),
-            positions,
-            triangles,
-        };
-        let loose = |centre| box_around(centre, DVec3::splat(1.4));
-        let attempt = Attempt {
-            simplified: simplified(join(loose(left), loose(right))),
-            cell: 0.1,
-            grid: [1, 1, 1],
-            surface_vertices: 0,
-            winding_volume: 0.0,
-            start: CageStart::Voxels,
-        };
-        let one_box = simplified(box_around(DVec3::ZERO, DVec3::new(2.6, 0.6, 0.6)));
-        assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, (&[], &mut None)).is_some());
-        let between = [DVec3::ZERO];
-        assert!(is_smaller_and_valid(&one_box, &attempt, &mesh, (&between, &mut None)).is_none());
-        // A gap point the loose boxes cover too does not hold the start back.
-        let inside_both = [DVec3::new(2.0, 0.55, 0.0)];
-        let accepted = is_smaller_and_valid(&one_box, &attempt, &mesh, (&inside_both, &mut None));
-        assert!(accepted.is_some());
     }
 }

@@ -20,11 +20,24 @@ enum Step {
 }
 
 /// `polygon` (simple, counter-clockwise) with at most `corners` corners,
-/// holding it; None when no step that keeps it simple is left first.
-pub(super) fn fewer_corners_holding(mut polygon: Vec<DVec2>, corners: usize) -> Option<Vec<DVec2>> {
+/// holding it, and how many of `keep_out` it leaves outside; None when no
+/// step that keeps it simple is left first. A step that would cover one of
+/// `keep_out` (gap points seen along the prism's axis, between fingers or
+/// the legs of a bench) is taken only when no other step is left, so the
+/// slots between parts are filled last.
+pub(super) fn fewer_corners_holding(
+    mut polygon: Vec<DVec2>,
+    corners: usize,
+    keep_out: &[DVec2],
+) -> Option<(Vec<DVec2>, usize)> {
     if corners < 3 {
         return None;
     }
+    // Only the points still outside can be covered: a step adds area outside.
+    let mut outside: Vec<DVec2> = (keep_out.iter())
+        .copied()
+        .filter(|&p| winding_number(&polygon, p) == 0)
+        .collect();
     while polygon.len() > corners {
         let n = polygon.len();
         if n <= 3 {
@@ -37,10 +50,20 @@ pub(super) fn fewer_corners_holding(mut polygon: Vec<DVec2>, corners: usize) -> 
         // Least added area first; a step that would make the polygon touch
         // itself is passed over.
         steps.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let step = steps
-            .into_iter()
-            .map(|(_, step)| step)
-            .find(|step| keeps_simple(&polygon, *step))?;
+        let simple = || {
+            (steps.iter())
+                .map(|&(_, step)| step)
+                .filter(|&step| keeps_simple(&polygon, step))
+        };
+        let covers_none = |step: Step| {
+            let triangle = added(&polygon, step);
+            !outside.iter().any(|&p| in_closed_triangle(p, triangle))
+        };
+        let step = simple()
+            .find(|&step| covers_none(step))
+            .or_else(|| simple().next())?;
+        let triangle = added(&polygon, step);
+        outside.retain(|&p| !in_closed_triangle(p, triangle));
         match step {
             Step::Fill(i) => {
                 polygon.remove(i);
@@ -51,7 +74,32 @@ pub(super) fn fewer_corners_holding(mut polygon: Vec<DVec2>, corners: usize) -> 
             }
         }
     }
-    Some(polygon)
+    Some((polygon, outside.len()))
+}
+
+/// How many times the polygon winds around `p`; 0 outside.
+fn winding_number(polygon: &[DVec2], p: DVec2) -> i32 {
+    let n = polygon.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+            let side = orientation(a, b, p);
+            match (a.y <= p.y, b.y <= p.y) {
+                (true, false) if side > 0.0 => 1,
+                (false, true) if side < 0.0 => -1,
+                _ => 0,
+            }
+        })
+        .sum()
+}
+
+/// The triangle that `step` adds to the polygon.
+fn added(polygon: &[DVec2], step: Step) -> [DVec2; 3] {
+    let n = polygon.len();
+    match step {
+        Step::Fill(i) => [polygon[(i + n - 1) % n], polygon[i], polygon[(i + 1) % n]],
+        Step::Cut(i, corner) => [polygon[i], corner, polygon[(i + 1) % n]],
+    }
 }
 
 /// Corners `i - 1`, `i`, `i + 1` and `i + 2`, wrapping.
@@ -85,17 +133,16 @@ fn keeps_simple(polygon: &[DVec2], step: Step) -> bool {
     // The triangle added, the new edges, the corners whose edges change,
     // and the corners the triangle may hold (its own, or on the lines
     // extended).
-    let (triangle, new_edges, changed, spared) = match step {
+    let triangle = added(polygon, step);
+    let (new_edges, changed, spared) = match step {
         Step::Fill(i) => {
             let [p, q, r] = [i + n - 1, i, i + 1].map(|k| k % n);
-            let triangle = [at(p), at(q), at(r)];
-            (triangle, vec![(at(p), at(r))], vec![p, q, r], vec![p, q, r])
+            (vec![(at(p), at(r))], vec![p, q, r], vec![p, q, r])
         }
         Step::Cut(i, corner) => {
             let [p, a, b, q] = [i + n - 1, i, i + 1, i + 2].map(|k| k % n);
-            let triangle = [at(a), corner, at(b)];
             let new_edges = vec![(at(a), corner), (corner, at(b))];
-            (triangle, new_edges, vec![a, b], vec![p, a, b, q])
+            (new_edges, vec![a, b], vec![p, a, b, q])
         }
     };
     let corner_inside = (0..n)
@@ -265,7 +312,8 @@ mod tests {
         for (s, shape) in shapes.iter().enumerate() {
             assert!(is_simple(shape) && area(shape) > 0.0, "shape {s}");
             for corners in [3, 4, 6, 9, 12] {
-                let cut = fewer_corners_holding(shape.clone(), corners)
+                let cut = fewer_corners_holding(shape.clone(), corners, &[])
+                    .map(|(cut, _)| cut)
                     .unwrap_or_else(|| panic!("shape {s} at {corners}"));
                 assert!(cut.len() <= corners, "shape {s}: {} corners", cut.len());
                 assert!(is_simple(&cut), "shape {s} at {corners} crosses itself");
@@ -308,13 +356,63 @@ mod tests {
             corners.push(p + (before - p).normalize() * chamfer);
             corners.push(p + (after - p).normalize() * chamfer);
         }
-        let cut = fewer_corners_holding(corners, 6).unwrap();
+        let cut = fewer_corners_holding(corners, 6, &[]).unwrap().0;
         assert_eq!(cut.len(), 6);
         assert!(area(&cut) <= 5.0 + 1e-9, "area {}", area(&cut));
         assert!(is_simple(&cut));
         for p in polygon(&l) {
             assert!(holds(&cut, p));
         }
+    }
+
+    /// Four fingers 2 wide and 6 long, 0.05 apart, on a palm, each with a
+    /// round tip of `tip` corners; and points midway across each slot.
+    fn fingers(tip: usize) -> (Vec<DVec2>, Vec<DVec2>) {
+        let (width, gap, length) = (2.0, 0.05, 6.0);
+        let pitch = width + gap;
+        let mut corners = vec![DVec2::new(0.0, -1.0), DVec2::new(3.0 * pitch + width, -1.0)];
+        for k in (0..4).rev() {
+            let centre = DVec2::new(f64::from(k) * pitch + 0.5 * width, length);
+            corners.extend((0..=tip).map(|j| {
+                let angle = std::f64::consts::PI * j as f64 / tip as f64;
+                centre + 0.5 * width * DVec2::new(angle.cos(), angle.sin())
+            }));
+            if k > 0 {
+                let left = f64::from(k) * pitch;
+                corners.extend([DVec2::new(left, 0.0), DVec2::new(left - gap, 0.0)]);
+            }
+        }
+        let midway = (1..4)
+            .flat_map(|k| {
+                (1..6)
+                    .map(move |j| DVec2::new(f64::from(k) * pitch - 0.5 * gap, 0.5 * f64::from(j)))
+            })
+            .collect();
+        (corners, midway)
+    }
+
+    /// Cut down to the fewest corners that keep the slots (two at each
+    /// fingertip, two at each slot's end, two for the palm), the points in
+    /// the slots stay outside; without them the least-area steps fill a slot
+    /// instead of squaring a fingertip. With too few corners for every slot,
+    /// the count says how many stay outside.
+    #[test]
+    fn points_to_keep_out_keep_the_slots_between_fingers() {
+        let (shape, midway) = fingers(8);
+        assert!(is_simple(&shape) && area(&shape) > 0.0);
+        assert!(midway.iter().all(|&p| !contains(&shape, p)));
+        let outside = |cut: &[DVec2]| midway.iter().filter(|&&p| !contains(cut, p)).count();
+        let (kept, count) = fewer_corners_holding(shape.clone(), 16, &midway).unwrap();
+        assert_eq!(kept.len(), 16);
+        assert!(is_simple(&kept));
+        assert!(shape.iter().all(|&p| holds(&kept, p)));
+        assert_eq!((count, outside(&kept)), (midway.len(), midway.len()));
+        let (blind, _) = fewer_corners_holding(shape.clone(), 16, &[]).unwrap();
+        assert!(outside(&blind) < midway.len(), "{}", outside(&blind));
+        let (fewer, count) = fewer_corners_holding(shape.clone(), 12, &midway).unwrap();
+        assert!(shape.iter().all(|&p| holds(&fewer, p)));
+        assert_eq!(count, outside(&fewer));
+        assert!(count < midway.len());
     }
 
     /// Each cap triangle turns counter-clockwise and lies inside, and their
