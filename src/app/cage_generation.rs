@@ -309,9 +309,12 @@ pub fn stats_lines(stats: &CageStats, show_time: bool) -> Vec<String> {
     if stats.start != CageStart::Voxels {
         let why = match stats.start_reason {
             Some(StartReason::MoreGapsOpen) => {
-                "it keeps open gaps that the cage from the voxels bridged"
+                "it keeps open gaps that the cage from the voxels bridged, though it encloses more"
             }
-            _ => "it encloses less than the cage from the voxels",
+            Some(StartReason::SmallerAndMoreGapsOpen) => {
+                "it encloses less than the cage from the voxels, and keeps open gaps that it bridged"
+            }
+            Some(StartReason::Smaller) | None => "it encloses less than the cage from the voxels",
         };
         lines.push(format!(
             "started from: the {}, tightened and polished; {why}",

@@ -104,13 +104,36 @@ pub(super) fn is_better_and_valid(
         .then_some(after)
 }
 
-pub(super) fn as_cage(cage: &Simplified) -> Option<Cage> {
+fn as_cage(cage: &Simplified) -> Option<Cage> {
+    cage_of(&cage.positions, &cage.triangles)
+}
+
+fn cage_of(positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<Cage> {
     let mesh = TriMesh {
-        triangle_faces: (0..cage.triangles.len() as u32).collect(),
-        positions: cage.positions.clone(),
-        triangles: cage.triangles.clone(),
+        triangle_faces: (0..triangles.len() as u32).collect(),
+        positions: positions.to_vec(),
+        triangles: triangles.to_vec(),
     };
     Cage::new(mesh).ok().map(|(cage, _)| cage)
+}
+
+/// Whether a start, before it is tightened, leaves outside every gap point
+/// that `voxels` leaves outside. Tightening moves its faces inward, so a
+/// start that bridges such a point now would almost always be refused
+/// after it: such starts are not tightened (a comb's prisms seen from the
+/// side, which fill every slot).
+pub(super) fn may_keep_gaps(
+    (positions, triangles): (&[DVec3], &[[u32; 3]]),
+    voxels: &Standing,
+    gap_points: &[DVec3],
+) -> bool {
+    if !voxels.open.contains(&true) {
+        return true;
+    }
+    cage_of(positions, triangles).is_some_and(|cage| {
+        let open = Standing::open(&cage, gap_points);
+        (voxels.open.iter().zip(&open)).all(|(&was, &is)| is || !was)
+    })
 }
 
 #[cfg(test)]
@@ -174,6 +197,15 @@ mod tests {
             better(&one_box, &attempt, &inside_both),
             Some(StartReason::Smaller)
         );
+        // Before it is tightened, a start that bridges a gap point the cage
+        // keeps open is not worth tightening; one that bridges only what
+        // the cage bridges too is.
+        let may_keep = |start: &Simplified, attempt: &Attempt, gaps: &[DVec3]| {
+            let standing = Standing::of(&attempt.simplified, gaps);
+            may_keep_gaps((&start.positions, &start.triangles), &standing, gaps)
+        };
+        assert!(!may_keep(&one_box, &attempt, &between));
+        assert!(may_keep(&one_box, &attempt, &inside_both));
         let bridged = Attempt {
             simplified: one_box,
             ..attempt

@@ -26,7 +26,7 @@ use rayon::prelude::*;
 
 mod choice;
 pub use choice::StartReason;
-use choice::{is_better_and_valid, Standing};
+use choice::{is_better_and_valid, may_keep_gaps, Standing};
 mod outline;
 #[cfg(test)]
 mod polygon_checks;
@@ -67,6 +67,9 @@ pub(super) fn replace_if_better(
     goal: &Goal,
 ) {
     let target = goal.target_vertices;
+    if !box_fits(target) && !prisms_fit(target) {
+        return;
+    }
     let to_beat = signed_volume(&best.simplified.positions, &best.simplified.triangles);
     // Between walls only: where a gap opens out, a coarse cage from the
     // voxels (a spiky ball's nine vertices) leaves points outside that no
@@ -76,23 +79,24 @@ pub(super) fn replace_if_better(
         .filter(|g| !g.opening)
         .map(|g| g.position)
         .collect();
+    let voxels = Standing::of(&best.simplified, &gaps);
+    let worth_tightening: &WorthTightening =
+        &|start: (&[DVec3], &[[u32; 3]])| may_keep_gaps(start, &voxels, &gaps);
     // Each start is tightened on its own, so they share the cores.
     let (boxed, prisms) = rayon::join(
         || {
             box_fits(target)
-                .then(|| boxed_cage(mesh, mesh_points, goal, best.cell))
+                .then(|| boxed_cage(mesh, mesh_points, goal, (best.cell, worth_tightening)))
                 .flatten()
                 .map(|cage| (CageStart::BoundingBox, cage))
         },
-        || prism_cages(mesh, (mesh_points, &gaps), goal, (best.cell, to_beat)),
+        || {
+            let beat = (best.cell, to_beat, worth_tightening);
+            prism_cages(mesh, (mesh_points, &gaps), goal, beat)
+        },
     );
-    let starts: Vec<(CageStart, Simplified)> = boxed.into_iter().chain(prisms).collect();
-    if starts.is_empty() {
-        return;
-    }
-    let voxels = Standing::of(&best.simplified, &gaps);
     let mut standing = voxels.clone();
-    for (kind, start) in starts {
+    for (kind, start) in boxed.into_iter().chain(prisms) {
         if let Some(better) = is_better_and_valid(&start, &standing, mesh, &gaps) {
             best.simplified = start;
             best.start = kind;
@@ -115,6 +119,11 @@ fn box_fits(target: usize) -> bool {
 /// the bundled comb 40.
 const MAX_PRISM_TARGET: usize = 64;
 
+/// Targets prisms are tried for.
+fn prisms_fit(target: usize) -> bool {
+    (8..=MAX_PRISM_TARGET).contains(&target)
+}
+
 /// A prism starting over this many times the cage it would replace is
 /// left untried.
 const HOPELESS: f64 = 1.25;
@@ -130,15 +139,21 @@ fn boxed_cage(
     mesh: &TriMesh,
     mesh_points: &PointTree,
     goal: &Goal,
-    cell: f64,
+    (cell, worth_tightening): (f64, &WorthTightening),
 ) -> Option<Simplified> {
     if mesh.positions.is_empty() {
         return None;
     }
     let (lo, hi) = mesh.bounds();
     let (centre, half) = (0.5 * (lo + hi), 0.5 * (hi - lo) + SPARE * goal.clearance);
-    tighten(mesh, mesh_points, goal, cell, box_around(centre, half))
+    let (positions, triangles) = box_around(centre, half);
+    worth_tightening((&positions, &triangles)).then_some(())?;
+    tighten(mesh, mesh_points, goal, cell, (positions, triangles))
 }
+
+/// Whether a start, before it is tightened, may still be kept
+/// ([`choice::may_keep_gaps`]).
+type WorthTightening<'a> = dyn Fn((&[DVec3], &[[u32; 3]])) -> bool + Sync + 'a;
 
 /// A closed box of eight corners.
 fn box_around(centre: DVec3, half: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
@@ -155,17 +170,18 @@ fn box_around(centre: DVec3, half: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
 /// cap, tightened and polished; none when the target is outside their
 /// range or the mesh is flat along the axis's view. A prism that starts
 /// well over `to_beat` (the volume of the cage it would replace) is not
-/// tightened: tightening took back at most 17 % of a prism (ManHead).
+/// tightened: tightening took back at most 18 % of a prism (the bundled
+/// comb's); nor is one that bridges a gap the cage keeps open.
 fn prism_cages(
     mesh: &TriMesh,
     (mesh_points, gaps): (&PointTree, &[DVec3]),
     goal: &Goal,
-    (cell, to_beat): (f64, f64),
+    (cell, to_beat, worth_tightening): (f64, f64, &WorthTightening),
 ) -> Vec<(CageStart, Simplified)> {
-    let target = goal.target_vertices;
-    if !(8..=MAX_PRISM_TARGET).contains(&target) || mesh.positions.is_empty() {
+    if !prisms_fit(goal.target_vertices) || mesh.positions.is_empty() {
         return Vec::new();
     }
+    let target = goal.target_vertices;
     (0..3)
         .into_par_iter()
         .filter_map(|axis| {
@@ -175,6 +191,7 @@ fn prism_cages(
             let reached = prism.0.len() as f64;
             ((reached - target as f64).abs() <= 0.15 * target as f64).then_some(())?;
             (signed_volume(&prism.0, &prism.1) <= HOPELESS * to_beat).then_some(())?;
+            worth_tightening((&prism.0, &prism.1)).then_some(())?;
             let tightened = tighten(mesh, mesh_points, goal, cell, prism)?;
             Some((CageStart::Prism { axis }, tightened))
         })
