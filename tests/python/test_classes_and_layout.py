@@ -142,7 +142,8 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     assert isinstance(cage, pmvc.Cage)
     assert report["vertices"] == len(cage.vertices) and report["outside_vertices"] == 0
     assert report["target_vertices"] == 80
-    # Second starts (a box, prisms) run only up to 64 vertices.
+    # Second starts (a box, prisms) run up to 64 vertices, and above only where
+    # the cage from the voxels bridges gaps; at 80 it keeps the comb's open.
     assert report["start"] == "voxels" and report["start_reason"] is None
     # From the voxels, a distance below which parts may merge (infinite only
     # for a box or prism, which begins around every part).

@@ -21,10 +21,10 @@
 //! 6. polish: move vertices in any direction that lowers the enclosed
 //!    volume, and flip edges that do, under the same checks ([`polish`]);
 //! 7. for eight vertices, also tighten and polish the bounding box, and for
-//!    targets up to 64 a prism along each axis (the mesh's convex or traced
-//!    outline seen along it, extruded); keep a valid one that bridges no gap
-//!    the simplification kept open and keeps more open or encloses less
-//!    ([`starts`]).
+//!    targets up to 64, or where the cage bridges gaps, a prism along each
+//!    axis (the mesh's convex or traced outline seen along it, extruded);
+//!    keep a valid one that bridges no gap the simplification kept open and
+//!    keeps more open or encloses less ([`starts`]).
 //!
 //! Step 4 keeps every surface around the previous one, so the cage contains
 //! the voxels, which contain the mesh's surface; each change in steps 4 to 6

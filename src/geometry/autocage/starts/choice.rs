@@ -65,6 +65,11 @@ impl Standing {
         }
     }
 
+    /// Whether the cage bridges any of the gap points.
+    pub(super) fn bridges_any(&self) -> bool {
+        self.open.contains(&false)
+    }
+
     fn open(cage: &Cage, gap_points: &[DVec3]) -> Vec<bool> {
         let classes = classify_points(cage, gap_points).classes;
         (classes.into_iter())

@@ -67,7 +67,7 @@ pub(super) fn replace_if_better(
     goal: &Goal,
 ) {
     let target = goal.target_vertices;
-    if !box_fits(target) && !prisms_fit(target) {
+    if target < 8 {
         return;
     }
     let to_beat = signed_volume(&best.simplified.positions, &best.simplified.triangles);
@@ -80,6 +80,10 @@ pub(super) fn replace_if_better(
         .map(|g| g.position)
         .collect();
     let voxels = Standing::of(&best.simplified, &gaps);
+    let prisms_tried = prisms_fit(target, voxels.bridges_any());
+    if !box_fits(target) && !prisms_tried {
+        return;
+    }
     let worth_tightening: &WorthTightening =
         &|start: (&[DVec3], &[[u32; 3]])| may_keep_gaps(start, &voxels, &gaps);
     // Each start is tightened on its own, so they share the cores.
@@ -92,7 +96,11 @@ pub(super) fn replace_if_better(
         },
         || {
             let beat = (best.cell, to_beat, worth_tightening);
-            prism_cages(mesh, (mesh_points, &gaps), goal, beat)
+            if prisms_tried {
+                prism_cages(mesh, (mesh_points, &gaps), goal, beat)
+            } else {
+                Vec::new()
+            }
         },
     );
     let mut standing = voxels.clone();
@@ -114,14 +122,17 @@ fn box_fits(target: usize) -> bool {
     8.0 >= 0.85 * target as f64
 }
 
-/// Prisms are tried up to this target: each costs a polish of its own. A
-/// hand of four fingers needs 32 corners (16 on each cap) to keep its gaps,
-/// the bundled comb 40.
+/// Prisms are tried up to this target, each at the cost of a polish of its
+/// own, and above it only where the cage from the voxels bridges gaps: a
+/// hand of four fingers needs 32 corners (16 on each cap) to keep its gaps
+/// as a prism, the bundled comb 40, and a hand whose fingers are 2.07 % of
+/// the diagonal apart is kept apart by the voxels only from about 120.
 const MAX_PRISM_TARGET: usize = 64;
 
-/// Targets prisms are tried for.
-fn prisms_fit(target: usize) -> bool {
-    (8..=MAX_PRISM_TARGET).contains(&target)
+/// Whether prisms are tried for `target`, where the cage from the voxels
+/// has `bridged` gap points midway between walls or not.
+fn prisms_fit(target: usize, bridged: bool) -> bool {
+    target >= 8 && (target <= MAX_PRISM_TARGET || bridged)
 }
 
 /// A prism starting over this many times the cage it would replace is
@@ -167,8 +178,8 @@ fn box_around(centre: DVec3, half: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
 }
 
 /// Prisms along x, y and z with about half the target's corners on each
-/// cap, tightened and polished; none when the target is outside their
-/// range or the mesh is flat along the axis's view. A prism that starts
+/// cap, tightened and polished; none where the mesh is flat along the
+/// axis's view. A prism that starts
 /// well over `to_beat` (the volume of the cage it would replace) is not
 /// tightened: tightening took back at most 18 % of a prism (the bundled
 /// comb's); nor is one that bridges a gap the cage keeps open.
@@ -178,7 +189,7 @@ fn prism_cages(
     goal: &Goal,
     (cell, to_beat, worth_tightening): (f64, f64, &WorthTightening),
 ) -> Vec<(CageStart, Simplified)> {
-    if !prisms_fit(goal.target_vertices) || mesh.positions.is_empty() {
+    if mesh.positions.is_empty() {
         return Vec::new();
     }
     let target = goal.target_vertices;
