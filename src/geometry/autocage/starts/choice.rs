@@ -32,9 +32,8 @@ impl StartReason {
     /// Why `after` is better than `before`; None when it is not (it bridges
     /// a gap point `before` kept open, or is neither smaller nor opens any).
     pub(super) fn between(before: &Standing, after: &Standing) -> Option<StartReason> {
-        let pairs = || before.open.iter().zip(&after.open);
-        let keeps_all = pairs().all(|(&was, &stays)| stays || !was);
-        let opens_more = pairs().any(|(&was, &stays)| stays && !was);
+        let keeps_all = keeps_every_open(&before.open, &after.open);
+        let opens_more = (before.open.iter().zip(&after.open)).any(|(&was, &is)| is && !was);
         let smaller = after.volume < before.volume;
         match (keeps_all, opens_more, smaller) {
             (false, _, _) | (true, false, false) => None,
@@ -135,10 +134,13 @@ pub(super) fn may_keep_gaps(
     if !voxels.open.contains(&true) {
         return true;
     }
-    cage_of(positions, triangles).is_some_and(|cage| {
-        let open = Standing::open(&cage, gap_points);
-        (voxels.open.iter().zip(&open)).all(|(&was, &is)| is || !was)
-    })
+    cage_of(positions, triangles)
+        .is_some_and(|cage| keeps_every_open(&voxels.open, &Standing::open(&cage, gap_points)))
+}
+
+/// Whether every gap point open `before` is open `after`.
+fn keeps_every_open(before: &[bool], after: &[bool]) -> bool {
+    before.iter().zip(after).all(|(&was, &is)| is || !was)
 }
 
 #[cfg(test)]

@@ -269,14 +269,11 @@ fn prism(
         .iter()
         .map(|t| t.map(|i| seen(&mesh.positions[i as usize])));
     // The traced outline when it keeps more gaps open, or as many in less area.
-    let rank = |(polygon, kept_out): &(Vec<DVec2>, usize)| (*kept_out, -area(polygon));
     let concave = outline::traced_outline(view, margin)
         .and_then(|traced| profile::fewer_corners_holding(traced, corners, &keep_out))
-        .filter(|concave| {
-            convex.as_ref().is_none_or(|convex| {
-                rank(concave)
-                    .partial_cmp(&rank(convex))
-                    .is_some_and(|o| o.is_gt())
+        .filter(|(concave, kept)| {
+            convex.as_ref().is_none_or(|(convex, convex_kept)| {
+                kept > convex_kept || (kept == convex_kept && area(concave) < area(convex))
             })
         })
         .map(|(polygon, _)| polygon);

@@ -50,18 +50,20 @@ pub(super) fn fewer_corners_holding(
         // Least added area first; a step that would make the polygon touch
         // itself is passed over.
         steps.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let simple = || {
-            (steps.iter())
-                .map(|&(_, step)| step)
-                .filter(|&step| keeps_simple(&polygon, step))
-        };
-        let covers_none = |step: Step| {
+        // The first simple step covering no point, else the first simple one.
+        let mut first_simple = None;
+        for step in (steps.iter()).map(|&(_, step)| step) {
+            if !keeps_simple(&polygon, step) {
+                continue;
+            }
+            first_simple.get_or_insert(step);
             let triangle = added(&polygon, step);
-            !outside.iter().any(|&p| in_closed_triangle(p, triangle))
-        };
-        let step = simple()
-            .find(|&step| covers_none(step))
-            .or_else(|| simple().next())?;
+            if !outside.iter().any(|&p| in_closed_triangle(p, triangle)) {
+                first_simple = Some(step);
+                break;
+            }
+        }
+        let step = first_simple?;
         let triangle = added(&polygon, step);
         outside.retain(|&p| !in_closed_triangle(p, triangle));
         match step {
