@@ -67,20 +67,32 @@ impl State<'_> {
     }
 
     pub(super) fn crosses_anything(&mut self, replaced: &[(u32, [u32; 3])], star: &[u32]) -> bool {
-        let mut nearby = Vec::new();
+        // One list for every query: growing a new one each time was a
+        // noticeable share of the checks.
+        let mut nearby = std::mem::take(&mut self.nearby);
+        let crosses = self.crosses_any_nearby(replaced, star, &mut nearby);
+        self.nearby = nearby;
+        crosses
+    }
+
+    fn crosses_any_nearby(
+        &mut self,
+        replaced: &[(u32, [u32; 3])],
+        star: &[u32],
+        nearby: &mut Vec<u32>,
+    ) -> bool {
         for (k, (_, tri)) in replaced.iter().enumerate() {
             let [p, q, r] = tri.map(|i| self.positions[i as usize]);
             let pad = DVec3::splat(self.tolerance);
             self.stamp += 1;
             self.triangle_hash.query(
-                p.min(q).min(r) - pad,
-                p.max(q).max(r) + pad,
-                &mut self.seen_triangles,
-                self.stamp,
-                &mut nearby,
+                (p.min(q).min(r) - pad, p.max(q).max(r) + pad),
+                &self.triangle_alive,
+                (&mut self.seen_triangles, self.stamp),
+                nearby,
             );
             let (lo, hi) = (p.min(q).min(r) - pad, p.max(q).max(r) + pad);
-            for &other in &nearby {
+            for &other in nearby.iter() {
                 let o = other as usize;
                 if !self.triangle_alive[o] || star.binary_search(&other).is_ok() {
                     continue;
@@ -130,11 +142,15 @@ impl State<'_> {
                 hi = hi.max(*p);
             }
         }
-        let mut nearby = Vec::new();
+        let mut nearby = std::mem::take(&mut self.nearby);
         self.stamp += 1;
-        self.vertex_hash
-            .query(lo, hi, &mut self.seen_vertices, self.stamp, &mut nearby);
-        nearby.iter().any(|&v| {
+        self.vertex_hash.query(
+            (lo, hi),
+            &self.vertex_alive,
+            (&mut self.seen_vertices, self.stamp),
+            &mut nearby,
+        );
+        let sweeps = nearby.iter().any(|&v| {
             let v = v as usize;
             if v == a || v == b || !self.vertex_alive[v] {
                 return false;
@@ -152,7 +168,9 @@ impl State<'_> {
             old_corners
                 .iter()
                 .any(|corners| inside_tetrahedron(p, position, *corners, self.volume_tolerance))
-        })
+        });
+        self.nearby = nearby;
+        sweeps
     }
 }
 

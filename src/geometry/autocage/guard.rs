@@ -48,14 +48,16 @@ impl SpatialHash {
         }
     }
 
-    /// Every item filed in a cell that the box touches, each once (using
-    /// `seen`, a per-item stamp array, and `stamp`, a value not used before).
+    /// Every live item filed in a cell that the box touches, each once
+    /// (using `seen`, a per-item stamp array, and `stamp`, a value not used
+    /// before). Items no longer `alive` are dropped from the cells visited:
+    /// a collapse leaves its old faces' entries behind, and between rebuilds
+    /// they were most of what a query read.
     pub(super) fn query(
-        &self,
-        lo: DVec3,
-        hi: DVec3,
-        seen: &mut [u32],
-        stamp: u32,
+        &mut self,
+        (lo, hi): (DVec3, DVec3),
+        alive: &[bool],
+        (seen, stamp): (&mut [u32], u32),
         out: &mut Vec<u32>,
     ) {
         out.clear();
@@ -63,8 +65,11 @@ impl SpatialHash {
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 for x in a[0]..=b[0] {
-                    if let Some(items) = self.cells.get(&[x, y, z]) {
-                        for &item in items {
+                    if let Some(items) = self.cells.get_mut(&[x, y, z]) {
+                        let before = items.len();
+                        items.retain(|&item| alive[item as usize]);
+                        self.entries -= before - items.len();
+                        for &item in items.iter() {
                             if seen[item as usize] != stamp {
                                 seen[item as usize] = stamp;
                                 out.push(item);

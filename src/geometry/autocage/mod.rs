@@ -34,6 +34,7 @@
 
 mod cell_choice;
 mod checks;
+mod chessboard;
 mod cost;
 mod error;
 mod flat;
@@ -395,7 +396,7 @@ impl Context<'_> {
             origin: voxels.origin,
             cell,
             dims: voxels.dims,
-            distance: voxels::distance_from_set(&voxels),
+            distance: chessboard::distance_from_set(&voxels.inside, voxels.dims),
             limit: (clearance_cells + 2) as u16,
         };
         step(0.7)?;

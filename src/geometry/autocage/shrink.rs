@@ -106,7 +106,10 @@ impl State<'_> {
         let new_corners: Vec<[DVec3; 3]> = star.iter().map(|&t| self.corners(t as usize)).collect();
         let mut sorted_star = star.clone();
         sorted_star.sort_unstable();
+        // A point that held this vertex before is the likeliest refusal, and
+        // the cheapest to find: it is asked before the faces are searched.
         let accepted = self.shapes_are_good(&replaced, (v, usize::MAX), (old, old))
+            && !self.held_within(v, &new_corners)
             && !self.crosses_anything(&replaced, &sorted_star)
             && !self.sweeps_over_vertices(v, v, old, &sorted_star, &new_corners)
             && !self.keeps_no_clearance(v, &new_corners)
@@ -125,14 +128,12 @@ impl State<'_> {
     }
 
     /// Whether a mesh point is closer than the clearance to one of the faces
-    /// around `v`. The points that stopped `v` before are tried first: a
-    /// vertex held by a face resting at the clearance is tried in direction
-    /// after direction, and mostly the same point holds it.
+    /// around `v`, remembering the point that is. Asked after
+    /// [`Self::held_within`]: a vertex held by a face resting at the
+    /// clearance is tried in direction after direction, and mostly the same
+    /// point holds it.
     fn keeps_no_clearance(&mut self, v: usize, faces: &[[DVec3; 3]]) -> bool {
         let held = &mut self.holding_points[v];
-        if held.iter().any(|&p| point_within(p, faces, self.clearance)) {
-            return true;
-        }
         let Some(point) = self.mesh_points.first_within(faces, self.clearance) else {
             return false;
         };
@@ -141,6 +142,12 @@ impl State<'_> {
         }
         held.push(point);
         true
+    }
+
+    /// Whether a point that held `v` before is closer than the clearance to
+    /// one of the faces.
+    fn held_within(&self, v: usize, faces: &[[DVec3; 3]]) -> bool {
+        (self.holding_points[v].iter()).any(|&p| point_within(p, faces, self.clearance))
     }
 
     /// Whether a mesh point is closer than `clearance` to one of the faces.

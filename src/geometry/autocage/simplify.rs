@@ -7,7 +7,7 @@
 //! condition, flip or squash a face, make two faces cross, or sweep over
 //! another part of the surface.
 
-use super::cost::Quadric;
+use super::cost::{sized_for, Quadric};
 use super::guard::SpatialHash;
 use super::points::PointTree;
 use super::voxels::Envelope;
@@ -68,6 +68,8 @@ pub(super) struct State<'a> {
     pub(super) entries_at_rebuild: usize,
     pub(super) seen_triangles: Vec<u32>,
     pub(super) seen_vertices: Vec<u32>,
+    /// What the last query of a hash found (kept to be reused).
+    pub(super) nearby: Vec<u32>,
     /// Points of the mesh (vertices and face centres) that must stay inside.
     pub(super) mesh_points: &'a PointTree,
     /// Points midway across gaps between parts of the mesh that must stay
@@ -222,6 +224,7 @@ impl<'a> State<'a> {
             entries_at_rebuild: 0,
             seen_triangles: vec![0; triangles.len()],
             seen_vertices: vec![0; count],
+            nearby: Vec::new(),
             mesh_points,
             gap_points,
             clearance: goal.clearance,
@@ -246,12 +249,14 @@ impl<'a> State<'a> {
     }
 
     pub(super) fn neighbours(&self, v: usize) -> Vec<usize> {
-        let mut out: Vec<usize> = self.vertex_triangles[v]
-            .iter()
-            .flat_map(|&t| self.triangles[t as usize])
-            .map(|i| i as usize)
-            .filter(|&i| i != v)
-            .collect();
+        let faces = &self.vertex_triangles[v];
+        let mut out: Vec<usize> = sized_for(
+            2 * faces.len(),
+            (faces.iter())
+                .flat_map(|&t| self.triangles[t as usize])
+                .map(|i| i as usize)
+                .filter(|&i| i != v),
+        );
         out.sort_unstable();
         out.dedup();
         out
@@ -291,18 +296,20 @@ impl<'a> State<'a> {
             return false;
         }
         let star = self.star(a, b);
-        let replaced: Vec<(u32, [u32; 3])> = star
-            .iter()
-            .filter(|&&t| {
-                let tri = self.triangles[t as usize];
-                !(tri.contains(&(a as u32)) && tri.contains(&(b as u32)))
-            })
-            .map(|&t| {
-                let tri =
-                    self.triangles[t as usize].map(|i| if i == b as u32 { a as u32 } else { i });
-                (t, tri)
-            })
-            .collect();
+        let replaced: Vec<(u32, [u32; 3])> = sized_for(
+            star.len(),
+            (star.iter())
+                .filter(|&&t| {
+                    let tri = self.triangles[t as usize];
+                    !(tri.contains(&(a as u32)) && tri.contains(&(b as u32)))
+                })
+                .map(|&t| {
+                    let tri =
+                        (self.triangles[t as usize])
+                            .map(|i| if i == b as u32 { a as u32 } else { i });
+                    (t, tri)
+                }),
+        );
         let old_corners: Vec<[DVec3; 3]> = star.iter().map(|&t| self.corners(t as usize)).collect();
         let (old_a, old_b) = (self.positions[a], self.positions[b]);
         self.positions[a] = position;
@@ -334,7 +341,7 @@ impl<'a> State<'a> {
             self.triangle_alive[t as usize] = false;
             self.alive_triangles -= 1;
         }
-        let mut touched = Vec::new();
+        let mut touched = Vec::with_capacity(3 * star.len());
         for &t in &star {
             touched.extend(self.triangles[t as usize]);
         }
@@ -448,7 +455,7 @@ impl<'a> State<'a> {
     /// has been, so it waits for as many new entries as that.
     pub(super) fn refile_if_crowded(&mut self) {
         let entries = self.triangle_hash.entries();
-        let added = entries - self.entries_at_rebuild;
+        let added = entries.saturating_sub(self.entries_at_rebuild);
         if entries > 4 * self.entries_at_rebuild.max(1024) && added > self.triangles.len() {
             let size = self.mean_edge_length().max(self.triangle_hash.cell_size());
             self.rebuild_hashes(size);
