@@ -38,7 +38,9 @@ pub fn bridged_legend(stats: &CageStats) -> Option<String> {
         return None;
     }
     let stride = bridged_dot_stride(bridged);
-    let which = if stride == 1 {
+    let which = if bridged == 1 {
+        "the 1 point".to_owned()
+    } else if stride == 1 {
         format!("the {bridged} points")
     } else {
         format!("one in {stride} of the {bridged} points")
@@ -538,6 +540,10 @@ mod tests {
         assert!(21_280usize.div_ceil(6) <= MAX_BRIDGED_DOTS);
         let mut stats = CageStats::default();
         assert_eq!(bridged_legend(&stats), None);
+        // The bundled scan at its hand-made cage's 162 vertices bridges one.
+        stats.gaps.bridged = vec![DVec3::ZERO; 1];
+        let legend = bridged_legend(&stats).expect("a key");
+        assert!(legend.contains("the 1 point in the gaps"), "{legend}");
         stats.gaps.bridged = vec![DVec3::ZERO; 21_280];
         let legend = bridged_legend(&stats).expect("a key");
         assert!(legend.contains("one in 6 of the 21280 points"), "{legend}");
