@@ -84,17 +84,18 @@ impl State<'_> {
         for (k, (_, tri)) in replaced.iter().enumerate() {
             let [p, q, r] = tri.map(|i| self.positions[i as usize]);
             let pad = DVec3::splat(self.tolerance);
+            let (lo, hi) = (p.min(q).min(r) - pad, p.max(q).max(r) + pad);
             self.stamp += 1;
+            // The query returns live faces only.
             self.triangle_hash.query(
-                (p.min(q).min(r) - pad, p.max(q).max(r) + pad),
+                (lo, hi),
                 &self.triangle_alive,
                 (&mut self.seen_triangles, self.stamp),
                 nearby,
             );
-            let (lo, hi) = (p.min(q).min(r) - pad, p.max(q).max(r) + pad);
             for &other in nearby.iter() {
                 let o = other as usize;
-                if !self.triangle_alive[o] || star.binary_search(&other).is_ok() {
+                if star.binary_search(&other).is_ok() {
                     continue;
                 }
                 // Most faces filed in the same cells are not even near.
@@ -152,7 +153,8 @@ impl State<'_> {
         );
         let sweeps = nearby.iter().any(|&v| {
             let v = v as usize;
-            if v == a || v == b || !self.vertex_alive[v] {
+            // Live vertices only, from the query.
+            if v == a || v == b {
                 return false;
             }
             let p = self.positions[v];
