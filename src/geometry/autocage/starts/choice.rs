@@ -121,21 +121,28 @@ fn cage_of(positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<Cage> {
     Cage::new(mesh).ok().map(|(cage, _)| cage)
 }
 
-/// Whether a start, before it is tightened, leaves outside every gap point
-/// that `voxels` leaves outside. Tightening moves its faces inward, so a
-/// start that bridges such a point now would almost always be refused
-/// after it: such starts are not tightened (a comb's prisms seen from the
-/// side, which fill every slot).
-pub(super) fn may_keep_gaps(
+/// The gap points a start leaves outside before it is tightened, which
+/// tightening then keeps outside; None when it already bridges a gap point
+/// that `voxels` leaves outside. Tightening moves its faces inward, so such
+/// a start would almost always be refused after it: it is not tightened (a
+/// comb's prisms seen from the side, which fill every slot).
+pub(super) fn gaps_to_keep(
     (positions, triangles): (&[DVec3], &[[u32; 3]]),
     voxels: &Standing,
     gap_points: &[DVec3],
-) -> bool {
-    if !voxels.open.contains(&true) {
-        return true;
-    }
-    cage_of(positions, triangles)
-        .is_some_and(|cage| keeps_every_open(&voxels.open, &Standing::open(&cage, gap_points)))
+) -> Option<Vec<DVec3>> {
+    let Some(cage) = cage_of(positions, triangles) else {
+        // Not a valid cage yet: tightened with nothing to keep out, and
+        // judged when it is one.
+        return (!voxels.open.contains(&true)).then(Vec::new);
+    };
+    let open = Standing::open(&cage, gap_points);
+    keeps_every_open(&voxels.open, &open).then(|| {
+        (gap_points.iter().zip(&open))
+            .filter(|(_, &is)| is)
+            .map(|(&p, _)| p)
+            .collect()
+    })
 }
 
 /// Whether every gap point open `before` is open `after`.
@@ -209,7 +216,7 @@ mod tests {
         // the cage bridges too is.
         let may_keep = |start: &Simplified, attempt: &Attempt, gaps: &[DVec3]| {
             let standing = Standing::of(&attempt.simplified, gaps);
-            may_keep_gaps((&start.positions, &start.triangles), &standing, gaps)
+            gaps_to_keep((&start.positions, &start.triangles), &standing, gaps).is_some()
         };
         assert!(!may_keep(&one_box, &attempt, &between));
         assert!(may_keep(&one_box, &attempt, &inside_both));

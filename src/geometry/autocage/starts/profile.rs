@@ -159,11 +159,11 @@ fn keeps_simple(polygon: &[DVec2], step: Step) -> bool {
     !corner_inside && !crossed
 }
 
-fn orientation(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+pub(super) fn orientation(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a)
 }
 
-fn in_closed_triangle(p: DVec2, [a, b, c]: [DVec2; 3]) -> bool {
+pub(super) fn in_closed_triangle(p: DVec2, [a, b, c]: [DVec2; 3]) -> bool {
     let s = [
         orientation(a, b, p),
         orientation(b, c, p),
@@ -192,110 +192,15 @@ fn segments_meet((a, b): (DVec2, DVec2), (c, d): (DVec2, DVec2)) -> bool {
         || (o4 == 0.0 && on(c, d, b))
 }
 
-/// The triangles of a simple counter-clockwise polygon, each
-/// counter-clockwise: ear clipping that clips, each time, the ear whose
-/// smallest angle is largest, so that the caps keep wide triangles.
-pub(super) fn cap_triangles(polygon: &[DVec2]) -> Option<Vec<[u32; 3]>> {
-    let mut left: Vec<usize> = (0..polygon.len()).collect();
-    let mut triangles = Vec::with_capacity(polygon.len().saturating_sub(2));
-    while left.len() > 3 {
-        let m = left.len();
-        let ear = (0..m)
-            .filter_map(|k| {
-                let [a, b, c] = [left[(k + m - 1) % m], left[k], left[(k + 1) % m]];
-                let corners = [polygon[a], polygon[b], polygon[c]];
-                if orientation(corners[0], corners[1], corners[2]) <= 0.0 {
-                    return None;
-                }
-                let blocked = left
-                    .iter()
-                    .filter(|&&o| o != a && o != b && o != c)
-                    .any(|&o| in_closed_triangle(polygon[o], corners));
-                (!blocked).then(|| (smallest_angle(corners), k))
-            })
-            .max_by(|x, y| x.0.total_cmp(&y.0))?
-            .1;
-        let [a, b, c] = [left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]];
-        triangles.push([a as u32, b as u32, c as u32]);
-        left.remove(ear);
-    }
-    if let [a, b, c] = left[..] {
-        triangles.push([a as u32, b as u32, c as u32]);
-    }
-    Some(triangles)
-}
-
-fn smallest_angle([a, b, c]: [DVec2; 3]) -> f64 {
-    let angle = |p: DVec2, q: DVec2, r: DVec2| (q - p).angle_to(r - p).abs();
-    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
-}
-
 #[cfg(test)]
 mod tests {
-    use super::super::polygon_checks::{area, boundary_distance, contains, is_simple};
+    use super::super::polygon_checks::{
+        area, boundary_distance, comb, contains, is_simple, star, tangle,
+    };
     use super::*;
-    use crate::geometry::procedural::SplitMix64;
 
     fn polygon(corners: &[(f64, f64)]) -> Vec<DVec2> {
         corners.iter().map(|&(x, y)| DVec2::new(x, y)).collect()
-    }
-
-    /// A comb: a spine along the bottom and `teeth` teeth upward, each as
-    /// wide as the gap after it.
-    fn comb(teeth: usize) -> Vec<DVec2> {
-        let mut corners = vec![(0.0, 0.0), (2.0 * teeth as f64 - 1.0, 0.0)];
-        for k in (0..teeth).rev() {
-            let x = 2.0 * k as f64;
-            corners.extend([(x + 1.0, 3.0), (x, 3.0)]);
-            if k > 0 {
-                corners.extend([(x, 1.0), (x - 1.0, 1.0)]);
-            }
-        }
-        // The spine's right end rises into the last tooth.
-        corners[1].0 = 2.0 * teeth as f64 - 1.0;
-        polygon(&corners)
-    }
-
-    /// A star-shaped polygon of random radii.
-    fn star(corners: usize, seed: u64) -> Vec<DVec2> {
-        let mut random = SplitMix64(seed);
-        (0..corners)
-            .map(|k| {
-                let angle = std::f64::consts::TAU * k as f64 / corners as f64;
-                DVec2::new(angle.cos(), angle.sin()) * (0.3 + random.unit())
-            })
-            .collect()
-    }
-
-    /// A random simple polygon, wiggling every way: random points joined
-    /// in random order, then untangled by reversing the path between any
-    /// two edges that cross (2-opt, which shortens the loop each time).
-    fn tangle(corners: usize, seed: u64) -> Vec<DVec2> {
-        let mut random = SplitMix64(seed);
-        let mut points: Vec<DVec2> = (0..corners)
-            .map(|_| DVec2::new(random.unit(), random.unit()))
-            .collect();
-        let crosses = |a: DVec2, b: DVec2, c: DVec2, d: DVec2| {
-            let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-            side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0
-        };
-        'untangle: loop {
-            let n = points.len();
-            for i in 0..n {
-                for j in i + 2..n {
-                    let (a, b, c, d) = (points[i], points[i + 1], points[j], points[(j + 1) % n]);
-                    if (j + 1) % n != i && crosses(a, b, c, d) {
-                        points[i + 1..=j].reverse();
-                        continue 'untangle;
-                    }
-                }
-            }
-            break;
-        }
-        if area(&points) < 0.0 {
-            points.reverse();
-        }
-        points
     }
 
     fn holds(outer: &[DVec2], p: DVec2) -> bool {
@@ -415,24 +320,5 @@ mod tests {
         assert!(shape.iter().all(|&p| holds(&fewer, p)));
         assert_eq!(count, outside(&fewer));
         assert!(count < midway.len());
-    }
-
-    /// Each cap triangle turns counter-clockwise and lies inside, and their
-    /// areas add up to the profile's.
-    #[test]
-    fn caps_cover_the_profile_once() {
-        for shape in [comb(4), star(12, 4), star(16, 5)] {
-            let triangles = cap_triangles(&shape).unwrap();
-            assert_eq!(triangles.len(), shape.len() - 2);
-            let mut total = 0.0;
-            for t in &triangles {
-                let [a, b, c] = t.map(|i| shape[i as usize]);
-                let twice = (b - a).perp_dot(c - a);
-                assert!(twice > 0.0, "{t:?} turns clockwise");
-                assert!(contains(&shape, (a + b + c) / 3.0), "{t:?} is outside");
-                total += 0.5 * twice;
-            }
-            assert!((total - area(&shape)).abs() <= 1e-9 * area(&shape));
-        }
     }
 }
