@@ -220,6 +220,12 @@ mod tests {
         };
         assert!(!may_keep(&one_box, &attempt, &between));
         assert!(may_keep(&one_box, &attempt, &inside_both));
+        // What a start leaves outside is what its tightening keeps outside.
+        let far = DVec3::new(0.0, 3.0, 0.0);
+        let gaps = [inside_both[0], far];
+        let standing = Standing::of(&attempt.simplified, &gaps);
+        let start = (&one_box.positions[..], &one_box.triangles[..]);
+        assert_eq!(gaps_to_keep(start, &standing, &gaps), Some(vec![far]));
         let bridged = Attempt {
             simplified: one_box,
             ..attempt
