@@ -125,7 +125,6 @@ mod tests {
             return true;
         }
         let (p, q) = (polygon[i], polygon[j]);
-        let side = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
         let crosses = (0..n).any(|k| {
             let l = (k + 1) % n;
             if [k, l].contains(&i) || [k, l].contains(&j) {
@@ -162,7 +161,7 @@ mod tests {
                     let corners = [polygon[i], polygon[k], polygon[j]];
                     if !is_chord(polygon, i, k)
                         || !is_chord(polygon, k, j)
-                        || side_of(corners) <= 0.0
+                        || side(corners[0], corners[1], corners[2]) <= 0.0
                     {
                         continue;
                     }
@@ -174,7 +173,9 @@ mod tests {
         best[0][n - 1]
     }
 
-    fn side_of([a, b, c]: [DVec2; 3]) -> f64 {
+    /// Twice the signed area of a b c: positive when they turn
+    /// counter-clockwise.
+    fn side(a: DVec2, b: DVec2, c: DVec2) -> f64 {
         (b - a).perp_dot(c - a)
     }
 
