@@ -1,4 +1,4 @@
-//! Automatic cages (`geometry::autocage::generate_cage`) against their documented
+//! Automatic cages (`cagegen::generate_cage`) against their documented
 //! contract: a valid, closed, edge-manifold cage that strictly encloses every
 //! point of the mesh's surface, follows its shape (prongs apart, holes open,
 //! separate parts in separate shells), is about the requested size and tight,
@@ -14,12 +14,13 @@ use common::measure::*;
 
 use common::winding_number;
 use glam::DVec3;
-use pmvc::coords::{cubemap::TexelTable, mvc, pmvc as pmvc_ref};
-use pmvc::geometry::autocage::{
+use pmvc::cagegen::{
     generate_cage, AutoCageError, CageOptions, GeneratedCage, DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE,
 };
+use pmvc::coords::{cubemap::TexelTable, mvc, pmvc as pmvc_ref};
+use pmvc::formats::load_mesh;
 use pmvc::geometry::procedural;
-use pmvc::geometry::{load_mesh, Cage, TriMesh};
+use pmvc::geometry::{Cage, TriMesh};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};

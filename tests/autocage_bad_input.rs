@@ -2,7 +2,7 @@
 //! properly, with an error that says why and with the numbers involved.
 
 use glam::DVec3;
-use pmvc::geometry::autocage::{
+use pmvc::cagegen::{
     generate_cage, AutoCageError, CageOptions, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use pmvc::geometry::{procedural, TriMesh};

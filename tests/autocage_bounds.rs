@@ -10,7 +10,7 @@ mod common;
 
 use common::winding_number;
 use glam::DVec3;
-use pmvc::geometry::autocage::{generate_cage, plan_cage, AutoCageError, CageOptions};
+use pmvc::cagegen::{generate_cage, plan_cage, AutoCageError, CageOptions};
 use pmvc::geometry::procedural::{self, SplitMix64};
 use pmvc::geometry::TriMesh;
 

@@ -11,8 +11,9 @@ mod common;
 
 use common::winding_number;
 use glam::DVec3;
-use pmvc::geometry::autocage::{generate_cage, CageOptions, GeneratedCage, DEFAULT_CLEARANCE};
-use pmvc::geometry::{load_cage, procedural, Cage, TriMesh};
+use pmvc::cagegen::{generate_cage, CageOptions, GeneratedCage, DEFAULT_CLEARANCE};
+use pmvc::formats::load_cage;
+use pmvc::geometry::{procedural, Cage, TriMesh};
 
 /// Grid steps per patch side in the refined surface: the grid is within
 /// `|twist| / (4·STEPS²)` of the patch.

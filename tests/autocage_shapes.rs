@@ -10,9 +10,7 @@ use common::measure::signed_volume;
 use common::shapes::{self, Shape};
 use common::winding_number;
 use glam::DVec3;
-use pmvc::geometry::autocage::{
-    generate_cage, CageOptions, CageStart, GeneratedCage, DEFAULT_CLEARANCE,
-};
+use pmvc::cagegen::{generate_cage, CageOptions, CageStart, GeneratedCage, DEFAULT_CLEARANCE};
 use pmvc::geometry::Cage;
 
 fn cage_volume(cage: &Cage) -> f64 {

@@ -90,7 +90,7 @@ fn the_shared_artist_cages_validate() {
     assert!(!names.is_empty());
     for path in names {
         let started = Instant::now();
-        let (cage, _) = pmvc::geometry::load_cage(&path).unwrap_or_else(|error| panic!("{error}"));
+        let (cage, _) = pmvc::formats::load_cage(&path).unwrap_or_else(|error| panic!("{error}"));
         eprintln!(
             "{}: {} triangles validated in {:.1} ms",
             path.display(),

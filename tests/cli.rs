@@ -4,7 +4,8 @@
 mod common;
 use common::*;
 use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method};
-use pmvc::geometry::{classify_points, load_mesh};
+use pmvc::formats::load_mesh;
+use pmvc::geometry::classify_points;
 use std::path::Path;
 
 fn read_npy_f32(path: &Path) -> (Vec<usize>, Vec<f32>, String) {

@@ -4,7 +4,8 @@
 
 mod common;
 use common::*;
-use pmvc::geometry::{classify_points, load_cage, load_mesh, procedural};
+use pmvc::formats::{load_cage, load_mesh};
+use pmvc::geometry::{classify_points, procedural};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -390,7 +391,7 @@ fn a_tiny_mesh_prints_its_figures_with_significant_digits() {
 #[test]
 fn a_coarsened_voxel_size_is_reported_as_coarsened() {
     use pmvc::app::cage_generation::stats_lines;
-    use pmvc::geometry::autocage::{generate_cage, CageOptions};
+    use pmvc::cagegen::{generate_cage, CageOptions};
     let sphere = procedural::icosphere(1.0, 2);
     let mesh = pmvc::geometry::TriMesh {
         positions: sphere.positions().to_vec(),

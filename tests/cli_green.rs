@@ -8,7 +8,7 @@ use common::*;
 use glam::{DMat3, DVec3};
 use pmvc::coords::green::bind_green;
 use pmvc::coords::BindProgress;
-use pmvc::geometry::load_mesh;
+use pmvc::formats::load_mesh;
 use std::io::Read as _;
 use std::path::Path;
 

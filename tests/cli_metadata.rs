@@ -127,7 +127,7 @@ fn bind_writes_metadata_and_row_classes_for_every_family() {
         assert_eq!(json["mesh"]["points"], points.len());
         assert_eq!(
             json["mesh"]["digest"],
-            pmvc::coords::metadata::positions_digest(&points)
+            pmvc::formats::metadata::positions_digest(&points)
         );
         assert_eq!(json["cage"]["file"], path_str(&cage_path));
         assert_eq!(json["cage"]["vertices"], cage.vertex_count());

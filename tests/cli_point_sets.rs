@@ -252,7 +252,7 @@ fn mutated_npy_point_sets_load_or_fail_cleanly() {
     for valid in [f64_points_npy(&points), f32_points_npy(&points)] {
         std::fs::write(&path, valid).unwrap();
         assert_eq!(
-            pmvc::geometry::load_mesh(&path).unwrap().mesh.positions,
+            pmvc::formats::load_mesh(&path).unwrap().mesh.positions,
             points
         );
     }
@@ -276,7 +276,7 @@ fn mutated_npy_point_sets_load_or_fail_cleanly() {
             }
         }
         std::fs::write(&path, &bytes).unwrap();
-        match pmvc::geometry::load_mesh(&path) {
+        match pmvc::formats::load_mesh(&path) {
             Ok(file) => {
                 loaded += 1;
                 assert!(

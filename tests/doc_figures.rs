@@ -5,7 +5,8 @@
 use glam::DVec3;
 use pmvc::coords::green::{bind_green, face_vectors};
 use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
-use pmvc::geometry::{classify_points, load_cage, load_mesh, Cage, TriMesh};
+use pmvc::formats::{load_cage, load_mesh};
+use pmvc::geometry::{classify_points, Cage, TriMesh};
 use std::path::{Path, PathBuf};
 
 /// The comparison gallery's pose of the bundled comb.

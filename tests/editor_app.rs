@@ -259,7 +259,7 @@ fn poses_save_load_reset_and_the_deformed_mesh_exports() {
     app.export_deformed(&export_path);
     assert!(app.last_error().is_none(), "{:?}", app.last_error());
 
-    let exported = pmvc::geometry::load_mesh(&export_path)
+    let exported = pmvc::formats::load_mesh(&export_path)
         .unwrap()
         .mesh
         .positions;

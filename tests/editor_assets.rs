@@ -4,8 +4,9 @@
 
 use glam::DVec3;
 use pmvc::app::scenes::{comb_cage, comb_mesh, BundledScene};
+use pmvc::formats::{load_cage, load_mesh, write_obj_to};
+use pmvc::geometry::classify_points;
 use pmvc::geometry::procedural::star_cage;
-use pmvc::geometry::{classify_points, load_cage, load_mesh, write_obj_to};
 use std::path::Path;
 
 fn assets() -> &'static Path {

@@ -174,7 +174,7 @@ fn a_mesh_opened_alone_sits_in_a_box_with_the_window_open() {
         app.cage_generation().target_vertices,
         pmvc::app::cage_generation::DEFAULT_TARGET_VERTICES
     );
-    let loaded = pmvc::geometry::load_mesh(&mesh).unwrap();
+    let loaded = pmvc::formats::load_mesh(&mesh).unwrap();
     assert_eq!(app.document().mesh().positions, loaded.mesh.positions);
     assert_eq!(app.document().cage().vertex_count(), 8);
     let classes = classify_points(app.document().cage(), &loaded.mesh.positions);
@@ -223,7 +223,7 @@ fn a_mesh_opened_away_from_the_cage_gets_a_box_and_the_window_and_undo_returns()
     let Some(mut harness) = editor() else { return };
     run_until_bound(&mut harness);
     let old_cage = cage_positions(harness.state());
-    let comb = pmvc::geometry::load_mesh(&assets("comb_mesh.obj"))
+    let comb = pmvc::formats::load_mesh(&assets("comb_mesh.obj"))
         .unwrap()
         .mesh;
     let far: Vec<DVec3> = comb

@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use glam::DVec3;
 use pmvc::app::ui::file_dialog::FileAction;
 use pmvc::app::EditorApp;
-use pmvc::geometry::load_mesh;
+use pmvc::formats::load_mesh;
 
 fn choose_in_file_menu(harness: &mut Harness<'static, EditorApp>, entry: &str) {
     harness.get_by_label("File").click();
@@ -313,8 +313,8 @@ fn save_cage_keeps_the_quads_and_writes_the_pose_beside_it_never_over_the_cage_r
     let posed_path = dir.path().join("cube_cage-edited.posed.obj");
     let posed = std::fs::read_to_string(&posed_path).unwrap();
     assert_eq!(faces_of(&posed), faces_of(QUAD_CUBE));
-    let rest_cage = pmvc::geometry::load_mesh(&out).unwrap().mesh;
-    let posed_cage = pmvc::geometry::load_mesh(&posed_path).unwrap().mesh;
+    let rest_cage = pmvc::formats::load_mesh(&out).unwrap().mesh;
+    let posed_cage = pmvc::formats::load_mesh(&posed_path).unwrap().mesh;
     assert_eq!(rest_cage.positions[6], glam::DVec3::new(1.0, 1.0, 1.0));
     assert_eq!(posed_cage.positions[6], moved);
     assert_eq!(

@@ -13,7 +13,7 @@ use pmvc::app::compare::{Layout, Overlay};
 use pmvc::app::recent::RecentEntry;
 use pmvc::app::{EditorOptions, FileRole};
 use pmvc::coords::Method;
-use pmvc::geometry::load_mesh;
+use pmvc::formats::load_mesh;
 use std::path::Path;
 
 fn read_json(path: &Path) -> serde_json::Value {

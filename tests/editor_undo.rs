@@ -267,7 +267,7 @@ fn quitting_with_an_unsaved_pose_asks_first() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("before-quit.obj");
     answer_file_dialog(&mut harness, &path);
-    let saved = pmvc::geometry::load_mesh(&path).expect("the pose was saved");
+    let saved = pmvc::formats::load_mesh(&path).expect("the pose was saved");
     assert_eq!(saved.mesh.positions, harness.state().document().pose());
     assert!(harness.state().quit_confirmed());
 

@@ -3,7 +3,8 @@
 
 use glam::{DMat3, DVec3};
 use pmvc::coords::mvc::{mvc_weights, MvcScratch, FAR_FIELD_DIAGONALS};
-use pmvc::geometry::{parse_mesh, procedural, write_obj_to, Cage};
+use pmvc::formats::{parse_mesh, write_obj_to};
+use pmvc::geometry::{procedural, Cage};
 use std::path::Path;
 
 #[cfg(feature = "editor")]
@@ -202,7 +203,7 @@ fn deform_is_exact_for_a_cage_far_from_the_origin() {
             path_str(&out),
         ]);
         assert!(output.status.success(), "{}", stderr(&output));
-        let deformed = pmvc::geometry::load_mesh(&out).unwrap().mesh.positions;
+        let deformed = pmvc::formats::load_mesh(&out).unwrap().mesh.positions;
         assert_eq!(deformed.len(), points.len());
         for (k, (before, after)) in points.iter().zip(&deformed).enumerate() {
             let error = (*after - (*before + shift)).length();

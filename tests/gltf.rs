@@ -10,7 +10,8 @@ use common::*;
 mod cli_support;
 use cli_support::obj_vertices;
 use glam::DVec3;
-use pmvc::geometry::{load_mesh, procedural};
+use pmvc::formats::load_mesh;
+use pmvc::geometry::procedural;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 

@@ -4,8 +4,9 @@
 //! positions, squashes them. Figures are printed with `--nocapture`.
 
 use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method};
+use pmvc::formats::load_mesh;
+use pmvc::geometry::classify_points;
 use pmvc::geometry::twisted_bar::{cross_sections, twisted_bar, CrossSections};
-use pmvc::geometry::{classify_points, load_mesh};
 
 const POSE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/poses/twisted-bar.obj");
 
@@ -57,7 +58,7 @@ fn the_gallerys_pose_file_is_the_twisted_cage() {
             triangles: bar.cage.triangles().to_vec(),
             triangle_faces: (0..bar.cage.triangle_count() as u32).collect(),
         };
-        pmvc::geometry::write_obj(std::path::Path::new(POSE), &mesh).expect("written");
+        pmvc::formats::write_obj(std::path::Path::new(POSE), &mesh).expect("written");
     }
     let pose = load_mesh(std::path::Path::new(POSE)).expect("docs/poses/twisted-bar.obj");
     assert_eq!(pose.mesh.positions.len(), bar.twisted.len());

@@ -6,7 +6,7 @@
 #[path = "common/tobj_reference.rs"]
 mod tobj_reference;
 
-use pmvc::geometry::{parse_mesh, LoadError, MeshFile};
+use pmvc::formats::{parse_mesh, LoadError, MeshFile};
 use std::path::{Path, PathBuf};
 use tobj_reference::parse_obj_with_tobj;
 

@@ -276,8 +276,8 @@ fn qmvc_data() -> Option<PathBuf> {
 /// ManHead and its artist cage, triangulated at the origin.
 fn man_head() -> Option<(Cage, Vec<DVec3>)> {
     let data = qmvc_data()?;
-    let mesh = pmvc::geometry::load_mesh(&data.join("ManHead.obj")).expect("mesh");
-    let (cage, _) = pmvc::geometry::load_cage(&data.join("ManHead_Cage.obj")).expect("cage");
+    let mesh = pmvc::formats::load_mesh(&data.join("ManHead.obj")).expect("mesh");
+    let (cage, _) = pmvc::formats::load_cage(&data.join("ManHead_Cage.obj")).expect("cage");
     Some((cage, mesh.mesh.positions))
 }
 
@@ -296,8 +296,8 @@ fn a_real_model_binds_the_same_far_from_the_origin() {
 mod command_line {
     use super::*;
     use crate::common::*;
-    use pmvc::coords::npy::{read_npy, ExpectedArray};
-    use pmvc::coords::npz::read_npz;
+    use pmvc::formats::npy::{read_npy, ExpectedArray};
+    use pmvc::formats::npz::read_npz;
 
     /// What `pmvc check` says about one scene, the parts that must not move.
     #[derive(Debug, PartialEq)]
@@ -421,7 +421,7 @@ mod command_line {
             path_str(&out),
         ]);
         assert!(output.status.success(), "{name}: {}", stderr(&output));
-        let moved = pmvc::geometry::load_mesh(&out).expect("deformed mesh");
+        let moved = pmvc::formats::load_mesh(&out).expect("deformed mesh");
         moved
             .mesh
             .positions

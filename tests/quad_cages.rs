@@ -3,8 +3,9 @@
 //! its triangles are classified, and what `pmvc check` reports about the split.
 
 use glam::DVec3;
+use pmvc::formats::load_cage;
 use pmvc::geometry::procedural_quads::{cage_from_polygons, twisted_box};
-use pmvc::geometry::{classify_points, load_cage, CageError, PointClass, QuadSplit};
+use pmvc::geometry::{classify_points, CageError, PointClass, QuadSplit};
 use std::process::Command;
 
 fn cube_positions() -> Vec<DVec3> {

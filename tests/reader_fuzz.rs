@@ -10,7 +10,7 @@ mod common;
 
 use common::Random;
 use glam::DVec3;
-use pmvc::geometry::{parse_mesh, LoadError, MeshFile};
+use pmvc::formats::{parse_mesh, LoadError, MeshFile};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
@@ -180,8 +180,8 @@ fn the_unmutated_files_read_as_written() {
 
 // Weights files: `.npy` and `.npz` headers and lengths, mutated.
 
-use pmvc::coords::npy::{read_npy, ExpectedArray, NpyError};
-use pmvc::coords::npz::read_npz;
+use pmvc::formats::npy::{read_npy, ExpectedArray, NpyError};
+use pmvc::formats::npz::read_npz;
 
 /// The shape every valid case has: 2 mesh vertices, a cage of 4 vertices and 4
 /// triangles.

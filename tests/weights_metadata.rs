@@ -1,15 +1,15 @@
-//! The metadata and class mask written beside weights (coords::metadata): what
+//! The metadata and class mask written beside weights (formats::metadata): what
 //! a reader gets back is what was bound, a file for other inputs is refused by
 //! naming the field, broken metadata is refused by naming the line, and the
 //! three files are replaced together or not at all.
 
 use glam::DVec3;
-use pmvc::coords::metadata::{
+use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method};
+use pmvc::formats::metadata::{
     classes_path, load_weights_set, metadata_path, read_classes_npy, read_metadata,
     save_weights_set, BindRecord, MetadataError, WeightsMetadata, CLASS_INSIDE, CLASS_ON_CAGE,
     CLASS_OUTSIDE,
 };
-use pmvc::coords::{bind_cpu, BindOptions, BindProgress, Method};
 use pmvc::geometry::procedural;
 use pmvc::geometry::{classify_points, Cage};
 use std::path::Path;
@@ -66,7 +66,7 @@ fn bind_and_save(dir: &Path, method: Method) -> (std::path::PathBuf, Cage, Vec<D
     };
     let path = dir.join(format!("W.{extension}"));
     let metadata = cpu_metadata(options, &cage, &points, &classes, &path);
-    let codes = pmvc::coords::metadata::class_codes(&classes);
+    let codes = pmvc::formats::metadata::class_codes(&classes);
     save_weights_set(&path, &weights, &metadata, &codes).unwrap();
     let loaded = load_weights_set(&path).unwrap();
     assert_eq!(

@@ -5,7 +5,7 @@
 //! A proposal belongs to the mesh it was generated around: if the document's
 //! mesh changes meanwhile (undo, another file), the proposal is dropped.
 
-use crate::geometry::autocage::{
+use crate::cagegen::{
     generate_cage, AutoCageError, CageOptions, CageStart, CageStats, GeneratedCage, StartReason,
     DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };

@@ -11,11 +11,12 @@ use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
 use crate::coords::Method;
-use crate::geometry::shown_path;
-use crate::geometry::{
-    load_cage, load_mesh, refuse_same_file, subdivide_midpoint, write_cage_and_pose,
-    write_deformed_mesh, write_mesh_with_normals, write_obj, MeshFile, TriMesh,
+use crate::formats::shown_path;
+use crate::formats::{
+    load_cage, load_mesh, refuse_same_file, write_cage_and_pose, write_deformed_mesh,
+    write_mesh_with_normals, write_obj, MeshFile,
 };
+use crate::geometry::{subdivide_midpoint, TriMesh};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
@@ -343,7 +344,7 @@ pub fn save_session(
 /// shape, each named pose as a morph target named after it, and the timeline's
 /// keys, when it has two or more, as the animation.
 pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<String, String> {
-    use crate::geometry::gltf::{write_gltf, AnimationKey, GltfPose, GltfScene};
+    use crate::formats::gltf::{write_gltf, AnimationKey, GltfPose, GltfScene};
     refuse_overwriting_open_files(path, current)?;
     if current.weights(method).is_none() {
         return Err(format!(
@@ -379,7 +380,7 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
         None => {
             made = MeshFile {
                 path: PathBuf::from(current.title()),
-                format: crate::geometry::MeshFormat::Obj,
+                format: crate::formats::MeshFormat::Obj,
                 mesh: (**current.mesh()).clone(),
                 obj_text: None,
             };

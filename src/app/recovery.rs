@@ -9,7 +9,7 @@
 
 use super::document::Document;
 use super::session::{save_session, SessionSettings};
-use crate::geometry::shown_path;
+use crate::formats::shown_path;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};

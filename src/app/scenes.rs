@@ -7,10 +7,9 @@
 //! neighbouring prong, and moving one prong drags its neighbours under MVC but not
 //! under PMVC.
 
+use crate::formats::{cage_from_file, parse_mesh, CageLoadError, LoadError, MeshFile};
 use crate::geometry::procedural::{comb_outline, extrude};
-use crate::geometry::{
-    cage_from_file, parse_mesh, Cage, CageLoadError, LoadError, MeshFile, TriMesh,
-};
+use crate::geometry::{Cage, TriMesh};
 use glam::{DVec2, DVec3};
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 use super::exports::save_png;
 use super::scripted_drag::{ScriptedDrag, DRAG_FRAMES, DRAG_START_FRAME};
 use super::ui::statistics::FrameStats;
-use crate::geometry::shown_path;
+use crate::formats::shown_path;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};

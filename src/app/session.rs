@@ -13,12 +13,13 @@ use super::session_checks::{
     camera_in_range, checked_pose, cut_text, inline_cage_defect, view_in_range, Reach,
     SESSION_SIZE_LIMIT,
 };
+use crate::budget::read_limited;
 use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
-use crate::geometry::budget::read_limited;
-use crate::geometry::{
+use crate::formats::{
     load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
-    write_obj, Cage, CageLoadError, LoadError, MeshFile, TriMesh, WriteError,
+    write_obj, CageLoadError, LoadError, MeshFile, WriteError,
 };
+use crate::geometry::{Cage, TriMesh};
 use crate::render::{OrbitCamera, SceneOrigin};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

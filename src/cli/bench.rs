@@ -3,7 +3,8 @@
 //! stdout and optionally as JSON.
 
 use crate::coords::{BindOptions, BindProgress, Method, QuadSplit};
-use crate::geometry::{self, classify_points, procedural, shown_path, Cage};
+use crate::formats::shown_path;
+use crate::geometry::{classify_points, procedural, Cage};
 use crate::gpu::{Backend, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
 use anyhow::{bail, Result};
 use glam::DVec3;
@@ -116,10 +117,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // reported now, not after the whole benchmark.
     let json_output = match &args.json {
         Some(path) => {
-            if let Some(warning) = geometry::extension_warning(path, &["json"], "JSON") {
+            if let Some(warning) = crate::formats::extension_warning(path, &["json"], "JSON") {
                 warn_line!("pmvc: {warning}");
             }
-            Some(geometry::PendingOutput::create(path)?)
+            Some(crate::formats::PendingOutput::create(path)?)
         }
         None => None,
     };
@@ -387,8 +388,8 @@ fn bench_shared_data(
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::new();
     for name in names {
-        let mesh = geometry::load_mesh(&args.data.join(format!("{name}.obj")))?;
-        let (cage, _) = geometry::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
+        let mesh = crate::formats::load_mesh(&args.data.join(format!("{name}.obj")))?;
+        let (cage, _) = crate::formats::load_cage(&args.data.join(format!("{name}_Cage.obj")))?;
         // On a cage with quads, each family as patches and split along the
         // shorter diagonal (as files were bound before quads were patches).
         let splits: &[QuadSplit] = if cage.has_quads() {

@@ -1,7 +1,7 @@
 //! `pmvc bind`: the weights of every mesh vertex, computed whole or in blocks of
 //! rows and written as `.npy` (or Green coordinates' `.npz`), with what a reader
 //! needs to trust them beside them: `W.json` (the family, its parameters, the
-//! backend, the bind's time, the columns, the inputs; [`crate::coords::metadata`])
+//! backend, the bind's time, the columns, the inputs; [`crate::formats::metadata`])
 //! and `W.classes.npy` (each row's class). The three are replaced together or
 //! not at all.
 
@@ -11,12 +11,12 @@ use super::commands::{
 };
 use super::weights_format::{check_weights_format, writes_npz};
 use super::BindArgs;
-use crate::coords::metadata::{
+use crate::formats::metadata::{
     class_codes, classes_path, metadata_path, write_classes_npy_to, BindRecord, WeightsMetadata,
 };
-use crate::coords::npy::{npy_file_bytes, npy_preamble, write_f32_values};
-use crate::coords::npz::{npz_payload_bytes, write_npz};
-use crate::geometry::{
+use crate::formats::npy::{npy_file_bytes, npy_preamble, write_f32_values};
+use crate::formats::npz::{npz_payload_bytes, write_npz};
+use crate::formats::{
     refuse_same_file, refuse_unwritable, resolve_output, shown_path, OutputSet, OutputTarget,
 };
 use crate::gpu::Backend;

@@ -2,15 +2,15 @@
 //! as OBJ, then print what was measured on it.
 
 use crate::app::cage_generation::stats_lines;
-use crate::geometry::autocage::{generate_cage, plan_cage, CageOptions};
-use crate::geometry::shown_path;
-use crate::geometry::{self, PendingOutput};
+use crate::cagegen::{generate_cage, plan_cage, CageOptions};
+use crate::formats::shown_path;
+use crate::formats::PendingOutput;
 use anyhow::{anyhow, Result};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct CageArgs {
-    /// The mesh to enclose (.obj or .off): a triangle mesh, closed or not.
+    /// The mesh to enclose (.obj, .off, .glb or .gltf): a triangle mesh, closed or not.
     #[arg(long, value_name = "MESH")]
     pub mesh: PathBuf,
     /// About how many vertices the cage should have (8 to 20000); the result is
@@ -39,7 +39,7 @@ pub struct CageArgs {
 
 pub(super) fn cage(args: &CageArgs) -> Result<()> {
     super::commands::check_output(&args.out, &[&args.mesh], &["obj"], "an OBJ cage")?;
-    let mesh = geometry::load_mesh(&args.mesh)?;
+    let mesh = crate::formats::load_mesh(&args.mesh)?;
     let options = CageOptions {
         clearance: args.clearance,
         cell_size: args.cell_size,
@@ -60,8 +60,9 @@ pub(super) fn cage(args: &CageArgs) -> Result<()> {
     bar.finish_and_clear();
     let generated = generated.map_err(|error| anyhow!("{}: {error}", shown_path(&args.mesh)))?;
     let cage = &generated.cage;
-    output
-        .finish(|out| geometry::write_polygons_obj_to(out, cage.positions(), &cage.polygons()))?;
+    output.finish(|out| {
+        crate::formats::write_polygons_obj_to(out, cage.positions(), &cage.polygons())
+    })?;
     say!(
         "wrote {}: a cage around {} ({} vertices, {} triangles)",
         shown_path(&args.out),

@@ -2,10 +2,8 @@
 
 use super::{BackendArg, CageInput, CheckArgs, GenerateArgs, MethodChoice};
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Weights};
-use crate::geometry::{
-    self, classify_points, extension_warning, refuse_same_file, shown_path, Cage, MeshFile,
-    OutputSet, PointClasses,
-};
+use crate::formats::{extension_warning, refuse_same_file, shown_path, MeshFile, OutputSet};
+use crate::geometry::{self, classify_points, Cage, PointClasses};
 use crate::gpu::backend_choice::{
     decide, decide_and_open, device_for, BackendRequest, Decision, Work,
 };
@@ -53,8 +51,8 @@ pub(super) struct InputRules<'a> {
 /// Weights rows that cannot fit in memory (`rules.resident_rows`) are an error
 /// before any work on the points.
 pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundInput> {
-    let mesh = geometry::load_mesh(&input.mesh)?;
-    let (cage, report) = geometry::load_cage(&input.cage)?;
+    let mesh = crate::formats::load_mesh(&input.mesh)?;
+    let (cage, report) = crate::formats::load_cage(&input.cage)?;
     let columns = rules.method.columns(&cage);
     let rows = (rules.resident_rows)(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
@@ -285,7 +283,7 @@ pub(super) fn check_output(
     what: &str,
 ) -> Result<()> {
     refuse_same_file(out, inputs)?;
-    crate::geometry::refuse_unwritable(out)?;
+    crate::formats::refuse_unwritable(out)?;
     if let Some(warning) = extension_warning(out, extensions, what) {
         warn_line!("pmvc: {warning}");
     }
@@ -295,7 +293,7 @@ pub(super) fn check_output(
 /// An error before the work starts when a dense `rows` × `cols` weights matrix
 /// cannot fit in the memory left, instead of an abort once it is allocated.
 fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result<()> {
-    use crate::geometry::budget::{bytes_for, check_memory};
+    use crate::budget::{bytes_for, check_memory};
     let bytes = bytes_for(rows as u64, bytes_for(cols as u64, 4));
     check_memory(
         || format!("its weights ({rows} vertices × {cols} columns × 4 bytes)"),
@@ -310,7 +308,7 @@ fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result
 }
 
 pub(super) fn check(args: &CheckArgs) -> Result<()> {
-    let mesh = geometry::load_mesh(&args.input.mesh)?;
+    let mesh = crate::formats::load_mesh(&args.input.mesh)?;
     say!(
         "mesh  {}: {} vertices, {} triangles{}",
         shown_path(&args.input.mesh),
@@ -322,7 +320,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
             ""
         }
     );
-    let (cage, report) = geometry::load_cage(&args.input.cage)?;
+    let (cage, report) = crate::formats::load_cage(&args.input.cage)?;
     let faces = if cage.has_quads() {
         format!(
             "{} quads (bilinear patches) and {} triangles",
@@ -437,8 +435,8 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
         (points, scene.cage)
     };
     outputs.finish(|index, out| match index {
-        0 => geometry::write_obj_to(out, &mesh.positions, &mesh.triangles),
-        _ => geometry::write_obj_to(out, cage.positions(), cage.triangles()),
+        0 => crate::formats::write_obj_to(out, &mesh.positions, &mesh.triangles),
+        _ => crate::formats::write_obj_to(out, cage.positions(), cage.triangles()),
     })?;
     say!(
         "{}: {} mesh vertices ({} triangles) in a {}-vertex cage",

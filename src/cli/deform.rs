@@ -8,10 +8,11 @@ use super::commands::{
 };
 use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
 use super::DeformArgs;
-use crate::coords::metadata::{metadata_path, read_metadata, WeightsMetadata};
 use crate::coords::{BindOptions, Method};
-use crate::geometry::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
-use crate::geometry::{self, bounds_of, find_crossing, shown_path, Cage};
+use crate::formats::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
+use crate::formats::metadata::{metadata_path, read_metadata, WeightsMetadata};
+use crate::formats::shown_path;
+use crate::geometry::{bounds_of, find_crossing, Cage};
 use anyhow::{bail, Result};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -152,7 +153,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     };
     let deformed = deform(&pose);
     if writes_points_npy(&args.out) {
-        geometry::write_points_npy(&args.out, &deformed)?;
+        crate::formats::write_points_npy(&args.out, &deformed)?;
     } else if gltf {
         let shapes: Vec<(String, Vec<DVec3>)> = args
             .poses
@@ -177,7 +178,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             },
         )?;
     } else {
-        geometry::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+        crate::formats::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
     }
     let source = match (&args.weights, &stored) {
         (Some(path), Some(stored)) if stored.metadata.is_some() => format!(
@@ -208,7 +209,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
 /// A pose of the cage read from `path`: its vertices, which must be as many as
 /// the cage's, in order. A pose that crosses itself gets a warning.
 pub(super) fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Vec<DVec3>> {
-    let pose = geometry::load_mesh(path)?;
+    let pose = crate::formats::load_mesh(path)?;
     let (expected, found) = (cage.vertex_count(), pose.mesh.positions.len());
     if found != expected {
         bail!(

@@ -42,7 +42,7 @@ pub(super) fn remove_unfinished_outputs_on_signals() {
         };
         std::thread::spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                crate::geometry::remove_unfinished_outputs();
+                crate::formats::remove_unfinished_outputs();
                 std::process::exit(128 + signal);
             }
         });

@@ -133,7 +133,7 @@ pub struct MethodChoice {
     pub backend: BackendArg,
     /// PMVC on a GPU: the kernel. `auto` takes the tile kernel where the cage
     /// allows it and a cost model predicts it faster, else the band kernel
-    /// (the only one before 2026-11-28: to reproduce earlier GPU weights);
+    /// (what older releases always used: to reproduce their GPU weights);
     /// `tiles` on a cage with quads or over 2,048 vertices is an error. The two
     /// differ where a ray grazes an edge (up to about 1e-4 in a weight, measured).
     #[arg(long, default_value = "auto", value_name = "auto|tiles|bands", value_parser = crate::gpu::PmvcKernel::parse)]
@@ -226,7 +226,7 @@ pub struct CheckArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct EditArgs {
-    /// Mesh to open instead of the bundled scene (.obj or .off). Without a cage
+    /// Mesh to open instead of the bundled scene (.obj, .off, .glb, .gltf or a .npy point set). Without a cage
     /// it opens in a box, with the Generate cage window offering a cage.
     pub mesh: Option<PathBuf>,
     /// Its cage.

@@ -4,7 +4,8 @@
 use super::CheckArgs;
 use crate::coords::split_effect::{split_effect, standard_twist, Spread};
 use crate::coords::{BindOptions, Method};
-use crate::geometry::{shown_path, Cage, PointClass};
+use crate::formats::shown_path;
+use crate::geometry::{Cage, PointClass};
 use anyhow::Result;
 use glam::DVec3;
 

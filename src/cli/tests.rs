@@ -7,7 +7,7 @@ use crate::coords::Method;
 #[test]
 fn an_error_line_quotes_each_cause_once() {
     let io = std::io::Error::other("No space left on device");
-    let error = anyhow::Error::from(crate::geometry::WriteError {
+    let error = anyhow::Error::from(crate::formats::WriteError {
         path: "w.npy".into(),
         source: io,
     })

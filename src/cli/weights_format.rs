@@ -5,10 +5,10 @@
 use super::commands::BoundInput;
 use super::BindArgs;
 use crate::coords::family::ColumnLayout;
-use crate::coords::npy::{read_npy, ExpectedArray};
-use crate::coords::npz::read_npz;
 use crate::coords::{Method, Weights};
-use crate::geometry::shown_path;
+use crate::formats::npy::{read_npy, ExpectedArray};
+use crate::formats::npz::read_npz;
+use crate::formats::shown_path;
 use anyhow::{bail, Result};
 
 /// Whether `method`'s weights are written as two arrays in a `.npz` (φ and ψ)

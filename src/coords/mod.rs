@@ -23,11 +23,7 @@ pub mod cubemap;
 pub mod family;
 pub mod green;
 pub mod harmonic;
-pub mod metadata;
 pub mod mvc;
-pub mod npy;
-pub use crate::geometry::npy_header;
-pub mod npz;
 pub mod pmvc;
 pub mod qmvc;
 pub mod quality;
@@ -315,7 +311,7 @@ pub enum BindFailure {
     #[error(transparent)]
     Parameter(#[from] ParameterError),
     #[error(transparent)]
-    TooLarge(#[from] crate::geometry::budget::TooLarge),
+    TooLarge(#[from] crate::budget::TooLarge),
 }
 
 impl From<harmonic::HarmonicError> for BindFailure {
@@ -352,9 +348,9 @@ pub fn bind_cpu(
         return Ok(weights);
     }
     let columns = options.method.columns(cage);
-    crate::geometry::budget::check_memory(
+    crate::budget::check_memory(
         || format!("the weights ({} rows × {columns} columns)", points.len()),
-        crate::geometry::budget::bytes_for(points.len() as u64, 4 * columns as u64),
+        crate::budget::bytes_for(points.len() as u64, 4 * columns as u64),
     )?;
     let mut weights = Weights::zeros(points.len(), columns);
     let rows: Vec<usize> = (0..points.len()).collect();

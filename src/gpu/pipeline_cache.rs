@@ -18,7 +18,7 @@
 //! A file that fails any check is ignored (the caller shows a notice) and
 //! replaced by the next write; nothing here fails a bind.
 
-use crate::geometry::budget::read_limited;
+use crate::budget::read_limited;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"PMVCPLC\0";
@@ -173,7 +173,7 @@ pub fn store(path: &Path, key: &str, data: &[u8]) -> Result<(), String> {
         _ => {}
     }
     let bytes = encode(key, data);
-    crate::geometry::write_atomically(path, |out| out.write_all(&bytes))
+    crate::formats::write_atomically(path, |out| out.write_all(&bytes))
         .map_err(|error| error.to_string())
 }
 

@@ -4,7 +4,7 @@
 //! stay quads. Everything that comes out is a numpy array.
 
 use super::errors::{error, Kind};
-use crate::geometry::budget::{bytes_for, check_memory};
+use crate::budget::{bytes_for, check_memory};
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
@@ -38,7 +38,7 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
             Kind::Input,
             format!(
                 "{what}: shape {} is not (n, 3)",
-                crate::geometry::npy_header::shape_text(
+                crate::formats::npy::header::shape_text(
                     &shape.iter().map(|&n| n as u64).collect::<Vec<_>>()
                 )
             ),

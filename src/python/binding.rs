@@ -8,8 +8,8 @@ use super::arrays::{matrix, positions};
 use super::errors::{error, Kind};
 use super::scene::PyCage;
 use super::weights::PyWeights;
-use crate::coords::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
+use crate::formats::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::geometry::classify_points;
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder, PmvcKernel};
@@ -277,9 +277,9 @@ pub(super) fn bind_points(
     let device = backend.clone();
     let rows = points.len();
     let columns = options.method.columns(&cage.cage);
-    crate::geometry::budget::check_memory(
+    crate::budget::check_memory(
         || format!("the weights ({rows} rows × {columns} columns × 4 bytes)"),
-        crate::geometry::budget::bytes_for(rows as u64, 4 * columns as u64),
+        crate::budget::bytes_for(rows as u64, 4 * columns as u64),
     )
     .map_err(|cause| error(Kind::TooLarge, format!("bind: {cause}")))?;
     let points: Arc<[glam::DVec3]> = points.into();

@@ -2,7 +2,7 @@
 //! (so that they can derive from `ValueError` or `OSError` as well as
 //! `PmvcError`, and carry `path` and `line`); this module raises them.
 
-use crate::geometry::{CageLoadError, LoadError};
+use crate::formats::{CageLoadError, LoadError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::Path;

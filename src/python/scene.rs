@@ -3,10 +3,10 @@
 use super::arrays::{faces_list, positions, positions_array, triangles_array};
 use super::binding::{run_interruptible, Interruptible};
 use super::errors::{cage_load_error, error, load_error, Kind};
+use crate::cagegen::{self, CageOptions};
 use crate::coords::family::ColumnLayout;
-use crate::coords::metadata::class_codes;
 use crate::coords::Method;
-use crate::geometry::autocage::{self, CageOptions};
+use crate::formats::metadata::class_codes;
 use crate::geometry::{self, classify_points, Cage, CageReport};
 use crate::geometry::{polygons_of, triangulate_faces};
 use numpy::{PyArray1, PyArray2};
@@ -37,7 +37,7 @@ impl PyCage {
     fn validated(mesh: geometry::TriMesh, path: Option<PathBuf>, py: Python<'_>) -> PyResult<Self> {
         let mut faces = polygons_of(&mesh);
         let (cage, report) = py.detach(|| Cage::new(mesh)).map_err(|cause| match &path {
-            Some(path) => cage_load_error(&geometry::CageLoadError::Invalid {
+            Some(path) => cage_load_error(&crate::formats::CageLoadError::Invalid {
                 path: path.clone(),
                 source: cause,
             }),
@@ -77,7 +77,7 @@ impl PyCage {
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let file = py
-            .detach(|| geometry::load_mesh(&path))
+            .detach(|| crate::formats::load_mesh(&path))
             .map_err(|cause| load_error(&cause))?;
         Self::validated(file.mesh, Some(path), py)
     }
@@ -167,7 +167,7 @@ impl PyCage {
             self.cage.triangle_count(),
             self.path
                 .as_ref()
-                .map(|p| format!(", from {}", geometry::shown_path(p)))
+                .map(|p| format!(", from {}", crate::formats::shown_path(p)))
                 .unwrap_or_default()
         )
     }
@@ -179,7 +179,7 @@ impl PyCage {
 #[pyfunction]
 pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
     let file = py
-        .detach(|| geometry::load_mesh(&path))
+        .detach(|| crate::formats::load_mesh(&path))
         .map_err(|cause| load_error(&cause))?;
     let vertices = positions_array(py, &file.mesh.positions)?;
     let faces = faces_list(py, &polygons_of(&file.mesh))?;
@@ -225,7 +225,7 @@ pub(super) fn generate_cage<'py>(
             Kind::Parameter,
             format!(
                 "generate_cage: target {target}: a cage needs at least {} vertices",
-                autocage::MIN_TARGET_VERTICES
+                cagegen::MIN_TARGET_VERTICES
             ),
         )
     })?;
@@ -238,7 +238,7 @@ pub(super) fn generate_cage<'py>(
         quads,
         ..CageOptions::new(target)
     };
-    autocage::plan_cage(&mesh, &options).map_err(|cause| autocage_error(&cause))?;
+    cagegen::plan_cage(&mesh, &options).map_err(|cause| cagegen_error(&cause))?;
     const TOTAL: u32 = 1000;
     let done = AtomicU32::new(0);
     let cancelled = AtomicBool::new(false);
@@ -248,13 +248,13 @@ pub(super) fn generate_cage<'py>(
         done: &|| (done.load(Ordering::Relaxed) as usize, TOTAL as usize),
     };
     let generated = run_interruptible(py, task, || {
-        autocage::generate_cage(&mesh, &options, &|fraction| {
+        cagegen::generate_cage(&mesh, &options, &|fraction| {
             let thousandths = (fraction.clamp(0.0, 1.0) * TOTAL as f32) as u32;
             done.fetch_max(thousandths, Ordering::Relaxed);
             !cancelled.load(Ordering::Relaxed)
         })
     })?
-    .map_err(|cause| autocage_error(&cause))?;
+    .map_err(|cause| cagegen_error(&cause))?;
     let stats = &generated.stats;
     let report = PyDict::new(py);
     report.set_item("vertices", stats.vertices)?;
@@ -277,7 +277,7 @@ pub(super) fn generate_cage<'py>(
     report.set_item("start", stats.start.name())?;
     report.set_item(
         "start_reason",
-        stats.start_reason.map(autocage::StartReason::name),
+        stats.start_reason.map(cagegen::StartReason::name),
     )?;
     report.set_item("merge_distance", stats.merge_distance())?;
     report.set_item("reach", stats.reach)?;
@@ -305,8 +305,8 @@ pub(super) fn generate_cage<'py>(
     Ok((cage, report))
 }
 
-fn autocage_error(cause: &autocage::AutoCageError) -> PyErr {
-    use autocage::AutoCageError as E;
+fn cagegen_error(cause: &cagegen::AutoCageError) -> PyErr {
+    use cagegen::AutoCageError as E;
     let kind = match cause {
         E::TooFewVertices { .. } | E::TooManyVertices { .. } => Kind::Parameter,
         E::BadClearance { .. } | E::BadCellSize { .. } => Kind::Parameter,

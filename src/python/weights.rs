@@ -1,17 +1,17 @@
 //! The `Weights` class, `save_weights` and `load_weights`: a bind's matrix with
-//! its class mask and metadata (`coords::metadata`, the files `pmvc bind`
+//! its class mask and metadata (`formats::metadata`, the files `pmvc bind`
 //! writes beside its weights).
 
 use super::errors::{error, file_error, Kind};
 use super::scene::PyCage;
+use crate::budget::{bytes_for, check_memory};
 use crate::coords::family::ColumnLayout;
-use crate::coords::metadata::{
+use crate::coords::{BindOptions, Method, Weights};
+use crate::formats::metadata::{
     classes_path, load_weights_set, save_weights_set, MetadataError, WeightsMetadata,
 };
-use crate::coords::npy::row_sum_off;
-use crate::coords::{BindOptions, Method, Weights};
-use crate::geometry::budget::{bytes_for, check_memory};
-use crate::geometry::shown_path;
+use crate::formats::npy::row_sum_off;
+use crate::formats::shown_path;
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -76,7 +76,7 @@ impl PyWeights {
                 format!(
                     "{}: the matrix has shape {}, but the weights are ({rows}, {columns})",
                     shown_path(&self.shown()),
-                    crate::geometry::npy_header::shape_text(
+                    crate::formats::npy::header::shape_text(
                         &shape.iter().map(|&n| n as u64).collect::<Vec<_>>()
                     )
                 ),

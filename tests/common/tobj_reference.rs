@@ -9,7 +9,8 @@
 //! The coordinates themselves are read here, in f64.
 
 use glam::DVec3;
-use pmvc::geometry::{triangulate_polygon, LoadError, MeshFile, MeshFormat, TriMesh};
+use pmvc::formats::{LoadError, MeshFile, MeshFormat};
+use pmvc::geometry::{triangulate_polygon, TriMesh};
 use std::path::Path;
 
 /// Largest vertex ordinal that survives the round trip through tobj's f32 positions.

@@ -383,7 +383,7 @@ impl EditorApp {
             Ok(pose) => {
                 self.apply(Command::edit_pose(pose));
                 self.apply(Command::MarkSaved);
-                self.info(format!("loaded pose {}", crate::geometry::shown_path(path)));
+                self.info(format!("loaded pose {}", crate::formats::shown_path(path)));
                 true
             }
             Err(error) => {

@@ -81,7 +81,7 @@ impl EditorApp {
                 crate::app::recovery::discard(path);
                 self.info(format!(
                     "discarded the autosaved work {}",
-                    crate::geometry::shown_path(path)
+                    crate::formats::shown_path(path)
                 ));
             }
             RecoverAnswer::Restore => {

@@ -9,7 +9,8 @@
 
 use crate::app::scenes::BundledScene;
 use crate::coords::{BindOptions, Method, WeightQuality, Weights, WeightsId};
-use crate::geometry::{Cage, MeshFile, TriMesh};
+use crate::formats::MeshFile;
+use crate::geometry::{Cage, TriMesh};
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

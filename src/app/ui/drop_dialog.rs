@@ -6,7 +6,7 @@
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
 use crate::app::editor::FileRole;
-use crate::geometry::{load_mesh, MeshFile};
+use crate::formats::{load_mesh, MeshFile};
 use std::path::PathBuf;
 
 /// A session file (`*.json`, as File > Save session writes them): dropped, it

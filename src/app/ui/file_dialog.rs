@@ -6,7 +6,7 @@
 
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
-use crate::geometry::shown_path;
+use crate::formats::shown_path;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

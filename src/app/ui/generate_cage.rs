@@ -8,7 +8,7 @@ use crate::app::cage_generation::{
     bridged_legend, stats_lines, CageGeneration, BRIDGED_GAP_ORANGE, PROPOSAL_GREEN,
 };
 use crate::app::ctx::PanelContext;
-use crate::geometry::autocage::{
+use crate::cagegen::{
     DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, FINEST_CELL_SIZE_FOR_GAPS, MAX_TARGET_VERTICES,
     MIN_TARGET_VERTICES,
 };

@@ -5,7 +5,7 @@
 use crate::app::actions::Action;
 use crate::app::ctx::PanelContext;
 use crate::app::recovery::LeftBehind;
-use crate::geometry::shown_path;
+use crate::formats::shown_path;
 
 /// The user's answer about a recovery file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

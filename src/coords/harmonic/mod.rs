@@ -159,7 +159,7 @@ pub fn plan(cage: &Cage, grid: u32, points: usize) -> Result<HarmonicPlan, Harmo
 
 /// Refuse a plan that would not fit, naming a grid that would.
 fn check_memory(cage: &Cage, plan: &HarmonicPlan, points: usize) -> Result<(), HarmonicError> {
-    let Some(available) = crate::geometry::budget::available_memory() else {
+    let Some(available) = crate::budget::available_memory() else {
         return Ok(());
     };
     let budget = (available as f64 * MEMORY_SHARE) as u64;

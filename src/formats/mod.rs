@@ -1,0 +1,59 @@
+//! Every file pmvc reads or writes: meshes and cages (OBJ, OFF, glTF 2.0, `.npy`
+//! point sets), coloured PLY, weights (`.npy`, Green's `.npz`) with their
+//! metadata and class masks, and outputs that are written whole or not at all.
+//! Readers predict their memory through `budget` before they allocate and name
+//! the file, the 1-based line or element, and what is wrong.
+//!
+//! Imports `geometry`, `coords` (the families that weights files describe) and
+//! `budget`; never wgpu or egui.
+
+mod error;
+pub mod gltf;
+mod io;
+pub mod metadata;
+pub mod npy;
+pub mod npz;
+mod obj;
+mod off;
+mod output;
+mod ply;
+
+pub use crate::budget::human_bytes;
+pub use error::{shown_path, CageLoadError, LoadError, WriteError};
+pub use io::{
+    cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
+    write_mesh_with_normals, write_obj, write_obj_to, write_polygons_obj_to,
+};
+pub use npy::points::write_points_npy;
+pub use output::{
+    extension_warning, refuse_same_file, refuse_unwritable, remove_unfinished_outputs,
+    resolve_output, write_atomically, OutputSet, OutputTarget, PendingOutput, WriteSeek,
+};
+pub use ply::{colour_byte, write_coloured_ply};
+
+use crate::geometry::TriMesh;
+use std::path::PathBuf;
+
+/// The file format a mesh was read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    Obj,
+    Off,
+    /// An (n, 3) float32 or float64 NumPy array: a point set.
+    Npy,
+    /// glTF 2.0, binary (`.glb`) or JSON (`.gltf`): one mesh of it ([`gltf`]).
+    Gltf,
+}
+
+/// A mesh as read from a file, with what is needed to write it back deformed.
+#[derive(Clone, Debug)]
+pub struct MeshFile {
+    pub path: PathBuf,
+    pub format: MeshFormat,
+    pub mesh: TriMesh,
+    /// The original text of an OBJ file: a deformed copy keeps its faces, texture
+    /// coordinates, groups and materials by rewriting only the `v` lines. For a
+    /// glTF file, OBJ text written from its mesh (positions, texture coordinates,
+    /// primitives as groups), which is what was parsed.
+    pub obj_text: Option<String>,
+}
