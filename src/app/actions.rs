@@ -1,17 +1,14 @@
 //! What panels and shortcuts ask the editor to do, as values (egui's demo app
-//! returns its commands the same way). The editor's one runner
-//! (`editor/runner.rs`) carries them out: actions do the I/O, and what changes
-//! the document goes on to the model as a [`Command`].
+//! returns its commands the same way), and the small types an action carries:
+//! which file, which side to look from, the dialogs' answers. The editor's one
+//! runner (`editor/runner.rs`) carries them out: actions do the I/O, and what
+//! changes the document goes on to the model as a [`Command`]. A leaf: it
+//! imports nothing of the editor or the panels, so both can depend on it.
 
+use super::commands::Command;
 use super::compare::ViewSettings;
-use super::editor::FileRole;
-use super::model::Command;
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
-use super::shortcuts::ViewSide;
-use super::ui::file_dialog::FileAction;
-use super::ui::recovery_dialog::RecoverAnswer;
-use super::ui::unsaved_dialog::UnsavedAnswer;
 use crate::coords::{Method, Parameter};
 use glam::DVec3;
 use std::path::PathBuf;
@@ -151,4 +148,81 @@ pub enum CageRequest {
     Cancel,
     /// Use the proposal as the cage.
     Use,
+}
+
+/// Which kind of file is being opened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileRole {
+    Mesh,
+    Cage,
+}
+
+/// What a file dialog is asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileAction {
+    OpenMesh,
+    OpenCage,
+    LoadPose,
+    SavePose,
+    /// The rest cage, polygons kept, and its pose beside it.
+    SaveCage,
+    ExportMesh,
+    OpenSession,
+    SaveSession,
+    SaveImage,
+    ExportColouredMesh,
+    /// The deformed mesh as glTF, named poses as morph targets, the timeline
+    /// as its animation.
+    ExportGltf,
+}
+
+/// A side to look at the scene from, as Blender's numpad views: the scene's y
+/// axis is up, and the front looks along −z.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewSide {
+    Front,
+    Back,
+    Right,
+    Left,
+    Top,
+    Bottom,
+}
+
+impl ViewSide {
+    /// The camera's yaw and pitch (radians) for this side.
+    pub fn yaw_pitch(self) -> (f32, f32) {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        match self {
+            ViewSide::Front => (0.0, 0.0),
+            ViewSide::Back => (PI, 0.0),
+            ViewSide::Right => (FRAC_PI_2, 0.0),
+            ViewSide::Left => (-FRAC_PI_2, 0.0),
+            ViewSide::Top => (0.0, FRAC_PI_2),
+            ViewSide::Bottom => (0.0, -FRAC_PI_2),
+        }
+    }
+}
+
+/// The user's answer to "Save changes before quitting (or opening)?".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnsavedAnswer {
+    /// Save the session (where it came from, else ask a name), then go on.
+    SaveSession,
+    /// Save the pose as OBJ, then go on: offered when only the pose is unsaved.
+    SavePose,
+    /// Go on without saving.
+    Discard,
+    /// Neither save nor go on.
+    Cancel,
+}
+
+/// The user's answer about a recovery file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecoverAnswer {
+    /// Open it as unsaved work.
+    Restore,
+    /// Delete it.
+    Discard,
+    /// Keep it for the next start.
+    Later,
 }

@@ -13,7 +13,7 @@ use crate::coords::{BindOptions, Method, Parameter, QuadSplit, QuadSupport};
 /// returned as a message.
 pub(super) fn with_asked_parameters(
     options: &mut crate::coords::BindOptions,
-    asked: &super::EditorOptions,
+    asked: &super::options::EditorOptions,
 ) -> Vec<String> {
     let mut refused = Vec::new();
     if let Some(split) = asked.triangulate {

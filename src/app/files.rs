@@ -4,25 +4,67 @@
 //! poses and deformed meshes. Nothing here touches the editor: a file that fails
 //! to load or validate is an error message, and the scene stays as it was.
 
+use super::actions::FileRole;
 use super::cage_generation::{cage_reaches, loose_box_cage, Proposal};
+use super::compare::ViewSettings;
 use super::document::Document;
-use super::editor::{Cameras, FileRole, Replacement};
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
-use crate::coords::Method;
+use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
 use crate::formats::{
     load_cage, load_mesh, refuse_same_file, write_cage_and_pose, write_deformed_mesh,
     write_mesh_with_normals, write_obj, MeshFile,
 };
 use crate::geometry::{subdivide_midpoint, TriMesh};
+use crate::render::OrbitCamera;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 pub(super) fn file_title(path: &Path) -> String {
     path.file_name()
         .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned())
+}
+
+/// Where the cameras go when the document is replaced.
+pub(super) enum Cameras {
+    /// Frame the new document.
+    Frame,
+    /// Stay where they are (a cage edit on the same mesh).
+    Keep,
+    /// A session's cameras.
+    Session(Vec<OrbitCamera>),
+}
+
+/// A whole-document replacement and what comes with it.
+pub(super) struct Replacement {
+    pub document: Document,
+    /// What undo calls it ("open cage.obj").
+    pub action: String,
+    pub cameras: Cameras,
+    /// A session's bind options and view settings.
+    pub settings: Option<(BindOptions, ViewSettings)>,
+}
+
+impl Replacement {
+    /// `document` replacing the current one by `action`, framed.
+    pub(super) fn framed(document: Document, action: impl Into<String>) -> Self {
+        Self {
+            document,
+            action: action.into(),
+            cameras: Cameras::Frame,
+            settings: None,
+        }
+    }
+
+    /// `document` replacing the current one by `action`, the cameras kept.
+    pub(super) fn in_place(document: Document, action: impl Into<String>) -> Self {
+        Self {
+            cameras: Cameras::Keep,
+            ..Self::framed(document, action)
+        }
+    }
 }
 
 /// A new document and what comes with it.

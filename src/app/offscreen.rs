@@ -4,7 +4,7 @@
 //! time drags. Each frame waits for the GPU to finish it, as presenting does.
 
 use super::editor::EditorApp;
-use super::{EditorError, EditorOptions, SCRIPTED_WINDOW_SIZE};
+use super::options::{editor_device_descriptor, EditorError, EditorOptions, SCRIPTED_WINDOW_SIZE};
 use eframe::egui_wgpu::{self, RenderState, ScreenDescriptor};
 use egui::{ViewportCommand, ViewportId};
 use std::sync::Arc;
@@ -73,7 +73,7 @@ pub fn run_offscreen(options: EditorOptions) -> Result<(), EditorError> {
 /// A render state with no surface, on the adapter and limits a window would get.
 async fn offscreen_render_state() -> Result<RenderState, EditorError> {
     let setup = egui_wgpu::WgpuSetup::CreateNew(egui_wgpu::WgpuSetupCreateNew {
-        device_descriptor: Arc::new(super::editor_device_descriptor),
+        device_descriptor: Arc::new(editor_device_descriptor),
         ..egui_wgpu::WgpuSetupCreateNew::without_display_handle()
     });
     let instance = setup.new_instance().await;

@@ -1,55 +1,16 @@
 //! The CPU read-outs behind the views: the mesh deformed per method (hover
 //! picking, the difference's colour bar) and the ranges the colour bars report.
-//! Cached, and invalidated by the document's changes, so a drag frame computes
-//! nothing here unless a colour bar needs it.
+//! Cached (the cache, `ReadoutCache`, is defined with `Views`, which holds it),
+//! and invalidated by the document's changes, so a drag frame computes nothing
+//! here unless a colour bar needs it.
 
 use super::compare::{self, Pane, ValueRange};
-use super::document::{Changes, Document};
+use super::document::Document;
 use super::views::Views;
 use crate::coords::{Method, WeightsId};
 use crate::render::{Colouring, Shading};
 use glam::Vec3;
-use std::collections::BTreeMap;
 use std::sync::Arc;
-
-/// A range is keyed by what it shows and the methods it reads.
-type RangeKey = (Colouring, Method, Option<WeightsId>);
-
-#[derive(Default)]
-pub struct ReadoutCache {
-    /// The mesh deformed per method, with the pose revision it was made for.
-    deformed: BTreeMap<WeightsId, (u64, Arc<Vec<Vec3>>)>,
-    /// Colour-bar ranges (a row-minimum scan of a large matrix is too slow to
-    /// repeat every frame).
-    ranges: Vec<(RangeKey, Option<ValueRange>)>,
-}
-
-impl ReadoutCache {
-    pub fn clear(&mut self) {
-        self.deformed.clear();
-        self.ranges.clear();
-    }
-
-    /// Forget what `changes` make stale.
-    pub fn invalidate(&mut self, changes: &Changes) {
-        if changes.scene {
-            self.clear();
-            return;
-        }
-        for method in &changes.weights {
-            self.deformed.remove(method);
-        }
-        let weights_changed = |key: &RangeKey| {
-            changes.weights.contains(&WeightsId::of(key.1))
-                || key.2.is_some_and(|id| changes.weights.contains(&id))
-        };
-        // Distances depend on the pose; weights and their ranges do not.
-        self.ranges.retain(|(key, _)| {
-            let distance_moved = changes.pose && key.0 == Colouring::MethodDistance;
-            !(weights_changed(key) || distance_moved)
-        });
-    }
-}
 
 impl Views {
     /// The mesh deformed with `method` on the CPU for the current pose (cached).

@@ -216,7 +216,8 @@ mod tests {
 
     #[test]
     fn an_autosave_is_due_a_minute_after_work_changed_and_not_again_until_it_changes() {
-        use crate::app::model::{Command, Model};
+        use crate::app::commands::Command;
+        use crate::app::model::Model;
         use crate::app::scenes;
         let dir = tempfile::tempdir().unwrap();
         let mut recovery = Recovery::new(dir.path());

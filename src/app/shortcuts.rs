@@ -3,9 +3,8 @@
 //! (`editor/frame.rs` reads them each frame). A transform under way (G, R, S)
 //! steers with its own keys (`viewport/modal.rs`) until it ends.
 
-use super::actions::Action;
-use super::model::{Command, Selection};
-use super::ui::file_dialog::FileAction;
+use super::actions::{Action, FileAction, ViewSide};
+use super::commands::{Command, Selection};
 use super::viewport::TransformKind;
 use egui::{Key, Modifiers};
 
@@ -33,32 +32,8 @@ pub enum Shortcut {
     OpenSession,
 }
 
-/// A side to look at the scene from, as Blender's numpad views: the scene's y
-/// axis is up, and the front looks along −z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ViewSide {
-    Front,
-    Back,
-    Right,
-    Left,
-    Top,
-    Bottom,
-}
-
+// What Help > Shortcuts says of each side.
 impl ViewSide {
-    /// The camera's yaw and pitch (radians) for this side.
-    pub fn yaw_pitch(self) -> (f32, f32) {
-        use std::f32::consts::{FRAC_PI_2, PI};
-        match self {
-            ViewSide::Front => (0.0, 0.0),
-            ViewSide::Back => (PI, 0.0),
-            ViewSide::Right => (FRAC_PI_2, 0.0),
-            ViewSide::Left => (-FRAC_PI_2, 0.0),
-            ViewSide::Top => (0.0, FRAC_PI_2),
-            ViewSide::Bottom => (0.0, -FRAC_PI_2),
-        }
-    }
-
     fn describe(self) -> &'static str {
         match self {
             ViewSide::Front => "View from the front (+z)",

@@ -11,12 +11,17 @@
 
 use super::actions::Action;
 use super::cage_generation::Proposal;
-use super::compare::ViewSettings;
-use super::model::{Applied, Command, Model, Outcome};
+use super::commands::Command;
+use super::compare::{ValueRange, ViewSettings};
+use super::document::Changes;
+use super::model::{Applied, Model, Outcome};
 use super::pose_tools::PoseToolSettings;
-use super::readouts::ReadoutCache;
 use super::viewport::ViewportState;
-use crate::coords::Method;
+use crate::coords::{Method, WeightsId};
+use crate::render::Colouring;
+use glam::Vec3;
+use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// What the viewport shows and keeps.
 #[derive(Default)]
@@ -36,6 +41,46 @@ impl Views {
             settings,
             ..Self::default()
         }
+    }
+}
+
+/// A range is keyed by what it shows and the methods it reads.
+type RangeKey = (Colouring, Method, Option<WeightsId>);
+
+/// The read-outs computed so far (`readouts.rs` computes them).
+#[derive(Default)]
+pub struct ReadoutCache {
+    /// The mesh deformed per method, with the pose revision it was made for.
+    pub(super) deformed: BTreeMap<WeightsId, (u64, Arc<Vec<Vec3>>)>,
+    /// Colour-bar ranges (a row-minimum scan of a large matrix is too slow to
+    /// repeat every frame).
+    pub(super) ranges: Vec<(RangeKey, Option<ValueRange>)>,
+}
+
+impl ReadoutCache {
+    pub fn clear(&mut self) {
+        self.deformed.clear();
+        self.ranges.clear();
+    }
+
+    /// Forget what `changes` make stale.
+    pub fn invalidate(&mut self, changes: &Changes) {
+        if changes.scene {
+            self.clear();
+            return;
+        }
+        for method in &changes.weights {
+            self.deformed.remove(method);
+        }
+        let weights_changed = |key: &RangeKey| {
+            changes.weights.contains(&WeightsId::of(key.1))
+                || key.2.is_some_and(|id| changes.weights.contains(&id))
+        };
+        // Distances depend on the pose; weights and their ranges do not.
+        self.ranges.retain(|(key, _)| {
+            let distance_moved = changes.pose && key.0 == Colouring::MethodDistance;
+            !(weights_changed(key) || distance_moved)
+        });
     }
 }
 

@@ -2,21 +2,22 @@
 //! reads a part, or does what a panel's action or a shortcut does, through
 //! the same runner and model.
 
-use super::{EditorApp, FileRole};
-use crate::app::actions::{Action, BlendStep, CageRequest};
+use super::EditorApp;
+use crate::app::actions::{Action, BlendStep, CageRequest, FileAction, FileRole};
 use crate::app::bind_queue::JobStatus;
 use crate::app::cage_generation::CageGeneration;
+use crate::app::commands::{Command, Selection};
 use crate::app::compare::{HoverReadout, Pane, ValueRange, ViewSettings};
 use crate::app::document::Document;
-use crate::app::model::{Command, Selection, Unsaved};
+use crate::app::model::Unsaved;
 use crate::app::pose_tools::{PoseToolSettings, Transform};
+use crate::app::posing;
 use crate::app::recent::{RecentEntry, RecentFiles};
 use crate::app::scenes::BundledScene;
 use crate::app::ui::drop_dialog::DroppedFile;
-use crate::app::ui::file_dialog::FileAction;
 use crate::app::ui::notices::Notices;
 use crate::app::ui::unsaved_dialog::Question;
-use crate::app::viewport::{self, TransformKind};
+use crate::app::viewport::TransformKind;
 use crate::coords::{BindOptions, Method, Parameter};
 use crate::render::{Colouring, OrbitCamera, Shading};
 use glam::DVec3;
@@ -150,7 +151,7 @@ impl EditorApp {
     }
 
     /// The gesture under way, if any.
-    pub fn gesture_under_way(&self) -> Option<crate::app::model::GestureKind> {
+    pub fn gesture_under_way(&self) -> Option<crate::app::commands::GestureKind> {
         self.model.gesture_under_way()
     }
 
@@ -245,7 +246,7 @@ impl EditorApp {
 
     /// Handles with no mirror partner under the symmetry in use.
     pub fn handles_without_partner(&self) -> usize {
-        viewport::handles_without_partner(self.model.document(), &self.panels.pose_tools.tools)
+        posing::handles_without_partner(self.model.document(), &self.panels.pose_tools.tools)
     }
 
     pub fn transform_under_way(&self) -> Option<TransformKind> {
@@ -256,7 +257,7 @@ impl EditorApp {
     /// soft selection and symmetry.
     pub fn pose_transformed(&self, start: &[DVec3], transform: &Transform) -> Vec<DVec3> {
         let tools = &self.panels.pose_tools.tools;
-        viewport::pose_transformed(self.model.document(), tools, start, transform)
+        posing::pose_transformed(self.model.document(), tools, start, transform)
     }
 
     /// The views drawn last frame and their screen rectangles.
@@ -331,7 +332,7 @@ impl EditorApp {
     /// Apply `transform` to the selection as one undo step.
     pub fn transform_selection(&mut self, transform: Transform) {
         let tools = &self.panels.pose_tools.tools;
-        viewport::transform_selection(&mut self.model, tools, transform);
+        posing::transform_selection(&mut self.model, tools, transform);
     }
 
     pub fn frame_scene(&mut self) {

@@ -16,12 +16,14 @@ use super::actions::Action;
 use super::bind_queue::BindQueue;
 use super::binding::{self, Binding};
 use super::cage_generation::CageGeneration;
+use super::commands::{Command, SessionView};
 use super::compare::ViewSettings;
 use super::document::Document;
 use super::exports::ImageRequest;
-use super::files::SceneChange;
+use super::files::{Cameras, Replacement, SceneChange};
 use super::focus::KeyboardFocus;
-use super::model::{Command, Model, Outcome, SessionView, Swapped};
+use super::model::{Model, Outcome, Swapped};
+use super::options::{BindOn, EditorOptions};
 use super::recent::RecentFiles;
 use super::recovery::Recovery;
 use super::scenes::{self, BundledScene};
@@ -37,15 +39,17 @@ use super::ui::statistics::StatisticsPanel;
 use super::ui::timeline::TimelinePanel;
 use super::ui::unsaved_dialog::UnsavedDialog;
 use super::views::Views;
-use super::{BindOn, EditorOptions};
 use crate::coords::{BindOptions, Method, Weights};
 use crate::gpu::{Backend, BackendRequest, GpuContext};
 use crate::render::viewport::MSAA_SAMPLES;
-use crate::render::{OrbitCamera, ViewportRenderer};
+use crate::render::ViewportRenderer;
 use eframe::egui_wgpu;
 use glam::DVec3;
 use std::path::PathBuf;
 use std::sync::Arc;
+
+// `editor::FileRole` stays a path to the type, which is vocabulary (`actions.rs`).
+pub use super::actions::FileRole;
 
 /// The wgpu handles the editor needs outside paint callbacks (uploads, readback).
 pub(super) struct GpuHandles {
@@ -55,53 +59,6 @@ pub(super) struct GpuHandles {
     /// A bind's weights and their copy already on this device, for the upload
     /// of those weights once the model has them.
     pub resident_weights: Option<(Arc<Weights>, wgpu::Buffer)>,
-}
-
-/// Where the cameras go when the document is replaced.
-pub(super) enum Cameras {
-    /// Frame the new document.
-    Frame,
-    /// Stay where they are (a cage edit on the same mesh).
-    Keep,
-    /// A session's cameras.
-    Session(Vec<OrbitCamera>),
-}
-
-/// A whole-document replacement and what comes with it.
-pub(super) struct Replacement {
-    pub document: Document,
-    /// What undo calls it ("open cage.obj").
-    pub action: String,
-    pub cameras: Cameras,
-    /// A session's bind options and view settings.
-    pub settings: Option<(BindOptions, ViewSettings)>,
-}
-
-impl Replacement {
-    /// `document` replacing the current one by `action`, framed.
-    pub(super) fn framed(document: Document, action: impl Into<String>) -> Self {
-        Self {
-            document,
-            action: action.into(),
-            cameras: Cameras::Frame,
-            settings: None,
-        }
-    }
-
-    /// `document` replacing the current one by `action`, the cameras kept.
-    pub(super) fn in_place(document: Document, action: impl Into<String>) -> Self {
-        Self {
-            cameras: Cameras::Keep,
-            ..Self::framed(document, action)
-        }
-    }
-}
-
-/// Which kind of file is being opened.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FileRole {
-    Mesh,
-    Cage,
 }
 
 pub struct EditorApp {

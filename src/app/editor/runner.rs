@@ -3,15 +3,16 @@
 //! writes, returning values) and change the model through commands; this is
 //! also where a finished bind's weights go to the model.
 
-use super::{EditorApp, FileRole, Waiting};
-use crate::app::actions::{Action, BlendStep, CageRequest};
+use super::{EditorApp, Waiting};
+use crate::app::actions::{Action, BlendStep, CageRequest, FileAction, FileRole};
 use crate::app::bind_queue::{Finished, JobError};
+use crate::app::commands::{Command, GestureKind, Selection};
 use crate::app::document::WeightSet;
 use crate::app::files;
-use crate::app::model::{Command, GestureKind, Outcome, Selection};
+use crate::app::model::Outcome;
 use crate::app::recent::RecentEntry;
 use crate::app::session::SessionSettings;
-use crate::app::ui::file_dialog::{DialogAnswer, FileAction};
+use crate::app::ui::file_dialog::DialogAnswer;
 use crate::app::ui::named_poses::blend_poses;
 use crate::render::Colouring;
 use std::path::Path;

@@ -3,12 +3,10 @@
 //! behind.
 
 use super::{EditorApp, Waiting};
-use crate::app::actions::Action;
+use crate::app::actions::{Action, FileAction, RecoverAnswer, UnsavedAnswer};
+use crate::app::commands::Command;
 use crate::app::files::{self, SceneChange};
-use crate::app::model::Command;
-use crate::app::ui::file_dialog::FileAction;
-use crate::app::ui::recovery_dialog::RecoverAnswer;
-use crate::app::ui::unsaved_dialog::{Question, UnsavedAnswer};
+use crate::app::ui::unsaved_dialog::Question;
 use std::path::Path;
 
 impl EditorApp {

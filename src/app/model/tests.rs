@@ -1,6 +1,7 @@
 use super::document::{Changes, Document};
 use super::*;
 use crate::app::compare::ViewSettings;
+use crate::coords::BindOptions;
 use crate::geometry::procedural::cube_cage;
 use crate::geometry::TriMesh;
 

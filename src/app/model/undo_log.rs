@@ -4,7 +4,7 @@
 //! and, when the replacement changed them, the view settings beside it.
 
 use super::document::{Document, NamedPose};
-use super::SessionView;
+use crate::app::commands::SessionView;
 use glam::DVec3;
 use std::sync::Arc;
 

@@ -3,9 +3,8 @@
 //! what it will do. A file's name does not decide: the dataset's
 //! `*_Cage_Deformed.obj` is a pose, not a new rest cage.
 
-use crate::app::actions::Action;
+use crate::app::actions::{Action, FileRole};
 use crate::app::ctx::PanelContext;
-use crate::app::editor::FileRole;
 use crate::formats::{load_mesh, MeshFile};
 use std::path::PathBuf;
 

@@ -5,6 +5,7 @@
 //! folders, lists meshes, and takes a typed path for every file action.
 
 use crate::app::actions::Action;
+pub use crate::app::actions::FileAction;
 use crate::app::ctx::PanelContext;
 use crate::formats::shown_path;
 use std::path::{Path, PathBuf};
@@ -14,25 +15,7 @@ use std::time::{Duration, Instant};
 /// person cancels a dialog that fast.
 const SYSTEM_DIALOG_MIN_TIME: Duration = Duration::from_millis(250);
 
-/// What a file dialog is asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FileAction {
-    OpenMesh,
-    OpenCage,
-    LoadPose,
-    SavePose,
-    /// The rest cage, polygons kept, and its pose beside it.
-    SaveCage,
-    ExportMesh,
-    OpenSession,
-    SaveSession,
-    SaveImage,
-    ExportColouredMesh,
-    /// The deformed mesh as glTF, named poses as morph targets, the timeline
-    /// as its animation.
-    ExportGltf,
-}
-
+// What the dialogs show and list for each action.
 impl FileAction {
     pub fn title(self) -> &'static str {
         match self {

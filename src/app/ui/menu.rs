@@ -3,11 +3,10 @@
 //! The menu bar sees the document, the view settings and the recent files,
 //! and sends an action for every entry chosen.
 
-use crate::app::actions::{Action, CageRequest};
+use crate::app::actions::{Action, CageRequest, FileAction};
 use crate::app::compare::HANDLE_SIZES;
 use crate::app::ctx::PanelContext;
 use crate::app::scenes::BundledScene;
-use crate::app::ui::file_dialog::FileAction;
 use crate::render::viewport::MSAA_SAMPLES;
 
 pub fn menu_bar(ui: &mut egui::Ui, cx: &mut PanelContext) {

@@ -2,7 +2,9 @@
 //! state (a struct, or none for the menu, the toolbar, the side panel's own
 //! sections and the quality table) and draws through a
 //! [`crate::app::ctx::PanelContext`]: read-only views of what it shows, and a
-//! queue of actions. No panel touches the editor itself.
+//! queue of actions. No panel touches the editor itself, nor imports it: what
+//! panels and the editor share (actions, commands, the dialogs' answers) is in
+//! leaf files below both.
 
 pub mod drop_dialog;
 pub mod file_dialog;

@@ -4,9 +4,9 @@
 //! what the slider shows.
 
 use crate::app::actions::{Action, BlendStep};
+use crate::app::commands::{Command, GestureKind};
 use crate::app::ctx::PanelContext;
 use crate::app::document::Document;
-use crate::app::model::{Command, GestureKind};
 use glam::DVec3;
 
 /// The rest-to-pose slider. While it is below 100% the document shows a blend of

@@ -7,7 +7,7 @@ use crate::app::pose_tools::{
     fitted_mirror_offset, mean_edge_length, MirrorPlane, Pivot, PoseToolSettings, AXIS_NAMES,
     MIRROR_TOLERANCES,
 };
-use crate::app::viewport::handles_without_partner;
+use crate::app::posing::handles_without_partner;
 
 /// The section and the settings it owns, which the viewport's edits read.
 #[derive(Default)]

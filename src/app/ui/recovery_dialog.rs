@@ -2,21 +2,10 @@
 //! was killed) is offered back: restore it, discard it, or decide at the next
 //! start.
 
-use crate::app::actions::Action;
+use crate::app::actions::{Action, RecoverAnswer};
 use crate::app::ctx::PanelContext;
 use crate::app::recovery::LeftBehind;
 use crate::formats::shown_path;
-
-/// The user's answer about a recovery file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RecoverAnswer {
-    /// Open it as unsaved work.
-    Restore,
-    /// Delete it.
-    Discard,
-    /// Keep it for the next start.
-    Later,
-}
 
 #[derive(Debug, Default)]
 pub struct RecoveryDialog {

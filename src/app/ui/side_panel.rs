@@ -2,8 +2,8 @@
 //! cancel), quality, the selected handle's position, and the notices.
 
 use crate::app::actions::Action;
+use crate::app::commands::{Command, GestureKind, POSE_EDIT};
 use crate::app::ctx::PanelContext;
-use crate::app::model::{Command, GestureKind, POSE_EDIT};
 use crate::app::ui::named_poses::PoseBlend;
 use crate::app::ui::notices::Notices;
 use crate::app::ui::pose_panel::PosePanel;

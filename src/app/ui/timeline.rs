@@ -5,8 +5,8 @@
 //! keys as the glTF animation.
 
 use crate::app::actions::Action;
+use crate::app::commands::{Command, GestureKind};
 use crate::app::ctx::PanelContext;
-use crate::app::model::{Command, GestureKind};
 use crate::app::timeline::{looped, pose_at, span};
 
 #[derive(Clone, Debug, Default)]

@@ -7,6 +7,7 @@
 //! from disk) is the editor's, which the answer's action resumes or drops.
 
 use crate::app::actions::Action;
+pub use crate::app::actions::UnsavedAnswer;
 use crate::app::ctx::PanelContext;
 use crate::app::model::Unsaved;
 
@@ -16,19 +17,6 @@ pub enum Question {
     Quit,
     /// Opening another scene, by what the editor's notice calls it.
     Open(String),
-}
-
-/// The user's answer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum UnsavedAnswer {
-    /// Save the session (where it came from, else ask a name), then go on.
-    SaveSession,
-    /// Save the pose as OBJ, then go on: offered when only the pose is unsaved.
-    SavePose,
-    /// Go on without saving.
-    Discard,
-    /// Neither save nor go on.
-    Cancel,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -1,29 +1,12 @@
 //! The mouse in the viewport: the drag state machine (orbit, pan, move handles,
 //! box select), the wheel and clicks. Keys are in `shortcuts.rs`.
 
+use super::Drag;
+use crate::app::commands::{Command, GestureKind, Selection, POSE_EDIT};
 use crate::app::compare::Overlay;
-use crate::app::model::{Command, GestureKind, Selection, POSE_EDIT};
 use crate::app::views::{ViewportContext, Views};
-use egui::{Key, PointerButton, Pos2, Rect};
+use egui::{Key, PointerButton, Rect};
 use glam::{DVec3, Vec2};
-
-/// What a mouse drag in the viewport is doing.
-#[derive(Clone, Debug)]
-pub(in crate::app) enum Drag {
-    Orbit,
-    Pan,
-    /// Moving the selected handles (a gesture of the model's, which keeps the
-    /// pose it began from): the total pointer motion since it began, so axis
-    /// constraints can change mid-drag.
-    Move {
-        motion: egui::Vec2,
-    },
-    /// Rubber-band selection from `origin`; `additive` keeps the old selection.
-    Box {
-        origin: Pos2,
-        additive: bool,
-    },
-}
 
 /// The soft-selection radii the wheel reaches during a transform, as fractions
 /// of the cage diagonal: those the Posing tools' slider offers.

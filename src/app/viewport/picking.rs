@@ -1,9 +1,9 @@
 //! Picking: the handle under the cursor, box selection, and the mesh vertex under
 //! the cursor whose weights the hover box reads out.
 
+use crate::app::commands::{Command, Selection};
 use crate::app::compare::{self, HoverReadout};
 use crate::app::document::Document;
-use crate::app::model::{Command, Selection};
 use crate::app::views::{ViewportContext, Views};
 use crate::app::widgets::hover_box;
 use egui::{Pos2, Rect};
