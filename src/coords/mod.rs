@@ -30,7 +30,7 @@ pub mod quality;
 pub mod split_effect;
 
 pub use crate::geometry::QuadSplit;
-use crate::geometry::{Cage, PointClass};
+use crate::geometry::{Cage, PointClass, PointClasses};
 pub use family::{
     FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
     DEFAULT_RESOLUTION,
@@ -110,6 +110,16 @@ impl BindOptions {
             None => std::borrow::Cow::Borrowed(cage),
             Some(split) => std::borrow::Cow::Owned(cage.split_quads(split)),
         }
+    }
+
+    /// Where `points` lie for a bind with these options: classified against the
+    /// cage the family binds ([`Self::cage_to_bind`]), not the cage as given.
+    /// Where quads are split, their triangles decide inside and outside (a
+    /// bilinear patch bulges past one of its two triangles), and a point on the
+    /// surface is on the triangle the bind reads. Binds whose
+    /// [`Self::split_applied`] agree share their classes.
+    pub fn classify(&self, cage: &Cage, points: &[DVec3]) -> PointClasses {
+        crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
     /// How the cage's quads are split for this bind, if they are.
@@ -329,8 +339,8 @@ const ROWS_PER_TASK: usize = 32;
 
 /// Bind `points` to `cage` on the CPU, in parallel.
 ///
-/// `classes` comes from [`crate::geometry::classify_points`] for the same points and
-/// cage; it decides the inside/outside/surface policy described in the module doc.
+/// `classes` comes from [`BindOptions::classify`] for the same points, cage and
+/// options; it decides the inside/outside/surface policy described in the module doc.
 /// Families with a closed form or per-point integral go row by row
 /// ([`bind_rows`]); harmonic coordinates solve over the whole cage first.
 pub fn bind_cpu(

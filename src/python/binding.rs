@@ -10,7 +10,6 @@ use super::scene::PyCage;
 use super::weights::PyWeights;
 use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
 use crate::formats::metadata::{class_codes, BindRecord, WeightsMetadata};
-use crate::geometry::classify_points;
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder, PmvcKernel};
 use numpy::PyArray2;
@@ -176,7 +175,7 @@ fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u
 /// The options of a bind of `method` with `resolution` and `grid`: the
 /// family's own parameter is checked, the others are not read.
 /// A parameter not given keeps its default.
-fn bind_options(
+pub(super) fn bind_options(
     method: Method,
     resolution: Option<&Bound<'_, PyAny>>,
     grid: Option<&Bound<'_, PyAny>>,
@@ -292,7 +291,7 @@ pub(super) fn bind_points(
     let cage_arc = Arc::clone(&cage.cage);
     let bound_points = Arc::clone(&points);
     let (classes, result) = run_interruptible(py, task, || {
-        let classes: Arc<[_]> = classify_points(&cage_arc, &bound_points).classes.into();
+        let classes: Arc<[_]> = options.classify(&cage_arc, &bound_points).classes.into();
         let input = BindInput {
             points: bound_points,
             classes: Arc::clone(&classes),

@@ -7,7 +7,7 @@ use crate::cagegen::{self, CageOptions};
 use crate::coords::family::ColumnLayout;
 use crate::coords::Method;
 use crate::formats::metadata::class_codes;
-use crate::geometry::{self, classify_points, Cage, CageReport};
+use crate::geometry::{self, Cage, CageReport};
 use crate::geometry::{polygons_of, triangulate_faces};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -187,16 +187,25 @@ pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'
 }
 
 /// Where each point lies, int8: 0 inside the cage, 1 on it, 2 outside (by the
-/// generalised winding number, as ``bind`` classes its rows).
+/// generalised winding number), exactly as ``bind`` with the same ``method``
+/// and ``triangulate`` classes its rows: against the cage it binds. Without
+/// them, a cage's quads are bilinear patches; ``triangulate="shorter"`` or
+/// ``"longer"`` classes against the quads split along that diagonal, and
+/// ``method="green"`` against the shorter split Green coordinates bind on.
 #[pyfunction]
+#[pyo3(signature = (points, cage, method=None, triangulate=None))]
 pub(super) fn classify<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
     cage: PyRef<'py, PyCage>,
+    method: Option<&str>,
+    triangulate: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<i8>>> {
+    let method = super::binding::method_from(method.unwrap_or("pmvc"))?;
+    let options = super::binding::bind_options(method, None, None, triangulate.as_ref())?;
     let points = positions(points, "points")?;
     let cage = Arc::clone(&cage.cage);
-    let codes = py.detach(|| class_codes(&classify_points(&cage, &points).classes));
+    let codes = py.detach(|| class_codes(&options.classify(&cage, &points).classes));
     Ok(PyArray1::from_vec(py, codes))
 }
 

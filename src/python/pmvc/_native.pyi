@@ -167,8 +167,16 @@ def deform(
     triangulate, pmvc_kernel)."""
     ...
 
-def classify(points: ArrayLike, cage: Cage) -> npt.NDArray[np.int8]:
-    """Per point: 0 inside the cage, 1 on it, 2 outside (as ``bind``)."""
+def classify(
+    points: ArrayLike,
+    cage: Cage,
+    method: Optional[str] = None,
+    triangulate: Optional[str] = None,
+) -> npt.NDArray[np.int8]:
+    """Per point: 0 inside the cage, 1 on it, 2 outside, as ``bind`` with the
+    same ``method`` and ``triangulate`` classes its rows: against the cage it
+    binds (quads split along a diagonal with ``triangulate``, and for Green
+    coordinates, which bind on triangles)."""
     ...
 
 def generate_cage(
