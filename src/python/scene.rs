@@ -31,11 +31,15 @@ pub(super) struct PyCage {
     faces: Vec<Vec<u32>>,
     report: CageReport,
     pub(super) path: Option<PathBuf>,
+    /// What the cage was validated from: its pickled state. Validating it
+    /// again gives this cage bit for bit (validation is deterministic).
+    source: Arc<geometry::TriMesh>,
 }
 
 impl PyCage {
     fn validated(mesh: geometry::TriMesh, path: Option<PathBuf>, py: Python<'_>) -> PyResult<Self> {
         let mut faces = polygons_of(&mesh);
+        let source = Arc::new(mesh.clone());
         let (cage, report) = py.detach(|| Cage::new(mesh)).map_err(|cause| match &path {
             Some(path) => cage_load_error(&crate::formats::CageLoadError::Invalid {
                 path: path.clone(),
@@ -56,8 +60,75 @@ impl PyCage {
             faces,
             report,
             path,
+            source,
         })
     }
+}
+
+/// A cage from its pickled state (``Cage.__reduce__``): the vertices,
+/// triangles and each triangle's face it was validated from, and its file.
+/// Checked and validated as any cage is, since a pickle is input like any other.
+#[pyfunction]
+#[pyo3(name = "_restore_cage", signature = (vertices, triangles, triangle_faces, path=None))]
+pub(super) fn restore_cage(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    triangles: &Bound<'_, PyAny>,
+    triangle_faces: &Bound<'_, PyAny>,
+    path: Option<PathBuf>,
+) -> PyResult<PyCage> {
+    let what = "pickled cage";
+    let positions = positions(vertices, &format!("{what}: vertices"))?;
+    let rows = super::arrays::faces(triangles, positions.len(), &format!("{what}: triangles"))?;
+    let triangles = rows
+        .iter()
+        .enumerate()
+        .map(|(t, row)| {
+            <[u32; 3]>::try_from(row.as_slice()).map_err(|_| {
+                error(
+                    Kind::Input,
+                    format!("{what}: triangle {t} has {} corners, not 3", row.len()),
+                )
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let triangle_faces: Vec<i64> = triangle_faces.extract().map_err(|_| {
+        error(
+            Kind::Input,
+            format!("{what}: triangle_faces is not a sequence of face indices"),
+        )
+    })?;
+    if triangle_faces.len() != triangles.len() {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "{what}: {} triangle faces for {} triangles",
+                triangle_faces.len(),
+                triangles.len()
+            ),
+        ));
+    }
+    let triangle_faces = triangle_faces
+        .iter()
+        .enumerate()
+        .map(|(t, &face)| {
+            u32::try_from(face).map_err(|_| {
+                error(
+                    Kind::Input,
+                    format!("{what}: triangle {t}'s face {face} is not a face index"),
+                )
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    PyCage::validated(
+        geometry::TriMesh {
+            positions,
+            triangles,
+            triangle_faces,
+        },
+        path,
+        py,
+    )
 }
 
 #[pymethods]
@@ -157,6 +228,30 @@ impl PyCage {
     #[getter]
     fn path(&self) -> Option<PathBuf> {
         self.path.clone()
+    }
+
+    /// Pickling, ``copy`` and ``copy.deepcopy``: the vertices and triangles the
+    /// cage was validated from (float64 and int64 arrays, so a pickle costs
+    /// their bytes) and its file; loading validates them again, which gives
+    /// this cage bit for bit.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.import("pmvc._native")?.getattr("_restore_cage")?;
+        let source = &self.source;
+        let faces: Vec<i64> = source.triangle_faces.iter().map(|&f| f.into()).collect();
+        let path = match &self.path {
+            Some(path) => path.into_pyobject(py)?.into_any(),
+            None => py.None().into_bound(py),
+        };
+        let state = PyTuple::new(
+            py,
+            [
+                positions_array(py, &source.positions)?.into_any(),
+                triangles_array(py, &source.triangles)?.into_any(),
+                PyArray1::from_vec(py, faces).into_any(),
+                path,
+            ],
+        )?;
+        PyTuple::new(py, [restore, state.into_any()])
     }
 
     fn __repr__(&self) -> String {

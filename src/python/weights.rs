@@ -15,8 +15,8 @@ use crate::formats::shown_path;
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-use std::path::PathBuf;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+use std::path::{Path, PathBuf};
 
 /// The weights of a bind: ``matrix`` (float32, one row per point, one column
 /// per entry of ``columns``), ``classes`` (int8 per row: 0 inside, 1 on the
@@ -251,6 +251,29 @@ impl PyWeights {
             .call_method1("loads", (self.metadata.to_json_pretty(),))
     }
 
+    /// Pickling, ``copy`` and ``copy.deepcopy``: the matrix and classes as the
+    /// arrays they are (a pickle costs their bytes, and protocol 5 hands them
+    /// over without a copy), the metadata as ``W.json`` holds it, and the file
+    /// they were read from. Loading checks the metadata as :func:`load_weights`
+    /// does and the arrays against it.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.import("pmvc._native")?.getattr("_restore_weights")?;
+        let path = match &self.path {
+            Some(path) => path.into_pyobject(py)?.into_any(),
+            None => py.None().into_bound(py),
+        };
+        let state = PyTuple::new(
+            py,
+            [
+                self.matrix.bind(py).clone().into_any(),
+                self.classes.bind(py).clone().into_any(),
+                PyString::new(py, &self.metadata.to_json_pretty()).into_any(),
+                path,
+            ],
+        )?;
+        PyTuple::new(py, [restore, state.into_any()])
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Weights({}, {} × {} float32, {})",
@@ -260,6 +283,67 @@ impl PyWeights {
             self.metadata.backend
         )
     }
+}
+
+/// Weights from their pickled state (``Weights.__reduce__``): the metadata
+/// checked as :func:`load_weights` checks ``W.json`` (format, family,
+/// parameters, columns), and the arrays against it.
+#[pyfunction]
+#[pyo3(name = "_restore_weights", signature = (matrix, classes, metadata, path=None))]
+pub(super) fn restore_weights(
+    matrix: &Bound<'_, PyAny>,
+    classes: &Bound<'_, PyAny>,
+    metadata: &str,
+    path: Option<PathBuf>,
+) -> PyResult<PyWeights> {
+    let what = Path::new("pickled weights");
+    let metadata: WeightsMetadata = serde_json::from_str(metadata).map_err(|cause| {
+        error(
+            Kind::Weights,
+            format!("pickled weights: the metadata is not W.json: {cause}"),
+        )
+    })?;
+    let options = metadata
+        .check_consistent(what)
+        .map_err(|cause| error(Kind::Weights, cause.to_string()))?;
+    let (rows, columns) = (metadata.rows, metadata.columns);
+    let matrix = matrix.cast::<PyArray2<f32>>().map_err(|_| {
+        error(
+            Kind::Weights,
+            "pickled weights: the matrix is not a 2-dimensional float32 array",
+        )
+    })?;
+    if matrix.shape() != [rows, columns] {
+        return Err(error(
+            Kind::Weights,
+            format!(
+                "pickled weights: the matrix has shape {}, but the metadata says ({rows}, {columns})",
+                crate::formats::npy::header::shape_text(
+                    &matrix.shape().iter().map(|&n| n as u64).collect::<Vec<_>>()
+                )
+            ),
+        ));
+    }
+    let classes = classes.cast::<PyArray1<i8>>().map_err(|_| {
+        error(
+            Kind::Weights,
+            "pickled weights: the classes are not a 1-dimensional int8 array",
+        )
+    })?;
+    if classes.len() != rows {
+        return Err(error(
+            Kind::Weights,
+            format!("pickled weights: {} classes for {rows} rows", classes.len()),
+        ));
+    }
+    let mut weights = PyWeights::new(
+        matrix.clone().unbind(),
+        classes.clone().unbind(),
+        metadata,
+        options,
+    );
+    weights.path = path;
+    Ok(weights)
 }
 
 /// Write ``weights`` as ``pmvc bind`` writes them: the matrix to ``path``

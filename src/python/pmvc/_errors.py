@@ -30,6 +30,11 @@ class PmvcError(Exception):
         self.path = path
         self.line = line
 
+    def __reduce__(self):
+        # Pickled whole (a Dask worker's error reaches the client so), not
+        # only the message that BaseException keeps in ``args``.
+        return (type(self), (str(self), self.path, self.line))
+
 
 class InputError(PmvcError, ValueError):
     """Arrays or arguments that cannot be used: a shape that is not (n, 3), a

@@ -22,6 +22,7 @@ class Cage:
     0-based vertex indices (quads stay quads; they are cut along their shorter
     diagonal, larger polygons fanned from their first corner). An inward-facing
     cage is flipped (see ``flipped``). Raises InputError or CageError.
+    Pickles and copies exactly (re-validated when loaded).
     """
 
     def __init__(self, vertices: ArrayLike, faces: Sequence[Sequence[int]]) -> None: ...
@@ -72,7 +73,9 @@ class Cage:
         ...
 
 class Weights:
-    """The weights of a bind, and what a reader needs to trust them."""
+    """The weights of a bind, and what a reader needs to trust them. Pickles
+    and copies exactly (the arrays as they are, the metadata checked when
+    loaded)."""
 
     @property
     def matrix(self) -> npt.NDArray[np.float32]:
