@@ -87,18 +87,7 @@ pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundI
 }
 
 fn outside_summary(classes: &PointClasses, total: usize) -> String {
-    let first: Vec<String> = classes.outside.iter().take(5).map(u32::to_string).collect();
-    let more = if classes.outside.len() > 5 {
-        ", …"
-    } else {
-        ""
-    };
-    format!(
-        "{} of {total} vertices ({:.2}%) lie outside the cage (first: {}{more})",
-        classes.outside.len(),
-        100.0 * classes.outside.len() as f64 / total.max(1) as f64,
-        first.join(", ")
-    )
+    crate::coords::outside_summary(&classes.outside, total)
 }
 
 /// Compute the weights with the chosen backend, showing progress on a terminal.

@@ -40,6 +40,20 @@ pub use quality::WeightQuality;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+/// How many of `total` points lie outside the cage, and the first few (0-based,
+/// ascending `outside`): the warning of a bind with outside points, and the
+/// error of a strict one (`--strict`, Python's `strict=True`).
+pub fn outside_summary(outside: &[u32], total: usize) -> String {
+    let first: Vec<String> = outside.iter().take(5).map(u32::to_string).collect();
+    let more = if outside.len() > 5 { ", …" } else { "" };
+    format!(
+        "{} of {total} vertices ({:.2}%) lie outside the cage (first: {}{more})",
+        outside.len(),
+        100.0 * outside.len() as f64 / total.max(1) as f64,
+        first.join(", ")
+    )
+}
+
 /// What to bind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BindOptions {

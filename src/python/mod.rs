@@ -18,6 +18,7 @@
 //! `BindOptions::validate`, the weights readers); nothing here re-implements a
 //! family.
 
+mod arguments;
 mod arrays;
 mod binding;
 mod errors;

@@ -124,6 +124,23 @@ impl PyWeights {
         })
     }
 
+    /// `strict=True` with these weights: an error when a row is outside the cage.
+    pub(super) fn check_strict(&self, py: Python<'_>) -> PyResult<()> {
+        let classes = self.classes.bind(py).readonly();
+        let outside: Vec<u32> = classes
+            .as_array()
+            .iter()
+            .enumerate()
+            .filter(|(_, &class)| class == crate::formats::metadata::CLASS_OUTSIDE)
+            .map(|(row, _)| row as u32)
+            .collect();
+        if outside.is_empty() {
+            Ok(())
+        } else {
+            Err(super::binding::outside_error(&outside, classes.len()))
+        }
+    }
+
     /// `points` moved as `pmvc deform --weights` moves them, after its checks:
     /// the weights were bound for these points and this cage (the metadata's
     /// counts and digests), and the matrix is sound.
@@ -353,9 +370,20 @@ pub(super) fn restore_weights(
 #[pyfunction]
 pub(super) fn save_weights(
     py: Python<'_>,
-    path: PathBuf,
-    weights: PyRef<'_, PyWeights>,
+    path: &Bound<'_, PyAny>,
+    weights: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
+    let path = super::arguments::path(path, "save_weights")?;
+    let weights = weights.cast::<PyWeights>().map_err(|_| {
+        error(
+            Kind::Input,
+            format!(
+                "save_weights: weights: {} is not a pmvc.Weights (from bind or load_weights)",
+                super::arguments::shown(weights)
+            ),
+        )
+    })?;
+    let weights = weights.get();
     let npz = weights.method().spec().columns == ColumnLayout::CageVerticesThenTriangles;
     let extension = path
         .extension()
@@ -389,7 +417,8 @@ pub(super) fn save_weights(
 /// (``W.json``) first, then the matrix with the shape it states (checked as
 /// ``pmvc deform --weights`` checks it), then the classes (``W.classes.npy``).
 #[pyfunction]
-pub(super) fn load_weights(py: Python<'_>, path: PathBuf) -> PyResult<PyWeights> {
+pub(super) fn load_weights(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyWeights> {
+    let path = super::arguments::path(path, "load_weights")?;
     let loaded = py
         .detach(|| load_weights_set(&path))
         .map_err(|cause| metadata_error(&cause))?;
