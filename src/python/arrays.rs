@@ -50,7 +50,7 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
         bytes_for(rows as u64, 2 * std::mem::size_of::<DVec3>() as u64),
     )
     .map_err(|too_large| error(Kind::TooLarge, format!("{what}: {too_large}")))?;
-    let contiguous = numpy.call_method1("ascontiguousarray", (array, numpy.getattr("float64")?))?;
+    let contiguous = aligned(&array, "float64")?;
     let contiguous = contiguous.cast_into::<PyArray2<f64>>()?;
     let readonly = contiguous.readonly();
     let values = readonly
@@ -68,6 +68,15 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
         ));
     }
     Ok(points)
+}
+
+/// `value` as a C-contiguous, aligned numpy array of `dtype`: the array itself
+/// when it is one, else a copy. Arrays rebuilt from a buffer (a Dask worker's,
+/// one from `numpy.frombuffer` at an odd offset) can be contiguous but
+/// misaligned, which Rust cannot read in place.
+pub(super) fn aligned<'py>(value: &Bound<'py, PyAny>, dtype: &str) -> PyResult<Bound<'py, PyAny>> {
+    let numpy = value.py().import("numpy")?;
+    numpy.call_method1("require", (value, numpy.getattr(dtype)?, ("C", "A")))
 }
 
 /// `value` as polygons of vertex indices (0-based) into `vertex_count` vertices,
@@ -178,7 +187,7 @@ fn integer_array_faces(
     } else {
         value.clone()
     };
-    let contiguous = numpy.call_method1("ascontiguousarray", (clipped, numpy.getattr("int64")?))?;
+    let contiguous = aligned(&clipped, "int64")?;
     let contiguous = contiguous.cast_into::<PyArray2<i64>>()?;
     let readonly = contiguous.readonly();
     let values = readonly

@@ -324,12 +324,17 @@ pub(super) fn restore_weights(
         .check_consistent(what)
         .map_err(|cause| error(Kind::Weights, cause.to_string()))?;
     let (rows, columns) = (metadata.rows, metadata.columns);
-    let matrix = matrix.cast::<PyArray2<f32>>().map_err(|_| {
+    // Arrays rebuilt from a buffer may be misaligned: aligned here, once.
+    let not_matrix = || {
         error(
             Kind::Weights,
             "pickled weights: the matrix is not a 2-dimensional float32 array",
         )
-    })?;
+    };
+    matrix.cast::<PyArray2<f32>>().map_err(|_| not_matrix())?;
+    let matrix = super::arrays::aligned(matrix, "float32")?
+        .cast_into::<PyArray2<f32>>()
+        .map_err(|_| not_matrix())?;
     if matrix.shape() != [rows, columns] {
         return Err(error(
             Kind::Weights,
@@ -341,24 +346,23 @@ pub(super) fn restore_weights(
             ),
         ));
     }
-    let classes = classes.cast::<PyArray1<i8>>().map_err(|_| {
+    let not_classes = || {
         error(
             Kind::Weights,
             "pickled weights: the classes are not a 1-dimensional int8 array",
         )
-    })?;
+    };
+    classes.cast::<PyArray1<i8>>().map_err(|_| not_classes())?;
+    let classes = super::arrays::aligned(classes, "int8")?
+        .cast_into::<PyArray1<i8>>()
+        .map_err(|_| not_classes())?;
     if classes.len() != rows {
         return Err(error(
             Kind::Weights,
             format!("pickled weights: {} classes for {rows} rows", classes.len()),
         ));
     }
-    let mut weights = PyWeights::new(
-        matrix.clone().unbind(),
-        classes.clone().unbind(),
-        metadata,
-        options,
-    );
+    let mut weights = PyWeights::new(matrix.unbind(), classes.unbind(), metadata, options);
     weights.path = path;
     Ok(weights)
 }

@@ -198,3 +198,28 @@ def test_a_tampered_pickle_is_refused_with_a_reason(comb_cage, comb_points):
         restore(matrix, classes, "{", path)
     with pytest.raises(pmvc.WeightsError, match="method"):
         restore(matrix, classes, metadata.replace('"method": "mvc"', '"method": "qvc"'), path)
+
+
+def misaligned(array: np.ndarray) -> np.ndarray:
+    """A copy of `array` one byte into a buffer: contiguous but misaligned, as
+    arrays rebuilt from a message (a Dask worker's) can be."""
+    raw = np.zeros(array.nbytes + 1, dtype=np.uint8)
+    copy = np.frombuffer(raw.data, dtype=array.dtype, count=array.size, offset=1).reshape(array.shape)
+    copy[...] = array
+    assert not copy.flags.aligned or array.dtype.itemsize == 1
+    return copy
+
+
+def test_misaligned_arrays_are_read_as_they_are(comb_cage, comb_points):
+    points = comb_points[::40]
+    expected = pmvc.bind(points, comb_cage, method="mvc", backend="cpu")
+    weights = pmvc.bind(misaligned(points), comb_cage, method="mvc", backend="cpu")
+    assert weights.matrix.tobytes() == expected.matrix.tobytes()
+    restore, (vertices, triangles, triangle_faces, path) = comb_cage.__reduce__()
+    cage = restore(misaligned(vertices), misaligned(triangles), misaligned(triangle_faces), path)
+    assert_same_cage(comb_cage, cage, "misaligned")
+    restore, (matrix, classes, metadata, path) = expected.__reduce__()
+    copied = restore(misaligned(matrix), misaligned(classes), metadata, path)
+    assert_same_weights(expected, copied, "misaligned")
+    moved = pmvc.deform(points, comb_cage, misaligned(comb_cage.vertices * 2), weights=copied)
+    assert moved.tobytes() == pmvc.deform(points, comb_cage, comb_cage.vertices * 2, weights=expected).tobytes()
