@@ -6,7 +6,7 @@
 
 use super::arguments::{flag, shown, text};
 use super::arrays::{matrix, positions};
-use super::errors::{error, Kind};
+use super::errors::{backend_warning, error, Kind};
 use super::scene::{cage_argument, PyCage};
 use super::weights::PyWeights;
 use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
@@ -120,6 +120,12 @@ fn choose_backend(
         )
     })?;
     let work = Work::of(options, points, &cage.cage);
+    if request != BackendRequest::Cpu {
+        // Before any GPU probe: libwayland's complaint about a missing
+        // XDG_RUNTIME_DIR would otherwise reach stderr once per probe.
+        py.import("pmvc._environment")?
+            .call_method0("ensure_runtime_dir")?;
+    }
     py.detach(|| decide_and_open(request, &work))
         .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))
 }
@@ -321,6 +327,20 @@ pub(super) fn bind_points(
     let decision = choose_backend(py, &how.backend, options, points.len(), cage)?;
     let pmvc_kernel = how.pmvc_kernel;
     let on_gpu = decision.on_gpu(options.method);
+    if how.backend == "gpu" && !on_gpu {
+        let label = match options.parameter() {
+            Some((spec, value)) => format!(
+                "{} {}",
+                options.family_name(&cage.cage),
+                (spec.format)(value)
+            ),
+            None => options.family_name(&cage.cage),
+        };
+        backend_warning(
+            py,
+            &format!("bind: {label} has no GPU kernel; it was bound on the CPU (backend \"gpu\" was asked for)"),
+        )?;
+    }
     let backend = decision.backend;
     let device = backend.clone();
     let rows = points.len();
@@ -365,8 +385,7 @@ pub(super) fn bind_points(
     };
     if let Backend::Gpu(context) = &device {
         for notice in context.take_notices() {
-            use std::io::Write as _;
-            let _ = writeln!(std::io::stderr(), "pmvc: {notice}");
+            backend_warning(py, &format!("bind: {notice}"))?;
         }
     }
     let output = result.map_err(|cause| bind_error(&cause))?;

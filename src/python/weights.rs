@@ -294,7 +294,7 @@ impl PyWeights {
     fn __repr__(&self) -> String {
         format!(
             "Weights({}, {} × {} float32, {})",
-            self.method().name(),
+            self.metadata.method_name,
             self.metadata.rows,
             self.metadata.columns,
             self.metadata.backend
