@@ -5,10 +5,12 @@
 //! that rows a family filled by its outside policy can be told from the rest.
 //! The command line and the Python package both read and write them here.
 
-use super::npy::{npy_preamble, read_npy, write_f32_values, ExpectedArray, NpyError};
-use super::npz::{read_npz, write_npz};
+use super::npy::{
+    npy_preamble_of, read_npy, read_npy_f64, write_values, ExpectedArray, LeBytes, NpyError,
+};
+use super::npz::{read_npz, read_npz_f64, write_npz_values};
 use crate::coords::family::ColumnLayout;
-use crate::coords::{BindOptions, Method, ParameterError, Weights};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method, ParameterError, Weights};
 use crate::formats::{shown_path, OutputSet, WriteError};
 use crate::geometry::{Cage, PointClass, QuadSplit};
 use glam::DVec3;
@@ -125,6 +127,11 @@ pub struct WeightsMetadata {
     /// diagonal they were split along (Green coordinates always split them).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub quads_bound_as: String,
+    /// How the matrix is stored: "float32", or "float64" where it was asked for
+    /// (`--dtype f64`, Python's `dtype=numpy.float64`). Files from before the
+    /// field read as "float32", which they are.
+    #[serde(default = "float32")]
+    pub dtype: String,
     /// "cpu" or "gpu".
     pub backend: String,
     /// Where they were computed, in words (the adapter, or the CPU threads).
@@ -169,6 +176,10 @@ fn no_split() -> String {
     QuadSplit::None.id().to_owned()
 }
 
+fn float32() -> String {
+    Dtype::Float32.id().to_owned()
+}
+
 impl WeightsMetadata {
     pub fn new(record: &BindRecord) -> Self {
         let method = record.options.method;
@@ -204,6 +215,7 @@ impl WeightsMetadata {
                 .map(|(parameter, value)| (parameter.key.id().to_owned(), value))
                 .into_iter()
                 .collect(),
+            dtype: float32(),
             backend: record.backend.to_owned(),
             device: record.device.to_owned(),
             seconds: record.seconds,
@@ -288,6 +300,20 @@ impl WeightsMetadata {
         Ok(options)
     }
 
+    /// The stored dtype, checked by [`Dtype::parse`] (the parser of `--dtype`).
+    pub fn checked_dtype(&self, path: &Path) -> Result<Dtype, MetadataError> {
+        Dtype::parse(&self.dtype).map_err(|error| MetadataError::Field {
+            path: path.to_owned(),
+            field: "dtype",
+            reason: error.to_string(),
+        })
+    }
+
+    /// The stored dtype; float32 for a value [`Self::checked_dtype`] refuses.
+    pub fn dtype(&self) -> Dtype {
+        Dtype::parse(&self.dtype).unwrap_or_default()
+    }
+
     /// Whether these weights belong to `points` and `cage`: the same number of
     /// rows and cage vertices and triangles, and the same digests.
     pub fn check_inputs(
@@ -358,6 +384,7 @@ impl WeightsMetadata {
             ));
         }
         let options = self.options(path)?;
+        self.checked_dtype(path)?;
         let layout = options.method.spec().columns;
         let expected = match layout {
             ColumnLayout::CageVertices => self.cage.vertices,
@@ -475,27 +502,70 @@ pub fn save_weights_set(
     metadata: &WeightsMetadata,
     classes: &[i8],
 ) -> Result<(), MetadataError> {
-    if classes.len() != weights.rows || metadata.rows != weights.rows {
+    save_values(
+        path,
+        (&weights.values, weights.rows, weights.cols),
+        metadata,
+        classes,
+    )
+}
+
+/// [`save_weights_set`] of weights of either dtype; the metadata's `dtype`
+/// must be theirs.
+pub fn save_any_weights_set(
+    path: &Path,
+    weights: &AnyWeights,
+    metadata: &WeightsMetadata,
+    classes: &[i8],
+) -> Result<(), MetadataError> {
+    match weights {
+        AnyWeights::F32(weights) => save_weights_set(path, weights, metadata, classes),
+        AnyWeights::F64(weights) => save_values(
+            path,
+            (&weights.values, weights.rows, weights.cols),
+            metadata,
+            classes,
+        ),
+    }
+}
+
+fn save_values<T: LeBytes>(
+    path: &Path,
+    (values, rows, cols): (&[T], usize, usize),
+    metadata: &WeightsMetadata,
+    classes: &[i8],
+) -> Result<(), MetadataError> {
+    if metadata.dtype() != T::DTYPE || metadata.dtype != T::DTYPE.id() {
+        return Err(MetadataError::Field {
+            path: path.to_owned(),
+            field: "dtype",
+            reason: format!(
+                "{:?} in the metadata, but the weights are {}",
+                metadata.dtype,
+                T::DTYPE.id()
+            ),
+        });
+    }
+    if classes.len() != rows || metadata.rows != rows {
         return Err(MetadataError::Field {
             path: path.to_owned(),
             field: "rows",
             reason: format!(
-                "{} weights rows, {} classes and {} rows in the metadata",
-                weights.rows,
+                "{rows} weights rows, {} classes and {} rows in the metadata",
                 classes.len(),
                 metadata.rows
             ),
         });
     }
     let outputs = OutputSet::create(&[path, &classes_path(path), &metadata_path(path)])?;
-    let preamble = npy_preamble(path, weights.rows, weights.cols)?;
+    let preamble = npy_preamble_of(path, rows, cols, T::DTYPE)?;
     let json = metadata.to_json_pretty();
     let npz = metadata.columns_layout == layout_id(ColumnLayout::CageVerticesThenTriangles);
     outputs.finish_seekable(|index, out| match index {
-        0 if npz => write_npz(out, path, weights, metadata.cage.vertices),
+        0 if npz => write_npz_values(out, path, (values, cols), metadata.cage.vertices),
         0 => {
             out.write_all(&preamble)?;
-            write_f32_values(out, &weights.values)
+            write_values(out, values)
         }
         1 => write_classes_npy_to(out, classes),
         _ => out.write_all(json.as_bytes()),
@@ -511,11 +581,38 @@ pub struct LoadedWeights {
     pub classes: Vec<i8>,
 }
 
+/// [`LoadedWeights`] of either dtype.
+pub struct LoadedAnyWeights {
+    pub weights: AnyWeights,
+    pub metadata: WeightsMetadata,
+    pub options: BindOptions,
+    pub classes: Vec<i8>,
+}
+
+/// The float32 weights of a set: [`load_any_weights_set`], refusing float64.
+pub fn load_weights_set(path: &Path) -> Result<LoadedWeights, MetadataError> {
+    let loaded = load_any_weights_set(path)?;
+    match loaded.weights {
+        AnyWeights::F32(weights) => Ok(LoadedWeights {
+            weights,
+            metadata: loaded.metadata,
+            options: loaded.options,
+            classes: loaded.classes,
+        }),
+        AnyWeights::F64(_) => Err(MetadataError::Field {
+            path: metadata_path(path),
+            field: "dtype",
+            reason: "is float64, and this reader takes float32 weights".to_owned(),
+        }),
+    }
+}
+
 /// Read weights written by [`save_weights_set`] or `pmvc bind`: the metadata
 /// first, then the arrays with the shapes it states (checked as `pmvc deform
 /// --weights` checks them: finite values, cage-vertex rows summing to 1 within
-/// [`super::npy::ROW_SUM_TOLERANCE`]), then the class mask.
-pub fn load_weights_set(path: &Path) -> Result<LoadedWeights, MetadataError> {
+/// [`super::npy::ROW_SUM_TOLERANCE`]), then the class mask. The matrix is float32
+/// or float64, as the metadata's `dtype` says.
+pub fn load_any_weights_set(path: &Path) -> Result<LoadedAnyWeights, MetadataError> {
     let json = metadata_path(path);
     if !json.exists() {
         return Err(MetadataError::Read {
@@ -536,9 +633,13 @@ pub fn load_weights_set(path: &Path) -> Result<LoadedWeights, MetadataError> {
         metadata.cage.vertices,
         metadata.cage.triangles,
     );
-    let weights = match options.method.spec().columns {
-        ColumnLayout::CageVerticesThenTriangles => read_npz(path, rows, vertices, triangles)?,
-        ColumnLayout::CageVertices => read_npy(path, ExpectedArray::cage_vertices(rows, vertices))?,
+    let npz = options.method.spec().columns == ColumnLayout::CageVerticesThenTriangles;
+    let expected = ExpectedArray::cage_vertices(rows, vertices);
+    let weights = match (metadata.dtype(), npz) {
+        (Dtype::Float32, true) => AnyWeights::F32(read_npz(path, rows, vertices, triangles)?),
+        (Dtype::Float32, false) => AnyWeights::F32(read_npy(path, expected)?),
+        (Dtype::Float64, true) => AnyWeights::F64(read_npz_f64(path, rows, vertices, triangles)?),
+        (Dtype::Float64, false) => AnyWeights::F64(read_npy_f64(path, expected)?),
     };
     // A bare file name beside the weights: the metadata never points elsewhere.
     let name = Path::new(&metadata.classes.file);
@@ -554,7 +655,7 @@ pub fn load_weights_set(path: &Path) -> Result<LoadedWeights, MetadataError> {
     }
     let classes_file = path.with_file_name(name);
     let classes = read_classes_npy(&classes_file, rows)?;
-    Ok(LoadedWeights {
+    Ok(LoadedAnyWeights {
         weights,
         metadata,
         options,
