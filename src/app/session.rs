@@ -6,7 +6,7 @@
 //! A rest mesh that no longer matches its source ("Use pose as rest shape") is
 //! written beside the session as `NAME.rest-mesh.obj`, so the session stays small.
 
-use super::compare::ViewSettings;
+use super::compare::{saturating_f32, ViewSettings};
 use super::document::{Document, NamedPose};
 use super::scenes::BundledScene;
 use super::session_checks::{
@@ -16,8 +16,8 @@ use super::session_checks::{
 use crate::budget::read_limited;
 use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
 use crate::formats::{
-    load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
-    write_obj, CageLoadError, LoadError, MeshFile, WriteError,
+    load_cage, load_mesh, not_a_regular_file, refuse_same_file, shown_path, write_atomically,
+    write_deformed_mesh, write_obj, CageLoadError, LoadError, MeshFile, WriteError,
 };
 use crate::geometry::{Cage, TriMesh};
 use crate::render::{OrbitCamera, SceneOrigin};
@@ -69,8 +69,11 @@ pub struct NamedPoseEntry {
 pub struct CameraEntry {
     /// World coordinates, in f64: a scene far from the origin keeps its view.
     pub target: [f64; 3],
+    #[serde(deserialize_with = "saturating_f32")]
     pub distance: f32,
+    #[serde(deserialize_with = "saturating_f32")]
     pub yaw: f32,
+    #[serde(deserialize_with = "saturating_f32")]
     pub pitch: f32,
     /// A parallel view (numpad 5); absent in sessions from before it existed.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -203,6 +206,30 @@ fn folder_of(path: &Path) -> PathBuf {
     match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
         _ => PathBuf::from("."),
+    }
+}
+
+/// The folder a session's relative paths are read from: beside the file it
+/// is, following a link as editors do, with a note when that is not the
+/// link's folder.
+fn session_folder(path: &Path, note: &mut impl FnMut(String)) -> PathBuf {
+    let linked = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !linked {
+        return folder_of(path);
+    }
+    match std::fs::canonicalize(path) {
+        Ok(target) => {
+            let folder = folder_of(&target);
+            if std::fs::canonicalize(folder_of(path)).ok().as_ref() != Some(&folder) {
+                note(format!(
+                    "a link to {}: its files are read from {}",
+                    shown_path(&target),
+                    shown_path(&folder)
+                ));
+            }
+            folder
+        }
+        Err(_) => folder_of(path),
     }
 }
 
@@ -364,6 +391,17 @@ fn cage_source(folder: &Path, document: &Document) -> CageSource {
 /// failure; the error names the file and what is wrong. The file is read up to
 /// [`SESSION_SIZE_LIMIT`]; a UTF-8 byte-order mark before it is skipped.
 pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
+    // A session's relative paths need a folder, and a named pipe with no
+    // writer would wait forever.
+    if let Some(kind) = not_a_regular_file(path) {
+        return Err(SessionError::Read {
+            path: path.to_owned(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("it is {kind}, not a session file"),
+            ),
+        });
+    }
     let bytes = read_limited(path, SESSION_SIZE_LIMIT).map_err(|source| SessionError::Read {
         path: path.to_owned(),
         source,
@@ -393,7 +431,9 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
             found: session.pmvc_session,
         });
     }
-    let folder = folder_of(path);
+    let mut notes = Vec::new();
+    let mut note = |text: String| notes.push(format!("{}: {text}", shown_path(path)));
+    let folder = session_folder(path, &mut note);
     let scene = |id: &str| {
         BundledScene::from_id(id).ok_or_else(|| SessionError::UnknownScene {
             path: path.to_owned(),
@@ -404,8 +444,6 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         path: path.to_owned(),
         source,
     };
-    let mut notes = Vec::new();
-    let mut note = |text: String| notes.push(format!("{}: {text}", shown_path(path)));
     let (title, cut) = cut_text(&session.title, "the title");
     cut.into_iter().for_each(&mut note);
     let mut bind_options = BindOptions::for_method(session.method);
