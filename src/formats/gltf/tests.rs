@@ -432,3 +432,56 @@ fn any_number_of_a_written_gltf_changed_is_read_or_refused_without_a_panic() {
         }
     }
 }
+
+/// The x extent of what `json` reads as.
+fn width(json: &str) -> Result<f64, LoadError> {
+    let read = parse_gltf(Path::new("graph.gltf"), json.as_bytes(), &MeshPick::First)?;
+    let xs = read.mesh.positions.iter().map(|p| p.x);
+    Ok(xs.clone().fold(f64::MIN, f64::max) - xs.fold(f64::MAX, f64::min))
+}
+
+#[test]
+fn a_node_hierarchy_that_is_not_a_forest_is_refused_naming_the_nodes() {
+    // A valid hierarchy: scale 2 under a parent, the triangle twice as wide.
+    let nodes = r#"{"mesh":0,"scale":[2,2,2]},{"children":[0]}"#;
+    assert_eq!(
+        width(&triangle_json(&triangle_uri(), 0, nodes)).unwrap(),
+        2.0
+    );
+    let cases = [
+        // Read as 4 units wide before: the scale applied twice.
+        (
+            r#"{"mesh":0,"scale":[2,2,2],"children":[0]}"#,
+            "node 0 is a child of itself",
+        ),
+        (
+            r#"{"mesh":0,"scale":[2,2,2],"children":[1]},{"children":[0]}"#,
+            "nodes 0 and 1 form a cycle: node 0 lists child 1, node 1 lists child 0",
+        ),
+        (
+            r#"{},{"children":[2]},{"children":[3]},{"mesh":0,"children":[1]}"#,
+            "nodes 1, 2 and 3 form a cycle: node 1 lists child 2, node 2 lists child 3, node 3 lists child 1",
+        ),
+        (
+            r#"{"mesh":0},{"children":[0]},{"children":[0]}"#,
+            "node 0 has two parents: nodes 1 and 2",
+        ),
+        (
+            r#"{"mesh":0},{"children":[0,0]}"#,
+            "node 1 lists child 0 twice",
+        ),
+        (
+            r#"{"mesh":0},{},{"children":[9]},{}"#,
+            "node 2 lists child 9, but the file has 4 nodes",
+        ),
+    ];
+    for (nodes, expected) in cases {
+        let json = triangle_json(&triangle_uri(), 0, nodes);
+        match width(&json) {
+            Err(LoadError::Gltf { message, .. }) => {
+                assert_eq!(message, expected, "for nodes {nodes}")
+            }
+            other => panic!("nodes {nodes} read as {other:?}, not refused"),
+        }
+    }
+}
