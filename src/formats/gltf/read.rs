@@ -394,6 +394,25 @@ fn read_primitive(
             position.dimensions()
         ));
     }
+    if primitive.mode() == Mode::Triangles {
+        match primitive.indices() {
+            Some(indices) if indices.count() % 3 != 0 => {
+                return Err(at(format!(
+                    "accessor {} holds {} indices, not a multiple of 3 as TRIANGLES needs",
+                    indices.index(),
+                    indices.count()
+                )))
+            }
+            None if position.count() % 3 != 0 => {
+                return Err(at(format!(
+                    "accessor {index} (POSITION) holds {} vertices and there are no indices, \
+                     but TRIANGLES needs a multiple of 3",
+                    position.count()
+                )))
+            }
+            _ => {}
+        }
+    }
     let positions = buffers.read(&position, |b| [0, 4, 8].map(|at| f32_at(b, at)))?;
     if let Some(k) = positions
         .iter()

@@ -314,11 +314,11 @@ fn bad_json_names_the_element_and_what_is_wrong() {
         "{message}"
     );
     let short_view =
-        triangle_json(&triangle_uri(), 0, "{}").replace(r#""count":3"#, r#""count":4"#);
+        triangle_json(&triangle_uri(), 0, "{}").replace(r#""count":3"#, r#""count":6"#);
     let message = gltf_error(path, &short_view);
     assert!(
         message.contains(
-            "accessor 0: its 4 elements end at byte 48, past the end of buffer view 0 (36 bytes)"
+            "accessor 0: its 6 elements end at byte 72, past the end of buffer view 0 (36 bytes)"
         ),
         "{message}"
     );
@@ -483,5 +483,62 @@ fn a_node_hierarchy_that_is_not_a_forest_is_refused_naming_the_nodes() {
             }
             other => panic!("nodes {nodes} read as {other:?}, not refused"),
         }
+    }
+}
+
+/// Four vertices (a unit square's corners) and the u16 indices `indices`, in
+/// one data: URI buffer: positions at 0, indices at 48.
+fn square_json(indices: Option<&[u16]>, mode: u32) -> String {
+    use base64::Engine as _;
+    let floats = [0f32, 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.];
+    let mut bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    let list = indices.unwrap_or_default();
+    bytes.extend(list.iter().flat_map(|i| i.to_le_bytes()));
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bytes)
+    );
+    let indexed = match indices {
+        Some(_) => r#","indices":1"#,
+        None => "",
+    };
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},
+        "buffers":[{{"byteLength":{length},"uri":"{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":{index_bytes}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}},
+            {{"bufferView":1,"componentType":5123,"count":{count},"type":"SCALAR"}}],
+        "meshes":[{{"name":"quad","primitives":[{{"attributes":{{"POSITION":0}}{indexed},"mode":{mode}}}]}}]}}"#,
+        length = bytes.len(),
+        index_bytes = 2 * list.len().max(1),
+        count = list.len().max(1),
+    )
+}
+
+#[test]
+fn triangles_whose_index_count_is_not_a_multiple_of_three_are_refused() {
+    let path = Path::new("quad.gltf");
+    let read = |json: &str| parse_gltf(path, json.as_bytes(), &MeshPick::First);
+    let six = read(&square_json(Some(&[0, 1, 2, 0, 2, 3]), 4)).unwrap();
+    assert_eq!(six.mesh.triangles.len(), 2);
+    // Before: the fourth index was dropped without a word.
+    let message = gltf_error(path, &square_json(Some(&[0, 1, 2, 3]), 4));
+    assert_eq!(
+        message,
+        "mesh 0 primitive 0: accessor 1 holds 4 indices, not a multiple of 3 as TRIANGLES needs"
+    );
+    let message = gltf_error(path, &square_json(None, 4));
+    assert_eq!(
+        message,
+        "mesh 0 primitive 0: accessor 0 (POSITION) holds 4 vertices and there are no indices, \
+         but TRIANGLES needs a multiple of 3"
+    );
+    // Strips, fans and points take any count.
+    for mode in [0, 5, 6] {
+        assert!(
+            read(&square_json(Some(&[0, 1, 2, 3]), mode)).is_ok(),
+            "mode {mode}"
+        );
+        assert!(read(&square_json(None, mode)).is_ok(), "mode {mode}");
     }
 }
