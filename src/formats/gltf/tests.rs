@@ -300,7 +300,9 @@ fn bad_json_names_the_element_and_what_is_wrong() {
     );
     let message = gltf_error(path, &triangle_json("../outside.bin", 0, "{}"));
     assert!(
-        message.contains("buffer 0: '../outside.bin' is not a file beside the glTF"),
+        message.contains(
+            "buffer 0 (\"../outside.bin\"): it is not a file beside the glTF or in a folder below it"
+        ),
         "{message}"
     );
     let message = gltf_error(path, &triangle_json("/etc/passwd", 0, "{}"));
@@ -541,4 +543,58 @@ fn triangles_whose_index_count_is_not_a_multiple_of_three_are_refused() {
         );
         assert!(read(&square_json(None, mode)).is_ok(), "mode {mode}");
     }
+}
+
+/// Runs `parse` on a thread and waits at most `seconds` for it; `unblock` is
+/// called before failing, to let a blocked thread go.
+fn within<T: Send + 'static>(
+    seconds: u64,
+    parse: impl FnOnce() -> T + Send + 'static,
+    unblock: impl FnOnce(),
+) -> T {
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(parse());
+    });
+    match receive.recv_timeout(std::time::Duration::from_secs(seconds)) {
+        Ok(result) => result,
+        Err(_) => {
+            unblock();
+            panic!("still reading after {seconds} s");
+        }
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_named_pipe_as_a_buffer_file_is_refused_without_opening_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let pipe = dir.path().join("pipe.bin");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let json = triangle_json("pipe.bin", 0, "{}")
+        .replace(r#""byteLength":36,"uri""#, r#""byteLength":0,"uri""#);
+    let path = dir.path().join("piped.gltf");
+    std::fs::write(&path, &json).unwrap();
+    let reading = path.clone();
+    let result = within(
+        10,
+        move || load_mesh(&reading).map(|_| ()).map_err(|e| e.to_string()),
+        || {
+            // Opening the write end lets a reader blocked in open go on.
+            let _ = std::fs::OpenOptions::new().write(true).open(&pipe);
+        },
+    );
+    let message = result.unwrap_err();
+    assert_eq!(
+        message,
+        format!(
+            "{}: buffer 0 (\"pipe.bin\"): it is a named pipe, not a regular file; \
+             buffers are read from regular files only",
+            path.display()
+        )
+    );
 }
