@@ -306,6 +306,11 @@ fn data_uri(index: usize, uri: &str) -> Result<Vec<u8>, String> {
         base64::engine::GeneralPurposeConfig::new()
             .with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
     );
+    check_memory(
+        || format!("buffer {index} (its data: URI)"),
+        (payload.len() as u64 / 4 + 1) * 3,
+    )
+    .map_err(|e| e.to_string())?;
     engine
         .decode(payload)
         .map_err(|e| format!("buffer {index}: its data: URI is not valid base64: {e}"))

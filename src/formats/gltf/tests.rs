@@ -598,3 +598,32 @@ fn a_named_pipe_as_a_buffer_file_is_refused_without_opening_it() {
         )
     );
 }
+
+#[test]
+fn a_document_of_many_empty_strings_is_predicted_past_a_small_limit() {
+    use super::json_size::JsonSize;
+    // A 3 MiB JSON whose 1 Mi strings become a 24-byte String each in a Vec
+    // that may have twice the room (the 540 MB file of 180 million aborted
+    // on a 6 GB allocation).
+    let count = 1 << 20;
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":[{}""]}}"#,
+        "\"\",".repeat(count - 1)
+    );
+    let size = JsonSize::of(json.as_bytes());
+    let limit: u64 = 32 << 20;
+    assert!(
+        size.bytes > limit,
+        "{} predicted for {} bytes of JSON",
+        size.bytes,
+        json.len()
+    );
+    assert!(size.bytes >= 48 * count as u64, "{}", size.bytes);
+    // And "2.0"; the members' names are not kept.
+    assert_eq!(size.strings, count as u64 + 1);
+    assert!(
+        size.describe().contains(&format!("{} strings", count + 1)),
+        "{}",
+        size.describe()
+    );
+}
