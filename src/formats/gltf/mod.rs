@@ -79,6 +79,8 @@ mod read;
 mod write;
 
 #[cfg(test)]
+mod fuzz_tests;
+#[cfg(test)]
 mod json_size_tests;
 #[cfg(test)]
 mod tests;
