@@ -233,6 +233,27 @@ fn session_folder(path: &Path, note: &mut impl FnMut(String)) -> PathBuf {
     }
 }
 
+/// The mesh and cage files a session names, read as loosely as can be: what a
+/// run must not overwrite even when the session then fails to open.
+pub fn files_named(path: &Path) -> Vec<PathBuf> {
+    if not_a_regular_file(path).is_some() {
+        return Vec::new();
+    }
+    let Ok(bytes) = read_limited(path, SESSION_SIZE_LIMIT) else {
+        return Vec::new();
+    };
+    let text = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(&bytes);
+    let Ok(session) = serde_json::from_slice::<serde_json::Value>(text) else {
+        return Vec::new();
+    };
+    let folder = session_folder(path, &mut |_| {});
+    ["mesh", "cage"]
+        .iter()
+        .filter_map(|key| session[key]["file"].as_str())
+        .map(|file| folder.join(file))
+        .collect()
+}
+
 /// Where a session saved as `session` keeps a rest mesh that changed.
 pub fn rest_mesh_path(session: &Path) -> PathBuf {
     let name = session

@@ -504,7 +504,16 @@ fn check_screenshot_path(
         &options.session,
         &options.pose,
     ];
-    let inputs: Vec<&std::path::Path> =
-        inputs.into_iter().flatten().map(PathBuf::as_path).collect();
+    let named = options
+        .session
+        .as_deref()
+        .map(crate::app::session::files_named)
+        .unwrap_or_default();
+    let inputs: Vec<&std::path::Path> = inputs
+        .into_iter()
+        .flatten()
+        .chain(&named)
+        .map(PathBuf::as_path)
+        .collect();
     commands::check_output(screenshot, &inputs, &["png"], "a PNG image")
 }

@@ -396,7 +396,13 @@ fn a_named_pipe_with_no_reader_is_waited_for_with_a_word() {
         return;
     }
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pmvc"))
-        .args(["deform", "--mesh", path_str(&mesh), "--cage", path_str(&cage)])
+        .args([
+            "deform",
+            "--mesh",
+            path_str(&mesh),
+            "--cage",
+            path_str(&cage),
+        ])
         .args(["--deformed-cage", path_str(&cage), "--method", "mvc"])
         .args(["--out", path_str(&fifo)])
         .stderr(std::process::Stdio::piped())
@@ -407,11 +413,15 @@ fn a_named_pipe_with_no_reader_is_waited_for_with_a_word() {
     let mut line = String::new();
     errors.read_line(&mut line).unwrap();
     assert!(
-        line.contains("waiting for a program to read the named pipe") && line.contains("deformed.obj"),
+        line.contains("waiting for a program to read the named pipe")
+            && line.contains("deformed.obj"),
         "{line}"
     );
     let mut written = String::new();
-    std::fs::File::open(&fifo).unwrap().read_to_string(&mut written).unwrap();
+    std::fs::File::open(&fifo)
+        .unwrap()
+        .read_to_string(&mut written)
+        .unwrap();
     assert_eq!(written.lines().filter(|l| l.starts_with("v ")).count(), 20);
     assert!(child.wait().unwrap().success());
 }

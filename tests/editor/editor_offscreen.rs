@@ -115,18 +115,30 @@ fn offscreen_without_a_screenshot_is_refused() {
 #[test]
 fn a_screenshot_never_replaces_an_input() {
     let dir = tempfile::tempdir().unwrap();
-    let (mesh, cage, _, _) = common::comb_scene(dir.path(), 50);
+    let (mesh, cage, cage_shape, _) = common::comb_scene(dir.path(), 50);
     let session = dir.path().join("s.json");
     let mut text = common::comb_session();
     text["mesh"] = serde_json::json!({"file": "mesh.obj"});
     text["cage"] = serde_json::json!({"file": "cage.obj"});
+    let rest: Vec<[f64; 3]> = cage_shape
+        .positions()
+        .iter()
+        .map(|p| p.to_array())
+        .collect();
+    text["pose"] = serde_json::json!(rest);
+    text["named_poses"] = serde_json::json!([]);
     std::fs::write(&session, serde_json::to_string(&text).unwrap()).unwrap();
     let before: Vec<Vec<u8>> = [&mesh, &cage, &session]
         .map(|path| std::fs::read(path).unwrap())
         .into();
     let unchanged = || {
         for (path, bytes) in [&mesh, &cage, &session].into_iter().zip(&before) {
-            assert_eq!(&std::fs::read(path).unwrap(), bytes, "{} changed", path.display());
+            assert_eq!(
+                &std::fs::read(path).unwrap(),
+                bytes,
+                "{} changed",
+                path.display()
+            );
         }
     };
     // Refused before any window opens: what the command line names.
@@ -143,10 +155,31 @@ fn a_screenshot_never_replaces_an_input() {
         assert!(text.contains("never overwrites"), "{text}");
         unchanged();
     }
-    // The mesh a session names is the scene's input too, checked when the
-    // picture is written.
-    let Some(output) = offscreen(&["--session", path_str(&session), "--screenshot", path_str(&mesh)])
-    else {
+    // The mesh a session names is the scene's input too: refused before the
+    // window opens, even when the session would not open.
+    let broken = dir.path().join("broken.json");
+    let mut text_broken = text.clone();
+    text_broken["pose"] = serde_json::json!([]);
+    std::fs::write(&broken, serde_json::to_string(&text_broken).unwrap()).unwrap();
+    let output = common::pmvc(&[
+        "edit",
+        "--session",
+        path_str(&broken),
+        "--screenshot",
+        path_str(&mesh),
+        "--offscreen",
+    ]);
+    let said = stderr(&output);
+    assert_eq!(output.status.code(), Some(1), "{said}");
+    assert!(said.contains("never overwrites"), "{said}");
+    unchanged();
+    // And checked again when the picture is written, against the scene's files.
+    let Some(output) = offscreen(&[
+        "--session",
+        path_str(&session),
+        "--screenshot",
+        path_str(&mesh),
+    ]) else {
         return;
     };
     let text = stderr(&output);

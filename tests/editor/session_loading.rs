@@ -300,12 +300,17 @@ fn a_named_pipe_is_refused_instead_of_waited_on() {
     }
     // No writer: opening it for reading would wait forever.
     let (sender, receiver) = std::sync::mpsc::channel();
-    std::thread::spawn(move || sender.send(open_session(&fifo).map(|_| ()).map_err(|e| e.to_string())));
+    std::thread::spawn(move || {
+        sender.send(open_session(&fifo).map(|_| ()).map_err(|e| e.to_string()))
+    });
     let answer = receiver
         .recv_timeout(std::time::Duration::from_secs(20))
         .expect("the loader waited on a named pipe");
     let error = answer.expect_err("a named pipe opened as a session");
-    assert!(error.contains("piped.json") && error.contains("named pipe"), "{error}");
+    assert!(
+        error.contains("piped.json") && error.contains("named pipe"),
+        "{error}"
+    );
 }
 
 #[cfg(unix)]
@@ -324,5 +329,8 @@ fn a_session_opened_through_a_link_reads_its_files_beside_the_target() {
     std::os::unix::fs::symlink(&target, &link).unwrap();
     let opened = open_session(&link).map_err(|e| e.to_string()).unwrap();
     let notes = opened.notes.join("\n");
-    assert!(notes.contains("a link to") && notes.contains("scenes"), "{notes}");
+    assert!(
+        notes.contains("a link to") && notes.contains("scenes"),
+        "{notes}"
+    );
 }
