@@ -2,13 +2,15 @@
 //! interactive.
 //!
 //! The queue holds the current scene prepared once: the points and the cage in
-//! `Arc`s, and the points' inside/outside classes, computed by the first job and
-//! shared by every later one. Each job runs [`crate::gpu::Binder::bind_blocking`]
+//! `Arc`s, and the points' inside/outside classes, computed by the first job that
+//! binds the cage's quads one way (as patches, or split along a diagonal:
+//! classes are taken against the cage bound, [`BindOptions::classify`]) and
+//! shared by every later one that binds them the same way. Each job runs [`crate::gpu::Binder::bind_blocking`]
 //! on a thread of its own with a shared [`BindProgress`], and calls the editor's
 //! wake callback when it ends, so nothing polls. Dropping or replacing a job
 //! cancels it.
 
-use crate::coords::{BindOptions, BindProgress, Method, WeightQuality, Weights};
+use crate::coords::{BindOptions, BindProgress, Method, QuadSplit, WeightQuality, Weights};
 use crate::geometry::{Cage, PointClass};
 use crate::gpu::backend_choice::{decide, BackendRequest, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder};
@@ -22,7 +24,8 @@ use std::time::{Duration, Instant};
 #[derive(Debug)]
 pub struct BindOutcome {
     pub weights: Arc<Weights>,
-    /// Mesh vertices outside the cage, ascending.
+    /// Mesh vertices outside the cage bound (its quads split if the job split
+    /// them), ascending.
     pub outside: Arc<[u32]>,
     /// Wall-clock time of classification (for the first job) and binding.
     pub elapsed: Duration,
@@ -57,16 +60,21 @@ pub struct Finished {
     pub on_gpu: bool,
 }
 
-/// Each point's class and the points outside, shared by every job of a scene.
+/// Each point's class and the points outside, shared by every job of a scene
+/// that binds the cage's quads the same way.
 type Classified = (Arc<[PointClass]>, Arc<[u32]>);
+
+/// The classes of a scene, one entry per way its quads were bound
+/// ([`BindOptions::split_applied`]): at most three.
+type ClassesBySplit = Vec<(Option<QuadSplit>, Classified)>;
 
 /// The scene every job binds, prepared once.
 #[derive(Clone)]
 struct Prepared {
     points: Arc<[DVec3]>,
     cage: Arc<Cage>,
-    /// Filled in by the first job that classifies the points.
-    classes: Arc<Mutex<Option<Classified>>>,
+    /// Filled in by the first job that classifies the points for its split.
+    classes: Arc<Mutex<ClassesBySplit>>,
 }
 
 struct Running {
@@ -144,7 +152,7 @@ impl BindQueue {
         self.prepared = Some(Prepared {
             points,
             cage,
-            classes: Arc::new(Mutex::new(None)),
+            classes: Arc::new(Mutex::new(Vec::new())),
         });
     }
 
@@ -343,12 +351,16 @@ fn run(
             .classes
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner());
-        cached
-            .get_or_insert_with(|| {
-                let classified = crate::geometry::classify_points(&prepared.cage, &prepared.points);
-                (classified.classes.into(), classified.outside.into())
-            })
-            .clone()
+        let split = options.split_applied(&prepared.cage);
+        match cached.iter().find(|(key, _)| *key == split) {
+            Some((_, classified)) => classified.clone(),
+            None => {
+                let classified = options.classify(&prepared.cage, &prepared.points);
+                let classified: Classified = (classified.classes.into(), classified.outside.into());
+                cached.push((split, classified.clone()));
+                classified
+            }
+        }
     };
     if progress.is_cancelled() {
         return Err(JobError::Cancelled);
@@ -402,5 +414,85 @@ fn run(
             method: options.method,
             source,
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::generalized_winding_number;
+    use crate::geometry::procedural_quads::twisted_box;
+
+    /// Points in a shell around the bent sides of [`twisted_box`], where a bent
+    /// patch and its two triangles disagree, away from its top and bottom.
+    fn shell_points() -> Vec<DVec3> {
+        let mut points = Vec::new();
+        for a in 0..48 {
+            let angle = (a as f64 + 0.37) * std::f64::consts::TAU / 48.0;
+            for r in 0..12 {
+                let radius = 0.7 + 0.75 * (r as f64 + 0.41) / 12.0;
+                for z in 0..8 {
+                    let height = 0.3 + 1.4 * (z as f64 + 0.53) / 8.0;
+                    points.push(DVec3::new(
+                        radius * angle.cos(),
+                        radius * angle.sin(),
+                        height,
+                    ));
+                }
+            }
+        }
+        points
+    }
+
+    /// A bind that splits the cage's quads reports as outside the points outside
+    /// the triangles it bound, not outside the patches it did not use, and its
+    /// PMVC rows are never negative elsewhere.
+    #[test]
+    fn a_split_bind_reports_the_outside_of_the_cage_it_bound() {
+        let cage = Arc::new(twisted_box(2.0, 0.6));
+        let points: Arc<[DVec3]> = shell_points().into();
+        let mut queue = BindQueue::new(Backend::Cpu, BackendRequest::Cpu, || {});
+        queue.set_scene(Arc::clone(&points), Arc::clone(&cage));
+        let mut differing = 0;
+        for split in [QuadSplit::None, QuadSplit::Shorter, QuadSplit::Longer] {
+            let options = BindOptions {
+                quads: split,
+                resolution: 8,
+                ..BindOptions::for_method(Method::Pmvc)
+            };
+            assert!(queue.request(options));
+            let finished = queue.wait(Duration::from_secs(120)).expect("the bind ends");
+            let outcome = finished.result.expect("the bind succeeds");
+            let outside: Vec<u32> = if split == QuadSplit::None {
+                crate::geometry::classify_points(&cage, &points).outside
+            } else {
+                // The split cage's own winding number.
+                let bound = cage.split_quads(split);
+                (0..points.len() as u32)
+                    .filter(|&i| generalized_winding_number(&bound, points[i as usize]) < 0.5)
+                    .collect()
+            };
+            let by_patches = crate::geometry::classify_points(&cage, &points).outside;
+            differing += outside.len().abs_diff(by_patches.len());
+            let wrong = outside.len().abs_diff(outcome.outside.len());
+            assert_eq!(
+                &*outcome.outside,
+                outside.as_slice(),
+                "{split:?}: {wrong} rows off"
+            );
+            let weights = &outcome.weights;
+            for row in (0..points.len()).filter(|&i| outside.binary_search(&(i as u32)).is_err()) {
+                let min = weights
+                    .row(row)
+                    .iter()
+                    .copied()
+                    .fold(f32::INFINITY, f32::min);
+                assert!(min >= 0.0, "{split:?}: row {row} inside has a weight {min}");
+            }
+        }
+        assert!(
+            differing >= 100,
+            "the splits change only {differing} classes"
+        );
     }
 }

@@ -4,7 +4,7 @@
 
 use crate::coords::{BindOptions, BindProgress, Method, QuadSplit};
 use crate::formats::shown_path;
-use crate::geometry::{classify_points, procedural, Cage};
+use crate::geometry::{procedural, Cage, PointClass};
 use crate::gpu::{Backend, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
 use anyhow::{bail, Result};
 use glam::DVec3;
@@ -291,7 +291,9 @@ fn bench_scene_split(
     runs: usize,
     only: &[Method],
 ) -> Result<Vec<BenchRow>> {
-    let classes = classify_points(cage, points);
+    // Classified once per way the quads are bound, against that cage
+    // ([`BindOptions::classify`]), outside the timings.
+    let mut classified: Vec<(Option<QuadSplit>, Arc<[PointClass]>)> = Vec::new();
     let mut rows = Vec::new();
     // Families without a choice of kernel are timed once per GPU, with its first.
     let first_kernel = backends.iter().find_map(|timed| timed.pmvc_kernel);
@@ -322,9 +324,18 @@ fn bench_scene_split(
             if gpu_backend && (repeated || pmvc_kernel.takes_tiles(&work).is_err()) {
                 continue;
             }
+            let split = options.split_applied(cage);
+            let classes = match classified.iter().find(|(key, _)| *key == split) {
+                Some((_, classes)) => Arc::clone(classes),
+                None => {
+                    let classes: Arc<[PointClass]> = options.classify(cage, points).classes.into();
+                    classified.push((split, Arc::clone(&classes)));
+                    classes
+                }
+            };
             let input = BindInput {
                 points: points.into(),
-                classes: classes.classes.as_slice().into(),
+                classes,
                 cage: Arc::new(cage.clone()),
                 options,
             };

@@ -103,7 +103,7 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     let input = load_input(
         &args.input,
         &InputRules {
-            method,
+            options: args.method.options(),
             strict: args.method.strict,
             outside_policy: outside_policy(Some(method)),
             resident_rows: &|rows, columns| bind_resident_rows(args, rows, columns),
@@ -274,6 +274,127 @@ fn bind_to(
 #[cfg(test)]
 mod tests {
     use super::resident_rows;
+    use crate::coords::QuadSplit;
+    use crate::formats::metadata::read_classes_npy;
+    use crate::formats::npy::{read_npy, ExpectedArray};
+    use crate::geometry::generalized_winding_number;
+    use crate::geometry::procedural_quads::twisted_box;
+    use glam::DVec3;
+    use std::fmt::Write as _;
+
+    /// `pmvc bind --triangulate` classes each row against the cage it binds,
+    /// the quads split into triangles, not against the bilinear patches: the
+    /// class mask it writes is the split cage's own winding number, and PMVC
+    /// rows it calls inside are never negative.
+    #[test]
+    fn a_split_bind_writes_the_classes_of_the_cage_it_bound() {
+        let cage = twisted_box(2.0, 0.6);
+        let folder = tempfile::tempdir().expect("a temporary folder");
+        let mut cage_text = String::new();
+        for p in cage.positions() {
+            let _ = writeln!(cage_text, "v {:?} {:?} {:?}", p.x, p.y, p.z);
+        }
+        for face in cage.polygons() {
+            let corners: Vec<String> = face.iter().map(|i| (i + 1).to_string()).collect();
+            let _ = writeln!(cage_text, "f {}", corners.join(" "));
+        }
+        // A shell around the bent sides, where a patch and its triangles disagree.
+        let mut points = Vec::new();
+        let mut mesh_text = String::new();
+        for a in 0..40 {
+            let angle = (a as f64 + 0.37) * std::f64::consts::TAU / 40.0;
+            for r in 0..10 {
+                let radius = 0.7 + 0.75 * (r as f64 + 0.41) / 10.0;
+                for z in 0..6 {
+                    let p = DVec3::new(
+                        radius * angle.cos(),
+                        radius * angle.sin(),
+                        0.4 + 0.2 * z as f64,
+                    );
+                    let _ = writeln!(mesh_text, "v {:?} {:?} {:?}", p.x, p.y, p.z);
+                    points.push(p);
+                }
+            }
+        }
+        let cage_file = folder.path().join("cage.obj");
+        let mesh_file = folder.path().join("points.obj");
+        std::fs::write(&cage_file, cage_text).expect("cage written");
+        std::fs::write(&mesh_file, mesh_text).expect("points written");
+        let by_patches = crate::geometry::classify_points(&cage, &points).outside;
+        for (split, diagonal) in [
+            (QuadSplit::Shorter, "shorter"),
+            (QuadSplit::Longer, "longer"),
+        ] {
+            let out = folder.path().join(format!("W-{diagonal}.npy"));
+            let cli = <super::super::Cli as clap::Parser>::try_parse_from([
+                "pmvc",
+                "bind",
+                "--mesh",
+                mesh_file.to_str().unwrap(),
+                "--cage",
+                cage_file.to_str().unwrap(),
+                "--method",
+                "pmvc",
+                "--resolution",
+                "8",
+                "--backend",
+                "cpu",
+                "--triangulate",
+                diagonal,
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .expect("the arguments parse");
+            let Some(super::super::Command::Bind(args)) = cli.command else {
+                panic!("not a bind");
+            };
+            super::bind(&args).expect("the bind succeeds");
+            let bound = cage.split_quads(split);
+            let expected: Vec<i8> = points
+                .iter()
+                .map(|&p| {
+                    if generalized_winding_number(&bound, p) > 0.5 {
+                        0
+                    } else {
+                        2
+                    }
+                })
+                .collect();
+            let classes = read_classes_npy(
+                &out.with_file_name(format!("W-{diagonal}.classes.npy")),
+                points.len(),
+            )
+            .expect("the classes are written");
+            let outside = expected.iter().filter(|&&c| c == 2).count();
+            assert!(
+                outside.abs_diff(by_patches.len()) >= 50,
+                "{diagonal}: the split changes too few classes"
+            );
+            let wrong = (0..points.len())
+                .filter(|&i| classes[i] != expected[i])
+                .count();
+            assert_eq!(
+                wrong, 0,
+                "{diagonal}: {wrong} rows classed against the patches"
+            );
+            let weights = read_npy(
+                &out,
+                ExpectedArray::cage_vertices(points.len(), cage.vertex_count()),
+            )
+            .expect("the weights are written");
+            for row in (0..points.len()).filter(|&row| classes[row] == 0) {
+                let min = weights
+                    .row(row)
+                    .iter()
+                    .copied()
+                    .fold(f32::INFINITY, f32::min);
+                assert!(
+                    min >= 0.0,
+                    "{diagonal}: row {row} inside has a weight {min}"
+                );
+            }
+        }
+    }
 
     /// The memory check counts the block being written and the one bound
     /// meanwhile.

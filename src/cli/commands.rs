@@ -35,11 +35,14 @@ pub(super) fn outside_policy(method: Option<Method>) -> &'static str {
     }
 }
 
-/// How `load_input` treats the inputs: whose columns the weights have, what
-/// vertices outside the cage get, and how many weights rows are held at once.
+/// How `load_input` treats the inputs: whose columns the weights have, against
+/// which cage the points are classified, what vertices outside the cage get,
+/// and how many weights rows are held at once.
 pub(super) struct InputRules<'a> {
-    /// The family whose weights are held: it decides their columns.
-    pub method: Method,
+    /// The bind whose weights are held: its family decides their columns, and
+    /// the points are classified against the cage it binds (its quads split if
+    /// it splits them; [`BindOptions::classify`]).
+    pub options: BindOptions,
     /// `--strict`: vertices outside the cage are an error.
     pub strict: bool,
     /// What the warning says those vertices get ([`outside_policy`]).
@@ -53,13 +56,13 @@ pub(super) struct InputRules<'a> {
 pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundInput> {
     let mesh = crate::formats::load_mesh(&input.mesh)?;
     let (cage, report) = crate::formats::load_cage(&input.cage)?;
-    let columns = rules.method.columns(&cage);
+    let columns = rules.options.method.columns(&cage);
     let rows = (rules.resident_rows)(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
     for message in report.messages() {
         warn_line!("pmvc: {}: {message}", shown_path(&input.cage));
     }
-    let classes = classify_points(&cage, &mesh.mesh.positions);
+    let classes = rules.options.classify(&cage, &mesh.mesh.positions);
     if !classes.outside.is_empty() {
         let summary = outside_summary(&classes, mesh.mesh.positions.len());
         if rules.strict {
@@ -84,18 +87,7 @@ pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundI
 }
 
 fn outside_summary(classes: &PointClasses, total: usize) -> String {
-    let first: Vec<String> = classes.outside.iter().take(5).map(u32::to_string).collect();
-    let more = if classes.outside.len() > 5 {
-        ", …"
-    } else {
-        ""
-    };
-    format!(
-        "{} of {total} vertices ({:.2}%) lie outside the cage (first: {}{more})",
-        classes.outside.len(),
-        100.0 * classes.outside.len() as f64 / total.max(1) as f64,
-        first.join(", ")
-    )
+    crate::coords::outside_summary(&classes.outside, total)
 }
 
 /// Compute the weights with the chosen backend, showing progress on a terminal.
@@ -411,7 +403,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
         100.0 * negative_rows as f64 / weights.rows.max(1) as f64,
         weights.min().min(0.0)
     );
-    super::quad_report::report_split_effect(args, &cage, &points, &sample_classes)?;
+    super::quad_report::report_split_effect(args, &cage, &points)?;
     Ok(())
 }
 

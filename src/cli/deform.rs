@@ -121,7 +121,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     let input = load_input(
         &args.input,
         &InputRules {
-            method,
+            options,
             strict: args.method.strict,
             outside_policy: policy,
             resident_rows: &|rows, _| if holds_weights { rows } else { 0 },

@@ -5,19 +5,14 @@ use super::CheckArgs;
 use crate::coords::split_effect::{split_effect, standard_twist, Spread};
 use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
-use crate::geometry::{Cage, PointClass};
+use crate::geometry::Cage;
 use anyhow::Result;
 use glam::DVec3;
 
 /// Print, for every family, how far splitting the quads along one diagonal or
 /// the other moves the sampled inside vertices, at `--deformed-cage` or the
 /// standard twist. Nothing for a cage without quads.
-pub(super) fn report_split_effect(
-    args: &CheckArgs,
-    cage: &Cage,
-    points: &[DVec3],
-    classes: &[PointClass],
-) -> Result<()> {
+pub(super) fn report_split_effect(args: &CheckArgs, cage: &Cage, points: &[DVec3]) -> Result<()> {
     if !cage.has_quads() || points.is_empty() {
         return Ok(());
     }
@@ -43,7 +38,7 @@ pub(super) fn report_split_effect(
             grid: args.grid,
             ..BindOptions::for_method(method)
         };
-        let Some(effect) = split_effect(points, classes, cage, &pose, options)? else {
+        let Some(effect) = split_effect(points, cage, &pose, options)? else {
             continue;
         };
         let patches = match (effect.patches_vs_shorter, effect.patches_vs_longer) {

@@ -30,7 +30,7 @@ pub mod quality;
 pub mod split_effect;
 
 pub use crate::geometry::QuadSplit;
-use crate::geometry::{Cage, PointClass};
+use crate::geometry::{Cage, PointClass, PointClasses};
 pub use family::{
     FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
     DEFAULT_RESOLUTION,
@@ -39,6 +39,20 @@ use glam::DVec3;
 pub use quality::WeightQuality;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// How many of `total` points lie outside the cage, and the first few (0-based,
+/// ascending `outside`): the warning of a bind with outside points, and the
+/// error of a strict one (`--strict`, Python's `strict=True`).
+pub fn outside_summary(outside: &[u32], total: usize) -> String {
+    let first: Vec<String> = outside.iter().take(5).map(u32::to_string).collect();
+    let more = if outside.len() > 5 { ", …" } else { "" };
+    format!(
+        "{} of {total} vertices ({:.2}%) lie outside the cage (first: {}{more})",
+        outside.len(),
+        100.0 * outside.len() as f64 / total.max(1) as f64,
+        first.join(", ")
+    )
+}
 
 /// What to bind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,6 +124,16 @@ impl BindOptions {
             None => std::borrow::Cow::Borrowed(cage),
             Some(split) => std::borrow::Cow::Owned(cage.split_quads(split)),
         }
+    }
+
+    /// Where `points` lie for a bind with these options: classified against the
+    /// cage the family binds ([`Self::cage_to_bind`]), not the cage as given.
+    /// Where quads are split, their triangles decide inside and outside (a
+    /// bilinear patch bulges past one of its two triangles), and a point on the
+    /// surface is on the triangle the bind reads. Binds whose
+    /// [`Self::split_applied`] agree share their classes.
+    pub fn classify(&self, cage: &Cage, points: &[DVec3]) -> PointClasses {
+        crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
     /// How the cage's quads are split for this bind, if they are.
@@ -329,8 +353,8 @@ const ROWS_PER_TASK: usize = 32;
 
 /// Bind `points` to `cage` on the CPU, in parallel.
 ///
-/// `classes` comes from [`crate::geometry::classify_points`] for the same points and
-/// cage; it decides the inside/outside/surface policy described in the module doc.
+/// `classes` comes from [`BindOptions::classify`] for the same points, cage and
+/// options; it decides the inside/outside/surface policy described in the module doc.
 /// Families with a closed form or per-point integral go row by row
 /// ([`bind_rows`]); harmonic coordinates solve over the whole cage first.
 pub fn bind_cpu(

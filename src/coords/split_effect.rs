@@ -5,7 +5,7 @@
 //! splits, not families; `pmvc check` and the benchmarks report this.
 
 use super::{bind_cpu, BindFailure, BindOptions, BindProgress, QuadSplit};
-use crate::geometry::{Cage, PointClass};
+use crate::geometry::Cage;
 use glam::{DQuat, DVec3};
 
 /// Distances between two deformations of the same points, as shares of the
@@ -72,10 +72,10 @@ pub fn standard_twist(cage: &Cage) -> Vec<DVec3> {
 
 /// Bind `points` with `options`' family three ways (patches, shorter, longer)
 /// and deform them to `pose`; `None` for a cage without quads. Binding is on the
-/// CPU, so that the figures are the reference's.
+/// CPU, so that the figures are the reference's; each bind classes the points
+/// against the cage it binds ([`BindOptions::classify`]).
 pub fn split_effect(
     points: &[DVec3],
-    classes: &[PointClass],
     cage: &Cage,
     pose: &[DVec3],
     options: BindOptions,
@@ -85,7 +85,8 @@ pub fn split_effect(
     }
     let deformed = |quads: QuadSplit| -> Result<Vec<DVec3>, BindFailure> {
         let options = BindOptions { quads, ..options };
-        let weights = bind_cpu(points, classes, cage, options, &BindProgress::default())?;
+        let classes = options.classify(cage, points).classes;
+        let weights = bind_cpu(points, &classes, cage, options, &BindProgress::default())?;
         let bound = options.cage_to_bind(cage);
         let moves = options.method.column_displacements(&bound, pose);
         Ok(weights.apply_displacements(points, &moves))

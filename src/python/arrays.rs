@@ -50,7 +50,7 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
         bytes_for(rows as u64, 2 * std::mem::size_of::<DVec3>() as u64),
     )
     .map_err(|too_large| error(Kind::TooLarge, format!("{what}: {too_large}")))?;
-    let contiguous = numpy.call_method1("ascontiguousarray", (array, numpy.getattr("float64")?))?;
+    let contiguous = aligned(&array, "float64")?;
     let contiguous = contiguous.cast_into::<PyArray2<f64>>()?;
     let readonly = contiguous.readonly();
     let values = readonly
@@ -70,13 +70,27 @@ pub(super) fn positions(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DV
     Ok(points)
 }
 
+/// `value` as a C-contiguous, aligned numpy array of `dtype`: the array itself
+/// when it is one, else a copy. Arrays rebuilt from a buffer (a Dask worker's,
+/// one from `numpy.frombuffer` at an odd offset) can be contiguous but
+/// misaligned, which Rust cannot read in place.
+pub(super) fn aligned<'py>(value: &Bound<'py, PyAny>, dtype: &str) -> PyResult<Bound<'py, PyAny>> {
+    let numpy = value.py().import("numpy")?;
+    numpy.call_method1("require", (value, numpy.getattr(dtype)?, ("C", "A")))
+}
+
 /// `value` as polygons of vertex indices (0-based) into `vertex_count` vertices,
-/// each of at least 3 corners.
+/// each of at least 3 corners: a numpy integer array of shape (m, k), k ≥ 3
+/// (libigl's `F`: triangles for k = 3), or any sequence of index sequences
+/// (polygons of mixed sizes, quads staying quads).
 pub(super) fn faces(
     value: &Bound<'_, PyAny>,
     vertex_count: usize,
     what: &str,
 ) -> PyResult<Vec<Vec<u32>>> {
+    if let Some(faces) = integer_array_faces(value, vertex_count, what)? {
+        return Ok(faces);
+    }
     let not_faces = |cause: PyErr| {
         error(
             Kind::Input,
@@ -106,28 +120,88 @@ pub(super) fn faces(
                     format!("{what}: face {face}: {shown} is not an integer vertex index"),
                 )
             })?;
-            if index < 0 || index as u64 >= vertex_count as u64 {
-                return Err(error(
-                    Kind::Input,
-                    format!(
-                        "{what}: face {face} refers to vertex {index}, but there are {vertex_count} vertices (indices count from 0)"
-                    ),
-                ));
-            }
-            corners.push(index as u32);
+            corners.push(vertex_index(index, face, vertex_count, what)?);
         }
-        if corners.len() < 3 {
-            return Err(error(
-                Kind::Input,
-                format!(
-                    "{what}: face {face} has {} corners; a face needs at least 3",
-                    corners.len()
-                ),
-            ));
-        }
+        check_corner_count(corners.len(), face, what)?;
         faces.push(corners);
     }
     Ok(faces)
+}
+
+/// A face's corner `index`, checked against the `vertex_count` vertices.
+fn vertex_index(index: i64, face: usize, vertex_count: usize, what: &str) -> PyResult<u32> {
+    if index < 0 || index as u64 >= vertex_count as u64 {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "{what}: face {face} refers to vertex {index}, but there are {vertex_count} vertices (indices count from 0)"
+            ),
+        ));
+    }
+    Ok(index as u32)
+}
+
+/// A face needs three corners or more.
+fn check_corner_count(corners: usize, face: usize, what: &str) -> PyResult<()> {
+    if corners < 3 {
+        return Err(error(
+            Kind::Input,
+            format!("{what}: face {face} has {corners} corners; a face needs at least 3"),
+        ));
+    }
+    Ok(())
+}
+
+/// `value` as faces when it is a numpy array of integers of shape (m, k), read
+/// in one piece (no Python object per index); None for anything else, which
+/// [`faces`] reads as a sequence of sequences. Checked as every face is.
+fn integer_array_faces(
+    value: &Bound<'_, PyAny>,
+    vertex_count: usize,
+    what: &str,
+) -> PyResult<Option<Vec<Vec<u32>>>> {
+    let py = value.py();
+    let numpy = py.import("numpy")?;
+    if !value.is_instance(&numpy.getattr("ndarray")?)? {
+        return Ok(None);
+    }
+    let kind: String = value.getattr("dtype")?.getattr("kind")?.extract()?;
+    let shape: Vec<usize> = value.getattr("shape")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u") || shape.len() != 2 {
+        return Ok(None);
+    }
+    let (count, corners) = (shape[0], shape[1]);
+    if count > 0 {
+        check_corner_count(corners, 0, what)?;
+    }
+    check_memory(
+        || format!("{what}: {count} faces"),
+        bytes_for(count as u64, 64),
+    )
+    .map_err(|too_large| error(Kind::TooLarge, format!("{what}: {too_large}")))?;
+    // 64-bit unsigned indices past i64 are out of range all the same; clip
+    // them there (narrower ones fit).
+    let itemsize: usize = value.getattr("dtype")?.getattr("itemsize")?.extract()?;
+    let clipped = if kind == "u" && itemsize >= 8 {
+        numpy.call_method1("minimum", (value, i64::MAX as u64))?
+    } else {
+        value.clone()
+    };
+    let contiguous = aligned(&clipped, "int64")?;
+    let contiguous = contiguous.cast_into::<PyArray2<i64>>()?;
+    let readonly = contiguous.readonly();
+    let values = readonly
+        .as_slice()
+        .map_err(|cause| error(Kind::Input, format!("{what}: {cause}")))?;
+    let mut faces = Vec::with_capacity(count);
+    for (face, row) in values.chunks_exact(corners.max(1)).enumerate() {
+        let corners = row
+            .iter()
+            .map(|&index| vertex_index(index, face, vertex_count, what))
+            .collect::<PyResult<Vec<u32>>>()?;
+        faces.push(corners);
+    }
+    Ok(Some(faces))
 }
 
 /// Positions as a float64 array of shape (n, 3).

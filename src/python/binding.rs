@@ -4,13 +4,13 @@
 //! cancels the work through its cancel flag and raises `KeyboardInterrupt`
 //! once the work has stopped (within one block of rows or one GPU batch).
 
+use super::arguments::{flag, shown, text};
 use super::arrays::{matrix, positions};
-use super::errors::{error, Kind};
-use super::scene::PyCage;
+use super::errors::{backend_warning, error, Kind};
+use super::scene::{cage_argument, PyCage};
 use super::weights::PyWeights;
 use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
 use crate::formats::metadata::{class_codes, BindRecord, WeightsMetadata};
-use crate::geometry::classify_points;
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder, PmvcKernel};
 use numpy::PyArray2;
@@ -120,6 +120,12 @@ fn choose_backend(
         )
     })?;
     let work = Work::of(options, points, &cage.cage);
+    if request != BackendRequest::Cpu {
+        // Before any GPU probe: libwayland's complaint about a missing
+        // XDG_RUNTIME_DIR would otherwise reach stderr once per probe.
+        py.import("pmvc._environment")?
+            .call_method0("ensure_runtime_dir")?;
+    }
     py.detach(|| decide_and_open(request, &work))
         .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))
 }
@@ -176,7 +182,7 @@ fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u
 /// The options of a bind of `method` with `resolution` and `grid`: the
 /// family's own parameter is checked, the others are not read.
 /// A parameter not given keeps its default.
-fn bind_options(
+pub(super) fn bind_options(
     method: Method,
     resolution: Option<&Bound<'_, PyAny>>,
     grid: Option<&Bound<'_, PyAny>>,
@@ -214,51 +220,99 @@ fn bind_options(
 /// a GPU kernel bind on the CPU. ``pmvc_kernel`` is PMVC's GPU kernel:
 /// ``"auto"``, ``"tiles"`` or ``"bands"`` (as ``pmvc bind --pmvc-kernel``).
 /// ``progress``, if given, is called with ``(done, total)`` rows, from
-/// ``(0, total)`` to ``(total, total)``. The GIL is released while binding;
-/// Ctrl-C cancels within about a second.
+/// ``(0, total)`` to ``(total, total)``. ``strict=True`` raises InputError,
+/// before binding, when points lie outside the cage (as ``pmvc bind
+/// --strict``). ``cage`` is a :class:`Cage` or libigl's ``(V, F)`` pair. The
+/// GIL is released while binding; Ctrl-C cancels within about a second.
 #[pyfunction]
 #[pyo3(
-    signature = (points, cage, method="pmvc", resolution=None, grid=None, backend="auto", progress=None, triangulate=None, pmvc_kernel="auto"),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto')"
+    signature = (points, cage, method=None, resolution=None, grid=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False)"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
-    cage: PyRef<'py, PyCage>,
-    method: &str,
+    cage: &Bound<'py, PyAny>,
+    method: Option<Bound<'py, PyAny>>,
     resolution: Option<Bound<'py, PyAny>>,
     grid: Option<Bound<'py, PyAny>>,
-    backend: &str,
+    backend: Option<Bound<'py, PyAny>>,
     progress: Option<Bound<'py, PyAny>>,
     triangulate: Option<Bound<'py, PyAny>>,
-    pmvc_kernel: &str,
+    pmvc_kernel: Option<Bound<'py, PyAny>>,
+    strict: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyWeights> {
-    let method = method_from(method)?;
-    let pmvc_kernel = pmvc_kernel_from("bind", pmvc_kernel)?;
+    let method = method_argument(method.as_ref())?;
     let options = bind_options(
         method,
         resolution.as_ref(),
         grid.as_ref(),
         triangulate.as_ref(),
     )?;
+    let how = HowToBind::from_arguments(
+        "bind",
+        backend.as_ref(),
+        pmvc_kernel.as_ref(),
+        strict.as_ref(),
+    )?;
+    let cage = cage_argument(cage)?;
     let points = positions(points, "points")?;
-    let how = HowToBind {
-        backend,
-        pmvc_kernel,
-    };
     bind_points(py, points, &cage, options, &how, progress.as_ref())
 }
 
-/// Where and by which GPU kernel a bind runs, as `bind` and `deform` were told.
-pub(super) struct HowToBind<'a> {
-    pub backend: &'a str,
+/// Where and by which GPU kernel a bind runs, and whether points outside the
+/// cage are an error, as `bind` and `deform` were told.
+pub(super) struct HowToBind {
+    pub backend: String,
     pub pmvc_kernel: PmvcKernel,
+    pub strict: bool,
+}
+
+impl HowToBind {
+    /// `backend=`, `pmvc_kernel=` and `strict=` of `function` (None: the defaults).
+    fn from_arguments<'py>(
+        function: &str,
+        backend: Option<&Bound<'py, PyAny>>,
+        pmvc_kernel: Option<&Bound<'py, PyAny>>,
+        strict: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Self> {
+        let given =
+            |value: Option<&Bound<'py, PyAny>>| value.filter(|value| !value.is_none()).cloned();
+        let backend = match given(backend) {
+            Some(value) => text(&value, &format!("{function}: backend"))?,
+            None => "auto".to_owned(),
+        };
+        let pmvc_kernel = match given(pmvc_kernel) {
+            Some(value) => pmvc_kernel_from(
+                function,
+                &text(&value, &format!("{function}: pmvc_kernel"))?,
+            )?,
+            None => PmvcKernel::Auto,
+        };
+        let strict = match given(strict) {
+            Some(value) => flag(&value, &format!("{function}: strict"))?,
+            None => false,
+        };
+        Ok(Self {
+            backend,
+            pmvc_kernel,
+            strict,
+        })
+    }
 }
 
 /// `pmvc_kernel=` checked by the command line's one parser.
 fn pmvc_kernel_from(function: &str, text: &str) -> PyResult<PmvcKernel> {
     PmvcKernel::parse(text).map_err(|cause| error(Kind::Parameter, format!("{function}: {cause}")))
+}
+
+/// `method=`: a family id, "pmvc" when not given.
+pub(super) fn method_argument(value: Option<&Bound<'_, PyAny>>) -> PyResult<Method> {
+    match value.filter(|value| !value.is_none()) {
+        Some(value) => method_from(&text(value, "method")?),
+        None => Ok(Method::Pmvc),
+    }
 }
 
 /// Bind already-checked points; `bind` and `deform` share it.
@@ -267,12 +321,26 @@ pub(super) fn bind_points(
     points: Vec<glam::DVec3>,
     cage: &PyCage,
     options: BindOptions,
-    how: &HowToBind<'_>,
+    how: &HowToBind,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyWeights> {
-    let decision = choose_backend(py, how.backend, options, points.len(), cage)?;
+    let decision = choose_backend(py, &how.backend, options, points.len(), cage)?;
     let pmvc_kernel = how.pmvc_kernel;
     let on_gpu = decision.on_gpu(options.method);
+    if how.backend == "gpu" && !on_gpu {
+        let label = match options.parameter() {
+            Some((spec, value)) => format!(
+                "{} {}",
+                options.family_name(&cage.cage),
+                (spec.format)(value)
+            ),
+            None => options.family_name(&cage.cage),
+        };
+        backend_warning(
+            py,
+            &format!("bind: {label} has no GPU kernel; it was bound on the CPU (backend \"gpu\" was asked for)"),
+        )?;
+    }
     let backend = decision.backend;
     let device = backend.clone();
     let rows = points.len();
@@ -291,8 +359,13 @@ pub(super) fn bind_points(
     };
     let cage_arc = Arc::clone(&cage.cage);
     let bound_points = Arc::clone(&points);
-    let (classes, result) = run_interruptible(py, task, || {
-        let classes: Arc<[_]> = classify_points(&cage_arc, &bound_points).classes.into();
+    let strict = how.strict;
+    let (classes, outside, result) = run_interruptible(py, task, || {
+        let classified = options.classify(&cage_arc, &bound_points);
+        let classes: Arc<[_]> = classified.classes.into();
+        if strict && !classified.outside.is_empty() {
+            return (classes, classified.outside, None);
+        }
         let input = BindInput {
             points: bound_points,
             classes: Arc::clone(&classes),
@@ -305,12 +378,14 @@ pub(super) fn bind_points(
                 ..BindConfig::default()
             })
             .bind_blocking(&input, &shared);
-        (classes, result)
+        (classes, classified.outside, Some(result))
     })?;
+    let Some(result) = result else {
+        return Err(outside_error(&outside, rows));
+    };
     if let Backend::Gpu(context) = &device {
         for notice in context.take_notices() {
-            use std::io::Write as _;
-            let _ = writeln!(std::io::stderr(), "pmvc: {notice}");
+            backend_warning(py, &format!("bind: {notice}"))?;
         }
     }
     let output = result.map_err(|cause| bind_error(&cause))?;
@@ -343,6 +418,18 @@ pub(super) fn bind_points(
     ))
 }
 
+/// `strict=True` with points outside the cage: the command line's `--strict`
+/// error.
+pub(super) fn outside_error(outside: &[u32], rows: usize) -> PyErr {
+    error(
+        Kind::Input,
+        format!(
+            "points: {} (strict=True)",
+            crate::coords::outside_summary(outside, rows)
+        ),
+    )
+}
+
 fn bind_error(cause: &BindError) -> PyErr {
     use crate::coords::harmonic::HarmonicError;
     use crate::gpu::GpuError;
@@ -363,10 +450,12 @@ fn bind_error(cause: &BindError) -> PyErr {
 /// With ``weights`` (from :func:`bind` or :func:`load_weights`), those are
 /// applied; they must have been bound for these points and this cage. Without,
 /// ``method`` (default ``"pmvc"``) is bound first, with ``resolution``,
-/// ``grid``, ``backend`` and ``progress`` as :func:`bind` takes them. Each
-/// point moves by Σₖ wₖ dₖ, dₖ the move of column k's vector (a cage vertex's
-/// position, or for Green coordinates a triangle's scaled normal), summed in
-/// float64.
+/// ``grid``, ``backend``, ``progress``, ``triangulate``, ``pmvc_kernel`` and
+/// ``strict`` as :func:`bind` takes them (``strict=True`` with ``weights``
+/// refuses weights with rows outside the cage). ``cage`` is a :class:`Cage` or
+/// libigl's ``(V, F)`` pair. Each point moves by Σₖ wₖ dₖ, dₖ the move of
+/// column k's vector (a cage vertex's position, or for Green coordinates a
+/// triangle's scaled normal), summed in float64.
 #[pyfunction]
 #[pyo3(
     signature = (points, cage, deformed_vertices, weights=None, method=None, **parameters),
@@ -375,12 +464,67 @@ fn bind_error(cause: &BindError) -> PyErr {
 pub(super) fn deform<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
-    cage: PyRef<'py, PyCage>,
+    cage: &Bound<'py, PyAny>,
     deformed_vertices: &Bound<'py, PyAny>,
-    weights: Option<PyRef<'py, PyWeights>>,
-    method: Option<&str>,
+    weights: Option<Bound<'py, PyAny>>,
+    method: Option<Bound<'py, PyAny>>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const BINDING: [&str; 7] = [
+        "resolution",
+        "grid",
+        "backend",
+        "progress",
+        "triangulate",
+        "pmvc_kernel",
+        "strict",
+    ];
+    let weights = match weights.filter(|value| !value.is_none()) {
+        Some(value) => Some(value.cast_into::<PyWeights>().map_err(|refused| {
+            error(
+                Kind::Input,
+                format!(
+                    "deform: weights: {} is not a pmvc.Weights (from bind or load_weights)",
+                    shown(refused.into_inner().as_any())
+                ),
+            )
+        })?),
+        None => None,
+    };
+    let parameter = |name: &str| -> PyResult<Option<Bound<'py, PyAny>>> {
+        parameters.map_or(Ok(None), |given| given.get_item(name))
+    };
+    if let Some(given) = parameters {
+        for key in given.keys() {
+            let key: String = key.extract()?;
+            if !BINDING.contains(&key.as_str()) {
+                return Err(error(
+                    Kind::Parameter,
+                    format!(
+                        "deform: unknown parameter \"{key}\" (known: {})",
+                        BINDING.join(", ")
+                    ),
+                ));
+            }
+            if weights.is_some() && key != "strict" {
+                return Err(error(
+                    Kind::Parameter,
+                    format!("deform: \"{key}\" is for binding, but weights were given"),
+                ));
+            }
+        }
+    }
+    let how = HowToBind::from_arguments(
+        "deform",
+        parameter("backend")?.as_ref(),
+        parameter("pmvc_kernel")?.as_ref(),
+        parameter("strict")?.as_ref(),
+    )?;
+    let asked = match method.filter(|value| !value.is_none()) {
+        Some(value) => Some(method_from(&text(&value, "deform: method")?)?),
+        None => None,
+    };
+    let cage = cage_argument(cage)?;
     let pose = positions(deformed_vertices, "deformed_vertices")?;
     let expected = cage.cage.vertex_count();
     if pose.len() != expected {
@@ -393,40 +537,10 @@ pub(super) fn deform<'py>(
         ));
     }
     let points = positions(points, "points")?;
-    let parameter = |name: &str| -> PyResult<Option<Bound<'py, PyAny>>> {
-        parameters.map_or(Ok(None), |given| given.get_item(name))
-    };
-    if let Some(given) = parameters {
-        for key in given.keys() {
-            let key: String = key.extract()?;
-            if ![
-                "resolution",
-                "grid",
-                "backend",
-                "progress",
-                "triangulate",
-                "pmvc_kernel",
-            ]
-            .contains(&key.as_str())
-            {
-                return Err(error(
-                    Kind::Parameter,
-                    format!("deform: unknown parameter \"{key}\" (known: resolution, grid, backend, progress, triangulate, pmvc_kernel)"),
-                ));
-            }
-            if weights.is_some() {
-                return Err(error(
-                    Kind::Parameter,
-                    format!("deform: \"{key}\" is for binding, but weights were given"),
-                ));
-            }
-        }
-    }
-    let fresh;
-    let weights = match weights {
-        Some(weights) => {
-            if let Some(asked) = method {
-                let asked = method_from(asked)?;
+    let weights: Bound<'py, PyWeights> = match weights {
+        Some(given) => {
+            let weights = given.get();
+            if let Some(asked) = asked {
                 if asked != weights.method() {
                     return Err(error(
                         Kind::Weights,
@@ -438,36 +552,25 @@ pub(super) fn deform<'py>(
                     ));
                 }
             }
-            weights
+            if how.strict {
+                weights.check_strict(py)?;
+            }
+            given
         }
         None => {
-            let method = method_from(method.unwrap_or("pmvc"))?;
             let options = bind_options(
-                method,
+                asked.unwrap_or(Method::Pmvc),
                 parameter("resolution")?.as_ref(),
                 parameter("grid")?.as_ref(),
                 parameter("triangulate")?.as_ref(),
             )?;
-            let backend: String = match parameter("backend")? {
-                Some(value) => value.extract()?,
-                None => "auto".into(),
-            };
-            let pmvc_kernel: String = match parameter("pmvc_kernel")? {
-                Some(value) => value.extract()?,
-                None => "auto".into(),
-            };
-            let how = HowToBind {
-                backend: &backend,
-                pmvc_kernel: pmvc_kernel_from("deform", &pmvc_kernel)?,
-            };
             let progress = parameter("progress")?.filter(|p| !p.is_none());
-            fresh = Py::new(
+            Bound::new(
                 py,
                 bind_points(py, points.clone(), &cage, options, &how, progress.as_ref())?,
-            )?;
-            fresh.borrow(py)
+            )?
         }
     };
-    let deformed = weights.apply(py, &points, &cage, &pose)?;
+    let deformed = weights.get().apply(py, &points, &cage, &pose)?;
     super::arrays::positions_array(py, &deformed)
 }

@@ -78,6 +78,15 @@ fn raise(kind: Kind, message: String, path: Option<&Path>, line: Option<usize>) 
     })
 }
 
+/// A `pmvc.BackendWarning` (through Python's `warnings`, so that filters and
+/// `pytest.warns` see it), pointing at the caller's line.
+pub(super) fn backend_warning(py: Python<'_>, message: &str) -> PyResult<()> {
+    let category = py.import("pmvc._errors")?.getattr("BackendWarning")?;
+    py.import("warnings")?
+        .call_method1("warn", (message, category, 1))
+        .map(|_| ())
+}
+
 /// A mesh file that could not be read, naming the file and line.
 pub(super) fn load_error(error: &LoadError) -> PyErr {
     let message = error.to_string();

@@ -18,6 +18,7 @@
 //! `BindOptions::validate`, the weights readers); nothing here re-implements a
 //! family.
 
+mod arguments;
 mod arrays;
 mod binding;
 mod errors;
@@ -32,6 +33,8 @@ fn _native(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<scene::PyCage>()?;
     module.add_class::<weights::PyWeights>()?;
     module.add_function(wrap_pyfunction!(scene::load_mesh, module)?)?;
+    module.add_function(wrap_pyfunction!(scene::restore_cage, module)?)?;
+    module.add_function(wrap_pyfunction!(weights::restore_weights, module)?)?;
     module.add_function(wrap_pyfunction!(scene::classify, module)?)?;
     module.add_function(wrap_pyfunction!(scene::generate_cage, module)?)?;
     module.add_function(wrap_pyfunction!(scene::families, module)?)?;

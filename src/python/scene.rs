@@ -7,7 +7,7 @@ use crate::cagegen::{self, CageOptions};
 use crate::coords::family::ColumnLayout;
 use crate::coords::Method;
 use crate::formats::metadata::class_codes;
-use crate::geometry::{self, classify_points, Cage, CageReport};
+use crate::geometry::{self, Cage, CageReport};
 use crate::geometry::{polygons_of, triangulate_faces};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -31,11 +31,15 @@ pub(super) struct PyCage {
     faces: Vec<Vec<u32>>,
     report: CageReport,
     pub(super) path: Option<PathBuf>,
+    /// What the cage was validated from: its pickled state. Validating it
+    /// again gives this cage bit for bit (validation is deterministic).
+    source: Arc<geometry::TriMesh>,
 }
 
 impl PyCage {
     fn validated(mesh: geometry::TriMesh, path: Option<PathBuf>, py: Python<'_>) -> PyResult<Self> {
         let mut faces = polygons_of(&mesh);
+        let source = Arc::new(mesh.clone());
         let (cage, report) = py.detach(|| Cage::new(mesh)).map_err(|cause| match &path {
             Some(path) => cage_load_error(&crate::formats::CageLoadError::Invalid {
                 path: path.clone(),
@@ -56,7 +60,136 @@ impl PyCage {
             faces,
             report,
             path,
+            source,
         })
+    }
+}
+
+/// A `cage` argument: a `pmvc.Cage`, or libigl's `(V, F)` pair, validated now
+/// as `Cage(V, F)` validates it.
+pub(super) enum CageArgument<'py> {
+    Cage(Bound<'py, PyCage>),
+    Built(PyCage),
+}
+
+impl std::ops::Deref for CageArgument<'_> {
+    type Target = PyCage;
+
+    fn deref(&self) -> &PyCage {
+        match self {
+            CageArgument::Cage(cage) => cage.get(),
+            CageArgument::Built(cage) => cage,
+        }
+    }
+}
+
+/// `value` as a cage: a `pmvc.Cage`, or a `(vertices, faces)` pair (a tuple or
+/// list of two) with `faces` an integer array (m, k) or a sequence of polygons.
+pub(super) fn cage_argument<'py>(value: &Bound<'py, PyAny>) -> PyResult<CageArgument<'py>> {
+    if let Ok(cage) = value.cast::<PyCage>() {
+        return Ok(CageArgument::Cage(cage.clone()));
+    }
+    let pair = value
+        .cast::<PyTuple>()
+        .map(|tuple| tuple.iter().collect::<Vec<_>>())
+        .or_else(|_| value.cast::<PyList>().map(|list| list.iter().collect()));
+    match pair {
+        Ok(items) if items.len() == 2 => {
+            PyCage::from_arrays(value.py(), &items[0], &items[1]).map(CageArgument::Built)
+        }
+        Ok(items) => Err(error(
+            Kind::Input,
+            format!(
+                "cage: a (vertices, faces) pair has 2 items, not {}",
+                items.len()
+            ),
+        )),
+        Err(_) => Err(error(
+            Kind::Input,
+            format!(
+                "cage: {} is neither a pmvc.Cage nor a (vertices, faces) pair",
+                super::arguments::shown(value)
+            ),
+        )),
+    }
+}
+
+/// A cage from its pickled state (``Cage.__reduce__``): the vertices,
+/// triangles and each triangle's face it was validated from, and its file.
+/// Checked and validated as any cage is, since a pickle is input like any other.
+#[pyfunction]
+#[pyo3(name = "_restore_cage", signature = (vertices, triangles, triangle_faces, path=None))]
+pub(super) fn restore_cage(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    triangles: &Bound<'_, PyAny>,
+    triangle_faces: &Bound<'_, PyAny>,
+    path: Option<PathBuf>,
+) -> PyResult<PyCage> {
+    let what = "pickled cage";
+    let positions = positions(vertices, &format!("{what}: vertices"))?;
+    let rows = super::arrays::faces(triangles, positions.len(), &format!("{what}: triangles"))?;
+    let triangles = rows
+        .iter()
+        .enumerate()
+        .map(|(t, row)| {
+            <[u32; 3]>::try_from(row.as_slice()).map_err(|_| {
+                error(
+                    Kind::Input,
+                    format!("{what}: triangle {t} has {} corners, not 3", row.len()),
+                )
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let triangle_faces: Vec<i64> = triangle_faces.extract().map_err(|_| {
+        error(
+            Kind::Input,
+            format!("{what}: triangle_faces is not a sequence of face indices"),
+        )
+    })?;
+    if triangle_faces.len() != triangles.len() {
+        return Err(error(
+            Kind::Input,
+            format!(
+                "{what}: {} triangle faces for {} triangles",
+                triangle_faces.len(),
+                triangles.len()
+            ),
+        ));
+    }
+    let triangle_faces = triangle_faces
+        .iter()
+        .enumerate()
+        .map(|(t, &face)| {
+            u32::try_from(face).map_err(|_| {
+                error(
+                    Kind::Input,
+                    format!("{what}: triangle {t}'s face {face} is not a face index"),
+                )
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    PyCage::validated(
+        geometry::TriMesh {
+            positions,
+            triangles,
+            triangle_faces,
+        },
+        path,
+        py,
+    )
+}
+
+impl PyCage {
+    /// `Cage(vertices, faces)`, and a `(V, F)` pair given where a cage is taken.
+    fn from_arrays(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let vertices = positions(vertices, "cage vertices")?;
+        let faces = super::arrays::faces(faces, vertices.len(), "cage faces")?;
+        Self::validated(triangulate_faces(&faces, &vertices), None, py)
     }
 }
 
@@ -68,14 +201,13 @@ impl PyCage {
         vertices: &Bound<'_, PyAny>,
         faces: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
-        let vertices = positions(vertices, "cage vertices")?;
-        let faces = super::arrays::faces(faces, vertices.len(), "cage faces")?;
-        Self::validated(triangulate_faces(&faces, &vertices), None, py)
+        Self::from_arrays(py, vertices, faces)
     }
 
     /// Read and validate a cage from an OBJ or OFF file.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let path = super::arguments::path(path, "Cage.load")?;
         let file = py
             .detach(|| crate::formats::load_mesh(&path))
             .map_err(|cause| load_error(&cause))?;
@@ -159,6 +291,30 @@ impl PyCage {
         self.path.clone()
     }
 
+    /// Pickling, ``copy`` and ``copy.deepcopy``: the vertices and triangles the
+    /// cage was validated from (float64 and int64 arrays, so a pickle costs
+    /// their bytes) and its file; loading validates them again, which gives
+    /// this cage bit for bit.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.import("pmvc._native")?.getattr("_restore_cage")?;
+        let source = &self.source;
+        let faces: Vec<i64> = source.triangle_faces.iter().map(|&f| f.into()).collect();
+        let path = match &self.path {
+            Some(path) => path.into_pyobject(py)?.into_any(),
+            None => py.None().into_bound(py),
+        };
+        let state = PyTuple::new(
+            py,
+            [
+                positions_array(py, &source.positions)?.into_any(),
+                triangles_array(py, &source.triangles)?.into_any(),
+                PyArray1::from_vec(py, faces).into_any(),
+                path,
+            ],
+        )?;
+        PyTuple::new(py, [restore, state.into_any()])
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Cage({} vertices, {} faces, {} triangles{})",
@@ -173,30 +329,53 @@ impl PyCage {
     }
 }
 
-/// Read an OBJ or OFF file, or a ``.npy`` point set: ``(vertices, faces)``,
-/// vertices float64 (n, 3) in file order, faces a list of polygons of 0-based
-/// indices (empty for a point set).
+/// Read an OBJ or OFF file, the first mesh of a glTF file, or a ``.npy`` point
+/// set: ``(vertices, faces)`` as libigl's ``read_triangle_mesh`` gives them.
+/// ``vertices`` is float64 (n, 3) in file order; ``faces`` is an int64 array
+/// (m, 3) of 0-based indices when every face is a triangle ((0, 3) for a point
+/// set), and a list of polygons (lists of indices) when a face has more
+/// corners, so that quads stay quads.
 #[pyfunction]
-pub(super) fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
+pub(super) fn load_mesh<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let path = super::arguments::path(path, "load_mesh")?;
     let file = py
         .detach(|| crate::formats::load_mesh(&path))
         .map_err(|cause| load_error(&cause))?;
     let vertices = positions_array(py, &file.mesh.positions)?;
-    let faces = faces_list(py, &polygons_of(&file.mesh))?;
-    PyTuple::new(py, [vertices.into_any(), faces.into_any()])
+    let polygons = polygons_of(&file.mesh);
+    let faces = if polygons.iter().all(|face| face.len() == 3) {
+        let flat: Vec<i64> = polygons.iter().flatten().map(|&i| i64::from(i)).collect();
+        super::arrays::matrix(py, flat, polygons.len(), 3)?.into_any()
+    } else {
+        faces_list(py, &polygons)?.into_any()
+    };
+    PyTuple::new(py, [vertices.into_any(), faces])
 }
 
 /// Where each point lies, int8: 0 inside the cage, 1 on it, 2 outside (by the
-/// generalised winding number, as ``bind`` classes its rows).
+/// generalised winding number), exactly as ``bind`` with the same ``method``
+/// and ``triangulate`` classes its rows: against the cage it binds. Without
+/// them, a cage's quads are bilinear patches; ``triangulate="shorter"`` or
+/// ``"longer"`` classes against the quads split along that diagonal, and
+/// ``method="green"`` against the shorter split Green coordinates bind on.
 #[pyfunction]
+#[pyo3(signature = (points, cage, method=None, triangulate=None))]
 pub(super) fn classify<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
-    cage: PyRef<'py, PyCage>,
+    cage: &Bound<'py, PyAny>,
+    method: Option<Bound<'py, PyAny>>,
+    triangulate: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<i8>>> {
+    let method = super::binding::method_argument(method.as_ref())?;
+    let options = super::binding::bind_options(method, None, None, triangulate.as_ref())?;
+    let cage = cage_argument(cage)?;
     let points = positions(points, "points")?;
     let cage = Arc::clone(&cage.cage);
-    let codes = py.detach(|| class_codes(&classify_points(&cage, &points).classes));
+    let codes = py.detach(|| class_codes(&options.classify(&cage, &points).classes));
     Ok(PyArray1::from_vec(py, codes))
 }
 
@@ -208,18 +387,29 @@ pub(super) fn classify<'py>(
 /// into quads (bilinear patches) where they fit, as ``pmvc cage --quads``.
 /// Ctrl-C cancels.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, target, clearance=None, cell_size=None, progress=None, quads=false))]
+#[pyo3(
+    signature = (vertices, faces, target, clearance=None, cell_size=None, progress=None, quads=None),
+    text_signature = "(vertices, faces, target, clearance=None, cell_size=None, progress=None, quads=False)"
+)]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments
 pub(super) fn generate_cage<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
     faces: &Bound<'py, PyAny>,
-    target: i64,
-    clearance: Option<f64>,
-    cell_size: Option<f64>,
+    target: &Bound<'py, PyAny>,
+    clearance: Option<Bound<'py, PyAny>>,
+    cell_size: Option<Bound<'py, PyAny>>,
     progress: Option<Bound<'py, PyAny>>,
-    quads: bool,
+    quads: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(PyCage, Bound<'py, PyDict>)> {
+    use super::arguments::{flag, integer, optional_number};
+    let target = integer(target, "generate_cage: target")?;
+    let clearance = optional_number(clearance.as_ref(), "generate_cage: clearance")?;
+    let cell_size = optional_number(cell_size.as_ref(), "generate_cage: cell_size")?;
+    let quads = match quads.filter(|value| !value.is_none()) {
+        Some(value) => flag(&value, "generate_cage: quads")?,
+        None => false,
+    };
     let target = usize::try_from(target).map_err(|_| {
         error(
             Kind::Parameter,

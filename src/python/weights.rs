@@ -15,8 +15,8 @@ use crate::formats::shown_path;
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-use std::path::PathBuf;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+use std::path::{Path, PathBuf};
 
 /// The weights of a bind: ``matrix`` (float32, one row per point, one column
 /// per entry of ``columns``), ``classes`` (int8 per row: 0 inside, 1 on the
@@ -122,6 +122,23 @@ impl PyWeights {
             cols: columns,
             values,
         })
+    }
+
+    /// `strict=True` with these weights: an error when a row is outside the cage.
+    pub(super) fn check_strict(&self, py: Python<'_>) -> PyResult<()> {
+        let classes = self.classes.bind(py).readonly();
+        let outside: Vec<u32> = classes
+            .as_array()
+            .iter()
+            .enumerate()
+            .filter(|(_, &class)| class == crate::formats::metadata::CLASS_OUTSIDE)
+            .map(|(row, _)| row as u32)
+            .collect();
+        if outside.is_empty() {
+            Ok(())
+        } else {
+            Err(super::binding::outside_error(&outside, classes.len()))
+        }
     }
 
     /// `points` moved as `pmvc deform --weights` moves them, after its checks:
@@ -251,15 +268,103 @@ impl PyWeights {
             .call_method1("loads", (self.metadata.to_json_pretty(),))
     }
 
+    /// Pickling, ``copy`` and ``copy.deepcopy``: the matrix and classes as the
+    /// arrays they are (a pickle costs their bytes, and protocol 5 hands them
+    /// over without a copy), the metadata as ``W.json`` holds it, and the file
+    /// they were read from. Loading checks the metadata as :func:`load_weights`
+    /// does and the arrays against it.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.import("pmvc._native")?.getattr("_restore_weights")?;
+        let path = match &self.path {
+            Some(path) => path.into_pyobject(py)?.into_any(),
+            None => py.None().into_bound(py),
+        };
+        let state = PyTuple::new(
+            py,
+            [
+                self.matrix.bind(py).clone().into_any(),
+                self.classes.bind(py).clone().into_any(),
+                PyString::new(py, &self.metadata.to_json_pretty()).into_any(),
+                path,
+            ],
+        )?;
+        PyTuple::new(py, [restore, state.into_any()])
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Weights({}, {} × {} float32, {})",
-            self.method().name(),
+            self.metadata.method_name,
             self.metadata.rows,
             self.metadata.columns,
             self.metadata.backend
         )
     }
+}
+
+/// Weights from their pickled state (``Weights.__reduce__``): the metadata
+/// checked as :func:`load_weights` checks ``W.json`` (format, family,
+/// parameters, columns), and the arrays against it.
+#[pyfunction]
+#[pyo3(name = "_restore_weights", signature = (matrix, classes, metadata, path=None))]
+pub(super) fn restore_weights(
+    matrix: &Bound<'_, PyAny>,
+    classes: &Bound<'_, PyAny>,
+    metadata: &str,
+    path: Option<PathBuf>,
+) -> PyResult<PyWeights> {
+    let what = Path::new("pickled weights");
+    let metadata: WeightsMetadata = serde_json::from_str(metadata).map_err(|cause| {
+        error(
+            Kind::Weights,
+            format!("pickled weights: the metadata is not W.json: {cause}"),
+        )
+    })?;
+    let options = metadata
+        .check_consistent(what)
+        .map_err(|cause| error(Kind::Weights, cause.to_string()))?;
+    let (rows, columns) = (metadata.rows, metadata.columns);
+    // Arrays rebuilt from a buffer may be misaligned: aligned here, once.
+    let not_matrix = || {
+        error(
+            Kind::Weights,
+            "pickled weights: the matrix is not a 2-dimensional float32 array",
+        )
+    };
+    matrix.cast::<PyArray2<f32>>().map_err(|_| not_matrix())?;
+    let matrix = super::arrays::aligned(matrix, "float32")?
+        .cast_into::<PyArray2<f32>>()
+        .map_err(|_| not_matrix())?;
+    if matrix.shape() != [rows, columns] {
+        return Err(error(
+            Kind::Weights,
+            format!(
+                "pickled weights: the matrix has shape {}, but the metadata says ({rows}, {columns})",
+                crate::formats::npy::header::shape_text(
+                    &matrix.shape().iter().map(|&n| n as u64).collect::<Vec<_>>()
+                )
+            ),
+        ));
+    }
+    let not_classes = || {
+        error(
+            Kind::Weights,
+            "pickled weights: the classes are not a 1-dimensional int8 array",
+        )
+    };
+    classes.cast::<PyArray1<i8>>().map_err(|_| not_classes())?;
+    let classes = super::arrays::aligned(classes, "int8")?
+        .cast_into::<PyArray1<i8>>()
+        .map_err(|_| not_classes())?;
+    if classes.len() != rows {
+        return Err(error(
+            Kind::Weights,
+            format!("pickled weights: {} classes for {rows} rows", classes.len()),
+        ));
+    }
+    let mut weights = PyWeights::new(matrix.unbind(), classes.unbind(), metadata, options);
+    weights.path = path;
+    Ok(weights)
 }
 
 /// Write ``weights`` as ``pmvc bind`` writes them: the matrix to ``path``
@@ -269,9 +374,20 @@ impl PyWeights {
 #[pyfunction]
 pub(super) fn save_weights(
     py: Python<'_>,
-    path: PathBuf,
-    weights: PyRef<'_, PyWeights>,
+    path: &Bound<'_, PyAny>,
+    weights: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
+    let path = super::arguments::path(path, "save_weights")?;
+    let weights = weights.cast::<PyWeights>().map_err(|_| {
+        error(
+            Kind::Input,
+            format!(
+                "save_weights: weights: {} is not a pmvc.Weights (from bind or load_weights)",
+                super::arguments::shown(weights)
+            ),
+        )
+    })?;
+    let weights = weights.get();
     let npz = weights.method().spec().columns == ColumnLayout::CageVerticesThenTriangles;
     let extension = path
         .extension()
@@ -305,7 +421,8 @@ pub(super) fn save_weights(
 /// (``W.json``) first, then the matrix with the shape it states (checked as
 /// ``pmvc deform --weights`` checks it), then the classes (``W.classes.npy``).
 #[pyfunction]
-pub(super) fn load_weights(py: Python<'_>, path: PathBuf) -> PyResult<PyWeights> {
+pub(super) fn load_weights(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyWeights> {
+    let path = super::arguments::path(path, "load_weights")?;
     let loaded = py
         .detach(|| load_weights_set(&path))
         .map_err(|cause| metadata_error(&cause))?;

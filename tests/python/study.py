@@ -24,15 +24,29 @@ import pmvc
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared" / "data" / "qmvc"
-# The reference every family is compared with: the finest PMVC.
+# Each family's method and parameters; the first is the MVC of the figure, the
+# third the reference every family is compared with (the finest PMVC).
 FAMILIES = [
-    ("MVC", "mvc", {}),
-    ("PMVC 32²", "pmvc", {"resolution": 32}),
-    ("PMVC 64²", "pmvc", {"resolution": 64}),
-    ("HC grid 64", "harmonic", {"grid": 64}),
-    ("Green", "green", {}),
+    ("mvc", {}),
+    ("pmvc", {"resolution": 32}),
+    ("pmvc", {"resolution": 64}),
+    ("harmonic", {"grid": 64}),
+    ("green", {}),
 ]
-REFERENCE = "PMVC 64²"
+MVC, REFERENCE = 0, 2
+
+
+def family_label(weights: pmvc.Weights) -> str:
+    """What the weights are, as the command line names them: the metadata's
+    family name on this cage (QMVC for MVC on a cage's bilinear quads) and the
+    parameter, e.g. "PMVC 32²", "HC grid 64"."""
+    name = weights.metadata["method_name"]
+    parameters = weights.parameters
+    if "resolution" in parameters:
+        return f"{name} {parameters['resolution']}²"
+    if "grid" in parameters:
+        return f"{name} grid {parameters['grid']}"
+    return name
 
 
 def middle_finger_pose(cage: pmvc.Cage, lift: float = 1.5) -> np.ndarray:
@@ -76,18 +90,20 @@ def study(name: str, figure: Path | None, backend: str) -> int:
         f"({len(cage.triangles)} triangles), pose: {pose_text}, backend {backend}"
     )
     results = {}
-    for label, method, parameters in FAMILIES:
+    for method, parameters in FAMILIES:
         weights = pmvc.bind(points, cage, method=method, backend=backend, **parameters)
         moved = pmvc.deform(points, cage, pose, weights=weights)
-        results[label] = (weights, moved)
-    classes = results[REFERENCE][0].classes
+        results[family_label(weights)] = (weights, moved)
+    labels = list(results)
+    reference_label = labels[REFERENCE]
+    classes = results[reference_label][0].classes
     inside = classes == pmvc.INSIDE
-    reference = results[REFERENCE][1]
+    reference = results[reference_label][1]
     vertices = len(cage.vertices)
     print()
     print(
         "| family | min weight, all rows | min weight inside | inside rows with a weight < 0 "
-        f"| max distance to {REFERENCE} | mean distance to {REFERENCE} |"
+        f"| max distance to {reference_label} | mean distance to {reference_label} |"
     )
     print("|---|---|---|---|---|---|")
     for label, (weights, moved) in results.items():
@@ -108,7 +124,7 @@ def study(name: str, figure: Path | None, backend: str) -> int:
     print(
         "bind seconds: "
         + ", ".join(f"{label} {weights.seconds:.2f}" for label, (weights, _) in results.items())
-        + f" ({results[REFERENCE][0].device})"
+        + f" ({results[reference_label][0].device})"
     )
     if figure is not None:
         save_figure(figure, name, points, results, diagonal, cage, pose)
@@ -122,8 +138,10 @@ def save_figure(path: Path, name, points, results, diagonal, cage, pose) -> None
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    reference = results[REFERENCE][1]
-    mvc = results["MVC"][1]
+    labels = list(results)
+    reference_label, mvc_label = labels[REFERENCE], labels[MVC]
+    reference = results[reference_label][1]
+    mvc = results[mvc_label][1]
     figure, (left, right) = plt.subplots(1, 2, figsize=(11, 4.6))
     # Left: the deformed points under MVC seen along z, coloured by their
     # distance to the PMVC 64² deformation.
@@ -134,18 +152,18 @@ def save_figure(path: Path, name, points, results, diagonal, cage, pose) -> None
     for a, b in edges:
         left.plot(pose[[a, b], 0], pose[[a, b], 1], color="0.6", linewidth=0.4)
     left.set_aspect("equal")
-    left.set_title(f"{name}: MVC deformation, distance to {REFERENCE}")
+    left.set_title(f"{name}: {mvc_label} deformation, distance to {reference_label}")
     figure.colorbar(shown, ax=left, label="% of cage diagonal")
     # Right: for each family, the share of points farther than d from PMVC 64².
     for label, (_, moved) in results.items():
-        if label == REFERENCE:
+        if label == reference_label:
             continue
         d = np.sort(100 * np.linalg.norm(moved - reference, axis=1) / diagonal)
         share = 1.0 - np.arange(len(d)) / len(d)
         right.step(np.maximum(d, 1e-6), share, where="post", label=label)
     right.set_xscale("log")
     right.set_xlim(1e-4, None)
-    right.set_xlabel(f"distance to {REFERENCE} (% of cage diagonal)")
+    right.set_xlabel(f"distance to {reference_label} (% of cage diagonal)")
     right.set_ylabel("share of points at least this far")
     right.set_title("per-point differences")
     right.legend()

@@ -45,6 +45,7 @@ def gpu_or_skip():
 
 @pytest.mark.parametrize("method,flags", FAMILIES)
 @pytest.mark.parametrize("backend", ["cpu", "gpu"])
+@pytest.mark.filterwarnings("ignore::pmvc.BackendWarning")  # harmonic on "gpu" binds on the CPU
 def test_every_family_is_bit_for_bit_the_command_lines(
     pmvc_bin, tmp_path, test_points, comb_cage, method, flags, backend
 ):

@@ -336,7 +336,7 @@ impl WeightsMetadata {
     /// Its own fields agree with each other: the format and version are known,
     /// the family and parameters are valid, and the columns are what the family
     /// gives a cage of the recorded size.
-    fn check_consistent(&self, path: &Path) -> Result<BindOptions, MetadataError> {
+    pub fn check_consistent(&self, path: &Path) -> Result<BindOptions, MetadataError> {
         let field = |field: &'static str, reason: String| MetadataError::Field {
             path: path.to_owned(),
             field,

@@ -89,17 +89,18 @@ impl Default for BindConfig {
 #[derive(Clone, Debug)]
 pub struct BindInput {
     pub points: Arc<[DVec3]>,
-    /// From [`crate::geometry::classify_points`] for the same points and cage.
+    /// From [`BindOptions::classify`] for the same points, cage and options:
+    /// against the cage bound, its quads split if the options split them.
     pub classes: Arc<[PointClass]>,
     pub cage: Arc<Cage>,
     pub options: BindOptions,
 }
 
 impl BindInput {
-    /// Classify `points` against `cage` (the slow part of preparing a bind) and
-    /// bind them with `options`.
+    /// Classify `points` against the cage `options` bind (the slow part of
+    /// preparing a bind; [`BindOptions::classify`]) and bind them with `options`.
     pub fn classify(points: Arc<[DVec3]>, cage: Arc<Cage>, options: BindOptions) -> Self {
-        let classes = crate::geometry::classify_points(&cage, &points).classes;
+        let classes = options.classify(&cage, &points).classes;
         Self {
             points,
             classes: classes.into(),
@@ -108,7 +109,9 @@ impl BindInput {
         }
     }
 
-    /// The same points and cage with other options.
+    /// The same points and cage with other options. The classes are kept: they
+    /// must split the cage's quads as `options` do
+    /// ([`BindOptions::split_applied`]).
     pub fn with_options(&self, options: BindOptions) -> Self {
         Self {
             options,

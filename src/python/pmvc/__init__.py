@@ -15,12 +15,14 @@ Every function checks its input as the ``pmvc`` command line does and raises a
 
 from ._errors import (
     BackendError,
+    BackendWarning,
     BindError,
     CageError,
     FileError,
     InputError,
     ParameterError,
     PmvcError,
+    PmvcWarning,
     TooLargeError,
     WeightsError,
 )
@@ -66,5 +68,7 @@ __all__ = [
     "BackendError",
     "BindError",
     "TooLargeError",
+    "PmvcWarning",
+    "BackendWarning",
     "__version__",
 ]

@@ -6,6 +6,8 @@ from __future__ import annotations
 from typing import Optional
 
 __all__ = [
+    "PmvcWarning",
+    "BackendWarning",
     "PmvcError",
     "InputError",
     "ParameterError",
@@ -29,6 +31,11 @@ class PmvcError(Exception):
         super().__init__(message)
         self.path = path
         self.line = line
+
+    def __reduce__(self):
+        # Pickled whole (a Dask worker's error reaches the client so), not
+        # only the message that BaseException keeps in ``args``.
+        return (type(self), (str(self), self.path, self.line))
 
 
 class InputError(PmvcError, ValueError):
@@ -65,3 +72,13 @@ class BindError(PmvcError):
 class TooLargeError(PmvcError, MemoryError):
     """Work refused before it started because it would not fit in memory or
     on the disk; the message gives the sizes."""
+
+
+class PmvcWarning(UserWarning):
+    """Base class of the warnings pmvc issues (through :mod:`warnings`)."""
+
+
+class BackendWarning(PmvcWarning):
+    """Work asked for on the GPU ran on the CPU (a family without a GPU kernel,
+    such as harmonic coordinates, or QMVC: MVC on a cage's quads), or the GPU
+    reported something worth knowing (a pipeline cache it ignored)."""

@@ -11,6 +11,11 @@ ArrayLike = npt.ArrayLike
 Path = Union[str, "PathLike[str]"]
 Progress = Callable[[int, int], Any]
 """Called with ``(done, total)``; raising an exception cancels the work."""
+Faces = Union[npt.NDArray[np.integer[Any]], Sequence[Sequence[int]]]
+"""Faces of 0-based vertex indices: an integer array (m, k), k >= 3 (libigl's
+``F``), or a sequence of polygons of any sizes (quads stay quads)."""
+CageLike = Union["Cage", Tuple[ArrayLike, Faces], List[Any]]
+"""A :class:`Cage`, or libigl's ``(V, F)`` pair, validated as ``Cage(V, F)``."""
 
 __version__: str
 
@@ -18,13 +23,15 @@ class Cage:
     """A validated cage: closed, edge-manifold, consistently oriented, no
     degenerate triangles, not crossing itself (the command line's checks).
 
-    ``vertices`` is an (m, 3) array-like; ``faces`` a sequence of polygons of
-    0-based vertex indices (quads stay quads; they are cut along their shorter
-    diagonal, larger polygons fanned from their first corner). An inward-facing
+    ``vertices`` is an (m, 3) array-like; ``faces`` an integer array (m, k) or a
+    sequence of polygons of 0-based vertex indices (quads stay quads; they are
+    cut along their shorter diagonal, larger polygons fanned from their first
+    corner). An inward-facing
     cage is flipped (see ``flipped``). Raises InputError or CageError.
+    Pickles and copies exactly (re-validated when loaded).
     """
 
-    def __init__(self, vertices: ArrayLike, faces: Sequence[Sequence[int]]) -> None: ...
+    def __init__(self, vertices: ArrayLike, faces: Faces) -> None: ...
     @staticmethod
     def load(path: Path) -> "Cage":
         """Read and validate an OBJ or OFF file. Raises FileError (naming the
@@ -72,7 +79,9 @@ class Cage:
         ...
 
 class Weights:
-    """The weights of a bind, and what a reader needs to trust them."""
+    """The weights of a bind, and what a reader needs to trust them. Pickles
+    and copies exactly (the arrays as they are, the metadata checked when
+    loaded)."""
 
     @property
     def matrix(self) -> npt.NDArray[np.float32]:
@@ -123,15 +132,18 @@ class Weights:
         layout, class counts, digests of the points and cage)."""
         ...
 
-def load_mesh(path: Path) -> Tuple[npt.NDArray[np.float64], List[List[int]]]:
-    """Read an OBJ or OFF file, or a .npy point set: ``(vertices, faces)``,
-    vertices float64 (n, 3) in file order, faces polygons of 0-based indices
-    (empty for a point set)."""
+def load_mesh(
+    path: Path,
+) -> Tuple[npt.NDArray[np.float64], Union[npt.NDArray[np.int64], List[List[int]]]]:
+    """Read an OBJ, OFF or glTF file, or a .npy point set: ``(vertices,
+    faces)``, vertices float64 (n, 3) in file order; faces an int64 array (m, 3)
+    of 0-based indices when every face is a triangle ((0, 3) for a point set),
+    else a list of polygons (lists of indices)."""
     ...
 
 def bind(
     points: ArrayLike,
-    cage: Cage,
+    cage: CageLike,
     method: str = "pmvc",
     resolution: int = 32,
     grid: int = 64,
@@ -139,6 +151,7 @@ def bind(
     progress: Optional[Progress] = None,
     triangulate: Optional[str] = None,
     pmvc_kernel: str = "auto",
+    strict: bool = False,
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
@@ -149,13 +162,15 @@ def bind(
     diagonal first; Green coordinates always bind on triangles. ``backend``: "auto" (the CPU, or a hardware GPU where it is
     predicted faster for this bind), "cpu" or "gpu". ``pmvc_kernel``: PMVC's GPU
     kernel, "auto", "tiles" or "bands" (as ``pmvc bind --pmvc-kernel``; "bands"
-    reproduces GPU weights bound before the tile kernel). The GIL is released;
-    Ctrl-C cancels within about a second."""
+    reproduces GPU weights bound before the tile kernel). ``strict=True``
+    raises InputError before binding when points lie outside the cage. ``cage``
+    is a Cage or a ``(V, F)`` pair. The GIL is released; Ctrl-C cancels within
+    about a second."""
     ...
 
 def deform(
     points: ArrayLike,
-    cage: Cage,
+    cage: CageLike,
     deformed_vertices: ArrayLike,
     weights: Optional[Weights] = None,
     method: str = "pmvc",
@@ -164,16 +179,25 @@ def deform(
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
     bound first with ``parameters`` (resolution, grid, backend, progress,
-    triangulate, pmvc_kernel)."""
+    triangulate, pmvc_kernel, strict); with ``weights``, ``strict=True``
+    refuses weights with rows outside the cage."""
     ...
 
-def classify(points: ArrayLike, cage: Cage) -> npt.NDArray[np.int8]:
-    """Per point: 0 inside the cage, 1 on it, 2 outside (as ``bind``)."""
+def classify(
+    points: ArrayLike,
+    cage: CageLike,
+    method: Optional[str] = None,
+    triangulate: Optional[str] = None,
+) -> npt.NDArray[np.int8]:
+    """Per point: 0 inside the cage, 1 on it, 2 outside, as ``bind`` with the
+    same ``method`` and ``triangulate`` classes its rows: against the cage it
+    binds (quads split along a diagonal with ``triangulate``, and for Green
+    coordinates, which bind on triangles)."""
     ...
 
 def generate_cage(
     vertices: ArrayLike,
-    faces: Sequence[Sequence[int]],
+    faces: Faces,
     target: int,
     clearance: Optional[float] = None,
     cell_size: Optional[float] = None,
