@@ -334,3 +334,46 @@ fn a_session_opened_through_a_link_reads_its_files_beside_the_target() {
         "{notes}"
     );
 }
+
+#[test]
+fn two_editors_saving_one_session_leave_one_whole_session() {
+    use pmvc::app::session::save_session;
+    let dir = tempfile::tempdir().unwrap();
+    let mut first = comb_session();
+    first["title"] = json!("first");
+    let mut second = comb_session();
+    second["title"] = json!("second");
+    let first = open(dir.path(), "a.json", &first).unwrap();
+    let second = open(dir.path(), "b.json", &second).unwrap();
+    let shared = dir.path().join("shared.json");
+    // Two writers, as two editors with the same session open would be: each
+    // write replaces the file whole, so a reader never sees a mix or a part.
+    std::thread::scope(|scope| {
+        for opened in [&first, &second] {
+            let shared = &shared;
+            scope.spawn(move || {
+                for _ in 0..40 {
+                    save_session(shared, &opened.document, &opened.settings).unwrap();
+                }
+            });
+        }
+        scope.spawn(|| {
+            for _ in 0..200 {
+                // Once the file exists it is always a whole session.
+                if !shared.exists() {
+                    continue;
+                }
+                let read = open_session(&shared).map_err(|e| e.to_string()).unwrap();
+                assert!(["first", "second"].contains(&read.document.title()));
+            }
+        });
+    });
+    let last = open_session(&shared).map_err(|e| e.to_string()).unwrap();
+    assert!(["first", "second"].contains(&last.document.title()));
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| !name.ends_with(".json"))
+        .collect();
+    assert!(left.is_empty(), "files left behind: {left:?}");
+}
