@@ -348,26 +348,29 @@ fn two_editors_saving_one_session_leave_one_whole_session() {
     let shared = dir.path().join("shared.json");
     // Two writers, as two editors with the same session open would be: each
     // write replaces the file whole, so a reader never sees a mix or a part.
+    let writing = std::sync::atomic::AtomicUsize::new(2);
+    let mut reads = 0;
     std::thread::scope(|scope| {
         for opened in [&first, &second] {
-            let shared = &shared;
+            let (shared, writing) = (&shared, &writing);
             scope.spawn(move || {
                 for _ in 0..40 {
                     save_session(shared, &opened.document, &opened.settings).unwrap();
                 }
+                writing.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
             });
         }
-        scope.spawn(|| {
-            for _ in 0..200 {
-                // Once the file exists it is always a whole session.
-                if !shared.exists() {
-                    continue;
-                }
-                let read = open_session(&shared).map_err(|e| e.to_string()).unwrap();
-                assert!(["first", "second"].contains(&read.document.title()));
+        while writing.load(std::sync::atomic::Ordering::SeqCst) > 0 {
+            // Once the file exists it is always a whole session.
+            if !shared.exists() {
+                continue;
             }
-        });
+            let read = open_session(&shared).map_err(|e| e.to_string()).unwrap();
+            assert!(["first", "second"].contains(&read.document.title()));
+            reads += 1;
+        }
     });
+    assert!(reads > 0, "no read happened while the writers wrote");
     let last = open_session(&shared).map_err(|e| e.to_string()).unwrap();
     assert!(["first", "second"].contains(&last.document.title()));
     let left: Vec<_> = std::fs::read_dir(dir.path())
