@@ -20,6 +20,7 @@
 //! their extra triangle columns, so their rows ignore the point's class.
 
 pub mod cubemap;
+pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;
