@@ -38,8 +38,9 @@
 //!
 //! # Rounding
 //!
-//! - Everything is computed relative to x: a scene 1e7 from the origin gives
-//!   the weights it gives at the origin.
+//! - Everything is computed relative to x: a scene moved 1e7 from the origin
+//!   gives the weights it gives at the origin, bit for bit when its
+//!   coordinates move exactly.
 //! - Sides of a plane are exact where they matter: a corner knows the cage
 //!   vertex or the two edge planes it lies on and is on them exactly, so
 //!   triangles that share an edge or a vertex meet with no sliver of overlap
