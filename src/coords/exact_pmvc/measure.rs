@@ -203,6 +203,13 @@ fn speed_and_fragments() {
     let cage = comb();
     let points = procedural::points_inside(&cage, 2000, 31, 1e-4);
     report("comb", &cage, &measure(&cage, &points));
+    // Larger cages, for how the pairs of candidates scale.
+    let hand = procedural::table1_scene("hand-size").expect("a scene");
+    let points: Vec<DVec3> = hand.points.iter().step_by(25).copied().collect();
+    report("hand-size", &hand.cage, &measure(&hand.cage, &points));
+    let sphere = procedural::icosphere(1.0, 3);
+    let points = procedural::points_inside(&sphere, 500, 41, 1e-3);
+    report("icosphere", &sphere, &measure(&sphere, &points));
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/qmvc");
     if !data.is_dir() {
         println!("not run: {} is not present", data.display());

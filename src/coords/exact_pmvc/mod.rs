@@ -38,8 +38,9 @@
 //!
 //! # Rounding
 //!
-//! - Everything is computed relative to x: a scene 1e7 from the origin gives
-//!   the weights it gives at the origin.
+//! - Everything is computed relative to x: a scene moved 1e7 from the origin
+//!   gives the weights it gives at the origin, bit for bit when its
+//!   coordinates move exactly.
 //! - Sides of a plane are exact where they matter: a corner knows the cage
 //!   vertex or the two edge planes it lies on and is on them exactly, so
 //!   triangles that share an edge or a vertex meet with no sliver of overlap
@@ -85,22 +86,29 @@
 //! largest error 6.1e-3, 3.0e-3, 1.3e-3, 4.6e-4 and 3.2e-4.
 //!
 //! Cost per point, one thread, release build, CPU time, against the cube map
-//! for the same points (inside points of each model's mesh, about 2000; the
-//! artist cages of `../shared/data/qmvc` with their quads split along the
-//! shorter diagonal):
+//! for the same points (the artist cages of `../shared/data/qmvc`, quads split
+//! along the shorter diagonal, at about 2000 of their mesh's inside vertices;
+//! the procedural cages at points spread inside):
 //!
 //! | cage | triangles | exact | fragments (max) | cube 32² | cube 64² | cube 64² largest error |
 //! |---|---|---|---|---|---|---|
-//! | comb | 60 | 53 µs | 40 (70) | 18 µs | 56 µs | 1.4e-3 |
-//! | ManHead | 20 | 13 µs | 20 (27) | 14 µs | 48 µs | 4.7e-4 |
-//! | Bench | 44 | 29 µs | 30 (44) | 18 µs | 51 µs | 1.7e-3 |
-//! | FireHydrant | 92 | 97 µs | 71 (84) | 21 µs | 56 µs | 2.8e-3 |
-//! | Ogre | 232 | 197 µs | 93 (212) | 28 µs | 65 µs | 1.5e-3 |
-//! | Beast | 300 | 202 µs | 97 (235) | 28 µs | 65 µs | 5.0e-4 |
+//! | ManHead | 20 | 13 µs | 20 (27) | 12 µs | 43 µs | 4.7e-4 |
+//! | Bench | 44 | 28 µs | 30 (44) | 16 µs | 50 µs | 1.7e-3 |
+//! | comb | 60 | 53 µs | 40 (70) | 18 µs | 55 µs | 1.4e-3 |
+//! | FireHydrant | 92 | 95 µs | 71 (84) | 21 µs | 50 µs | 2.8e-3 |
+//! | Ogre | 232 | 200 µs | 93 (212) | 26 µs | 58 µs | 1.5e-3 |
+//! | Beast | 300 | 226 µs | 97 (235) | 30 µs | 69 µs | 5.0e-4 |
+//! | hand-size | 500 | 800 µs | 207 (370) | 64 µs | 133 µs | 2.4e-3 |
+//! | icosphere | 1280 | 2.9 ms | 1280 | 104 µs | 139 µs | 2.6e-5 |
 //!
-//! About half the time goes to the pairs of candidates, most of which turn out
-//! not to overlap (Beast: 9754 pairs scanned per point, 2234 with bounding
-//! cones meeting, 316 occluding), a fifth to cutting pieces. Commands:
+//! The time goes to the pairs of candidates: every candidate scans those not
+//! wholly farther than itself, which grows as the square of their number
+//! (Beast: 9754 pairs scanned per point, 2234 with bounding cones meeting, 316
+//! occluding; the icosphere, where every triangle is at about the same
+//! distance: 913,313 scanned), then to cutting pieces. A grid of directions
+//! listing the candidates by cube-map cell (to scan only those sharing a
+//! cell) halved the icosphere's time but doubled the hand's and Beast's,
+//! whose large triangles fill many cells; it is not used. Commands:
 //! `cargo test --release --no-default-features --lib coords::exact_pmvc::measure
 //! -- --ignored --nocapture --test-threads 1`.
 
