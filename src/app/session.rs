@@ -13,6 +13,7 @@ use super::session_checks::{
     camera_in_range, checked_pose, cut_text, inline_cage_defect, view_in_range, Reach,
     SESSION_SIZE_LIMIT,
 };
+use super::session_paths::{folder_of, session_folder};
 use crate::budget::read_limited;
 use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
 use crate::formats::{
@@ -200,37 +201,6 @@ fn relative_to(path: &Path, folder: &Path) -> PathBuf {
         .strip_prefix(&folder)
         .map(Path::to_owned)
         .unwrap_or(absolute)
-}
-
-fn folder_of(path: &Path) -> PathBuf {
-    match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
-        _ => PathBuf::from("."),
-    }
-}
-
-/// The folder a session's relative paths are read from: beside the file it
-/// is, following a link as editors do, with a note when that is not the
-/// link's folder.
-fn session_folder(path: &Path, note: &mut impl FnMut(String)) -> PathBuf {
-    let linked = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
-    if !linked {
-        return folder_of(path);
-    }
-    match std::fs::canonicalize(path) {
-        Ok(target) => {
-            let folder = folder_of(&target);
-            if std::fs::canonicalize(folder_of(path)).ok().as_ref() != Some(&folder) {
-                note(format!(
-                    "a link to {}: its files are read from {}",
-                    shown_path(&target),
-                    shown_path(&folder)
-                ));
-            }
-            folder
-        }
-        Err(_) => folder_of(path),
-    }
 }
 
 /// The mesh and cage files a session names, read as loosely as can be: what a
