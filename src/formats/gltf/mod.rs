@@ -73,6 +73,7 @@
 //! element (`accessor 3: …`, `node 2 …`, `buffer 0 ("data.bin"): …`).
 
 mod buffers;
+mod hierarchy;
 mod json_size;
 mod layout;
 mod read;
