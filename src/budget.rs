@@ -11,7 +11,7 @@ use std::path::Path;
 
 /// An allocation refused before it was made.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{what} would need {}, {}", human_bytes(*.needed), limit_text(*.available))]
+#[error("{what} would need {}", sizes_text(*.needed, *.available))]
 pub struct TooLarge {
     /// What was to be allocated, e.g. "the voxel grid (4096 × 4096 × 4096)".
     pub what: String,
@@ -21,11 +21,26 @@ pub struct TooLarge {
     pub available: Option<u64>,
 }
 
-fn limit_text(available: Option<u64>) -> String {
-    match available {
-        Some(bytes) => format!("but only {} of memory is available", human_bytes(bytes)),
-        None => "more than this machine can address".to_owned(),
+/// "3.6 GiB, but only 3.5 GiB of memory is available", with as many digits as
+/// it takes for the two sizes to read differently.
+fn sizes_text(needed: u64, available: Option<u64>) -> String {
+    let Some(available) = available else {
+        return format!(
+            "{}, more than this machine can address",
+            human_bytes(needed)
+        );
+    };
+    let mut digits = 1;
+    let (mut needed_text, mut available_text) = (human_bytes(needed), human_bytes(available));
+    while needed_text == available_text && needed != available && digits < 12 {
+        digits += 1;
+        needed_text = bytes_with_digits(needed, digits);
+        available_text = bytes_with_digits(available, digits);
     }
+    if needed_text == available_text && needed != available {
+        (needed_text, available_text) = (format!("{needed} bytes"), format!("{available} bytes"));
+    }
+    format!("{needed_text}, but only {available_text} of memory is available")
 }
 
 /// `count` items of `each` bytes, saturating: a product that overflows is
@@ -197,6 +212,11 @@ fn invalid_data(message: String) -> std::io::Error {
 
 /// `1.5 GiB`: sizes in messages, binary units.
 pub fn human_bytes(bytes: u64) -> String {
+    bytes_with_digits(bytes, 1)
+}
+
+/// [`human_bytes`] with `digits` after the point.
+fn bytes_with_digits(bytes: u64, digits: usize) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
     let mut value = bytes as f64;
     let mut unit = 0;
@@ -207,13 +227,40 @@ pub fn human_bytes(bytes: u64) -> String {
     if unit == 0 {
         format!("{bytes} bytes")
     } else {
-        format!("{value:.1} {}", UNITS[unit])
+        format!("{value:.digits$} {}", UNITS[unit])
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sizes_that_round_alike_are_printed_with_the_digits_that_tell_them_apart() {
+        let refused = |needed, available| {
+            TooLarge {
+                what: "the grid".to_owned(),
+                needed,
+                available: Some(available),
+            }
+            .to_string()
+        };
+        let gib = 1u64 << 30;
+        // 3.6 GiB both, one slightly more: the one-digit form would read alike.
+        let text = refused(3_900_000_000, 3_880_000_000);
+        assert_eq!(
+            text,
+            "the grid would need 3.63 GiB, but only 3.61 GiB of memory is available"
+        );
+        assert_eq!(
+            refused(2 * gib, gib),
+            "the grid would need 2.0 GiB, but only 1.0 GiB of memory is available"
+        );
+        assert_eq!(
+            refused(3 * gib + 1, 3 * gib),
+            "the grid would need 3.000000001 GiB, but only 3.000000000 GiB of memory is available"
+        );
+    }
 
     #[test]
     fn a_size_past_any_allocation_is_refused_without_asking_the_system() {

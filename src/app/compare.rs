@@ -152,6 +152,7 @@ pub struct ViewSettings {
     /// The difference view's colour scale ends here (a fraction of the cage
     /// diagonal) when set; otherwise at the largest distance, but never below
     /// [`DIFFERENCE_FLOOR`].
+    #[serde(deserialize_with = "saturating_f32_option")]
     pub difference_limit: Option<f32>,
     /// All views share one camera.
     pub cameras_locked: bool,
@@ -160,11 +161,26 @@ pub struct ViewSettings {
     /// Draw the cage's edges and handles; hidden ones cannot be picked.
     pub show_cage: bool,
     /// Handle radius in points (`HANDLE_SIZES`).
+    #[serde(deserialize_with = "saturating_f32")]
     pub handle_size: f32,
     /// Draw the mesh's edges over its surface.
     pub wireframe: bool,
     /// Light the mesh with per-vertex normals of the deformed mesh; else per face.
     pub smooth_shading: bool,
+}
+
+/// An f32 of a file: a number past f32's range reads as ±infinity, which the
+/// session's range checks then bring into range with a notice, instead of
+/// refusing the whole file.
+pub fn saturating_f32<'de, D: serde::Deserializer<'de>>(from: D) -> Result<f32, D::Error> {
+    f64::deserialize(from).map(|value| value as f32)
+}
+
+/// [`saturating_f32`] for an optional value.
+pub fn saturating_f32_option<'de, D: serde::Deserializer<'de>>(
+    from: D,
+) -> Result<Option<f32>, D::Error> {
+    Option::<f64>::deserialize(from).map(|value| value.map(|value| value as f32))
 }
 
 /// The handle radii the View menu offers, in points; the default is 4.

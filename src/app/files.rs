@@ -323,10 +323,26 @@ pub fn check_pose(
 /// over the rest cage, or a deformed mesh over its source, would lose the
 /// scene's input.
 pub fn refuse_overwriting_open_files(path: &Path, current: &Document) -> Result<(), String> {
+    refuse_overwriting_inputs(path, current, None)
+}
+
+/// The files the open scene was read from: its mesh, its cage and the session
+/// that named them. Only Save session may write the session file.
+pub fn open_inputs<'a>(current: &'a Document, session: Option<&'a Path>) -> Vec<&'a Path> {
     let mut inputs = Vec::new();
     inputs.extend(current.mesh_file().map(|file| file.path.as_path()));
     inputs.extend(current.cage_path());
-    refuse_same_file(path, &inputs).map_err(|error| error.to_string())
+    inputs.extend(session);
+    inputs
+}
+
+/// [`refuse_overwriting_open_files`], the session file included.
+pub fn refuse_overwriting_inputs(
+    path: &Path,
+    current: &Document,
+    session: Option<&Path>,
+) -> Result<(), String> {
+    refuse_same_file(path, &open_inputs(current, session)).map_err(|error| error.to_string())
 }
 
 /// Write the pose as a cage-shaped OBJ.

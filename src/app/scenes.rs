@@ -59,7 +59,7 @@ impl BundledScene {
 
     /// The scene's mesh and cage. The scan is embedded text that goes through the
     /// same loader as a user's files, so a bad number is an error, never 0.0
-    /// (`tests/editor_assets.rs` checks that it loads).
+    /// (`tests/editor/editor_assets.rs` checks that it loads).
     pub fn build(self) -> Result<(TriMesh, Cage), CageLoadError> {
         match self {
             BundledScene::Comb => Ok((comb_mesh(), comb_cage())),
@@ -97,7 +97,7 @@ const DEMO_LIFT: f64 = 4.5;
 /// The first run's pose of the comb cage: the middle prong's tip pulled up. MVC
 /// give the neighbouring fingers negative weights for those handles, so they
 /// sink and bend toward it; PMVC leave them where they are. The difference is
-/// a visible share of the cage (tests/editor_views.rs measures it).
+/// a visible share of the cage (tests/editor/editor_views.rs measures it).
 pub fn comb_demo_pose(cage: &Cage) -> Vec<DVec3> {
     let top = cage
         .positions()

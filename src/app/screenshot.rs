@@ -5,8 +5,8 @@
 use super::exports::save_png;
 use super::scripted_drag::{ScriptedDrag, DRAG_FRAMES, DRAG_START_FRAME};
 use super::ui::statistics::FrameStats;
-use crate::formats::shown_path;
-use std::path::PathBuf;
+use crate::formats::{refuse_same_file, shown_path};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -77,7 +77,15 @@ impl ScreenshotState {
 impl ScreenshotState {
     /// Each frame of a scripted run: wait for the binds (`binding`), let a few
     /// frames settle, capture the window, then close it.
-    pub fn drive(&mut self, ctx: &egui::Context, binding: bool, frames: &mut FrameStats) {
+    /// `inputs` are the files the scene was read from, which the PNG may never
+    /// replace.
+    pub fn drive(
+        &mut self,
+        ctx: &egui::Context,
+        binding: bool,
+        inputs: Vec<PathBuf>,
+        frames: &mut FrameStats,
+    ) {
         if binding {
             ctx.request_repaint_after(Duration::from_millis(50));
             return;
@@ -104,7 +112,10 @@ impl ScreenshotState {
             let failures = self.failures();
             let repaint = ctx.clone();
             ctx.request_screenshot(move |image| {
-                if let Err(error) = save_png(&path, &image, None) {
+                let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+                let saved_png =
+                    refuse_same_file(&path, &inputs).and_then(|()| save_png(&path, &image, None));
+                if let Err(error) = saved_png {
                     let text = format!("cannot save {}: {error}", shown_path(&path));
                     eprintln!("pmvc editor: {text}");
                     if let Ok(mut failures) = failures.lock() {

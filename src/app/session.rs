@@ -6,18 +6,19 @@
 //! A rest mesh that no longer matches its source ("Use pose as rest shape") is
 //! written beside the session as `NAME.rest-mesh.obj`, so the session stays small.
 
-use super::compare::ViewSettings;
+use super::compare::{saturating_f32, ViewSettings};
 use super::document::{Document, NamedPose};
 use super::scenes::BundledScene;
 use super::session_checks::{
     camera_in_range, checked_pose, cut_text, inline_cage_defect, view_in_range, Reach,
     SESSION_SIZE_LIMIT,
 };
+use super::session_paths::{folder_of, session_folder};
 use crate::budget::read_limited;
 use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
 use crate::formats::{
-    load_cage, load_mesh, refuse_same_file, shown_path, write_atomically, write_deformed_mesh,
-    write_obj, CageLoadError, LoadError, MeshFile, WriteError,
+    load_cage, load_mesh, not_a_regular_file, refuse_same_file, shown_path, write_atomically,
+    write_deformed_mesh, write_obj, CageLoadError, LoadError, MeshFile, WriteError,
 };
 use crate::geometry::{Cage, TriMesh};
 use crate::render::{OrbitCamera, SceneOrigin};
@@ -69,8 +70,11 @@ pub struct NamedPoseEntry {
 pub struct CameraEntry {
     /// World coordinates, in f64: a scene far from the origin keeps its view.
     pub target: [f64; 3],
+    #[serde(deserialize_with = "saturating_f32")]
     pub distance: f32,
+    #[serde(deserialize_with = "saturating_f32")]
     pub yaw: f32,
+    #[serde(deserialize_with = "saturating_f32")]
     pub pitch: f32,
     /// A parallel view (numpad 5); absent in sessions from before it existed.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -199,11 +203,25 @@ fn relative_to(path: &Path, folder: &Path) -> PathBuf {
         .unwrap_or(absolute)
 }
 
-fn folder_of(path: &Path) -> PathBuf {
-    match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
-        _ => PathBuf::from("."),
+/// The mesh and cage files a session names, read as loosely as can be: what a
+/// run must not overwrite even when the session then fails to open.
+pub fn files_named(path: &Path) -> Vec<PathBuf> {
+    if not_a_regular_file(path).is_some() {
+        return Vec::new();
     }
+    let Ok(bytes) = read_limited(path, SESSION_SIZE_LIMIT) else {
+        return Vec::new();
+    };
+    let text = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(&bytes);
+    let Ok(session) = serde_json::from_slice::<serde_json::Value>(text) else {
+        return Vec::new();
+    };
+    let folder = session_folder(path, &mut |_| {});
+    ["mesh", "cage"]
+        .iter()
+        .filter_map(|key| session[key]["file"].as_str())
+        .map(|file| folder.join(file))
+        .collect()
 }
 
 /// Where a session saved as `session` keeps a rest mesh that changed.
@@ -364,6 +382,17 @@ fn cage_source(folder: &Path, document: &Document) -> CageSource {
 /// failure; the error names the file and what is wrong. The file is read up to
 /// [`SESSION_SIZE_LIMIT`]; a UTF-8 byte-order mark before it is skipped.
 pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
+    // A session's relative paths need a folder, and a named pipe with no
+    // writer would wait forever.
+    if let Some(kind) = not_a_regular_file(path) {
+        return Err(SessionError::Read {
+            path: path.to_owned(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("it is {kind}, not a session file"),
+            ),
+        });
+    }
     let bytes = read_limited(path, SESSION_SIZE_LIMIT).map_err(|source| SessionError::Read {
         path: path.to_owned(),
         source,
@@ -393,7 +422,9 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
             found: session.pmvc_session,
         });
     }
-    let folder = folder_of(path);
+    let mut notes = Vec::new();
+    let mut note = |text: String| notes.push(format!("{}: {text}", shown_path(path)));
+    let folder = session_folder(path, &mut note);
     let scene = |id: &str| {
         BundledScene::from_id(id).ok_or_else(|| SessionError::UnknownScene {
             path: path.to_owned(),
@@ -404,8 +435,6 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
         path: path.to_owned(),
         source,
     };
-    let mut notes = Vec::new();
-    let mut note = |text: String| notes.push(format!("{}: {text}", shown_path(path)));
     let (title, cut) = cut_text(&session.title, "the title");
     cut.into_iter().for_each(&mut note);
     let mut bind_options = BindOptions::for_method(session.method);

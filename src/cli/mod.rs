@@ -445,12 +445,18 @@ pub fn main() -> ExitCode {
         Some(Command::Edit(args)) => {
             let offscreen = args.offscreen;
             let options = args.editor_options();
-            if offscreen {
-                crate::app::run_offscreen(options)
-            } else {
-                crate::app::run_editor(options)
-            }
-            .map_err(anyhow::Error::from)
+            let checked = match &options.screenshot {
+                Some(screenshot) => check_screenshot_path(screenshot, &options),
+                None => Ok(()),
+            };
+            checked.and_then(|()| {
+                if offscreen {
+                    crate::app::run_offscreen(options)
+                } else {
+                    crate::app::run_editor(options)
+                }
+                .map_err(anyhow::Error::from)
+            })
         }
         Some(Command::Bind(args)) => bind::bind(&args),
         Some(Command::Deform(args)) => deform::deform(&args),
@@ -496,3 +502,30 @@ fn error_line(error: &anyhow::Error) -> String {
 
 #[cfg(test)]
 mod tests;
+
+/// `--screenshot` before the window opens: never one of the run's inputs (the
+/// scene's files are checked again when the image is written, since a session
+/// names its own), and a warning when the name does not say PNG.
+fn check_screenshot_path(
+    screenshot: &std::path::Path,
+    options: &crate::app::EditorOptions,
+) -> anyhow::Result<()> {
+    let inputs = [
+        &options.mesh,
+        &options.cage,
+        &options.session,
+        &options.pose,
+    ];
+    let named = options
+        .session
+        .as_deref()
+        .map(crate::app::session::files_named)
+        .unwrap_or_default();
+    let inputs: Vec<&std::path::Path> = inputs
+        .into_iter()
+        .flatten()
+        .chain(&named)
+        .map(PathBuf::as_path)
+        .collect();
+    commands::check_output(screenshot, &inputs, &["png"], "a PNG image")
+}

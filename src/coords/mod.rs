@@ -21,6 +21,7 @@
 
 pub mod cubemap;
 pub mod dtype;
+pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;

@@ -57,3 +57,31 @@ pub struct MeshFile {
     /// primitives as groups), which is what was parsed.
     pub obj_text: Option<String>,
 }
+
+/// What `path` is when it is not a regular file ("a named pipe", "a device",
+/// "a folder"), for messages; `None` for a regular file or one that cannot be
+/// looked at (its reader then says why). Opening a named pipe for reading
+/// waits for a writer, so readers that need a file ask this before opening.
+pub fn not_a_regular_file(path: &std::path::Path) -> Option<&'static str> {
+    let kind = std::fs::metadata(path).ok()?.file_type();
+    if kind.is_file() {
+        return None;
+    }
+    if kind.is_dir() {
+        return Some("a folder");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("a named pipe");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("a device");
+        }
+    }
+    Some("not a regular file")
+}

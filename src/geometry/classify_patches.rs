@@ -77,7 +77,7 @@ pub(super) fn correct_class(
             continue;
         }
         // Relative to the quad's centre, so that the class does not depend on
-        // where the scene is (tests/origin_offsets.rs).
+        // where the scene is (tests/coords/origin_offsets.rs).
         let corners = cage.quad(quad.quad);
         let centre = (corners[0] + corners[1] + corners[2] + corners[3]) * 0.25;
         let q = corners.map(|p| p - centre);

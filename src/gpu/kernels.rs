@@ -145,7 +145,7 @@ impl PmvcKernel {
 }
 
 /// Uniform block of both kernels: `Params` in `shaders/shared/bind_params.wgsl`
-/// (layouts compared by `tests/shader_layouts.rs`).
+/// (layouts compared by `tests/gpu/shader_layouts.rs`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Params {

@@ -2,7 +2,7 @@
 //! re_renderer's shaders do; each import is replaced by its text, once per shader
 //! however often it is named (imports may import). Shared structs that Rust also
 //! defines (`Frame`, `Params`) and tables that Rust owns (the cube faces) are thus
-//! written once; `tests/shader_layouts.rs` checks the structs against Rust.
+//! written once; `tests/gpu/shader_layouts.rs` checks the structs against Rust.
 
 use super::kernels::{BAND_TEXELS, FALLBACK, TILES_MAX_VERTICES, WORKGROUP_SIZE};
 use crate::coords::cubemap::CUBE_FACES;

@@ -22,7 +22,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const FRAME_SLOT_BYTES: u64 = 256;
 
 /// The uniform of every viewport shader: `struct Frame` in
-/// `shaders/shared/frame.wgsl` (layouts compared by `tests/shader_layouts.rs`).
+/// `shaders/shared/frame.wgsl` (layouts compared by `tests/gpu/shader_layouts.rs`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FrameUniform {

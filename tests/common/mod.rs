@@ -81,6 +81,7 @@ pub fn bind_on_cpu(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Outp
 }
 
 /// `pmvc bind --mesh mesh --cage cage --out out`, then `extra`.
+#[cfg(feature = "editor")]
 pub fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "bind",

@@ -1,6 +1,6 @@
 //! The OBJ reader pmvc had before its own (`geometry/obj.rs`): the checks it made
 //! itself, then tobj for the faces. Kept here as the reference the direct reader
-//! is compared with (tests/obj_reader.rs).
+//! is compared with (tests/geometry/obj_reader.rs).
 //!
 //! tobj splits a file into one model per `o`/`g` group and re-indexes each model's
 //! vertices in first-use order, which loses the file's `v` order. To undo that, tobj

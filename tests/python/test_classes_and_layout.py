@@ -151,7 +151,7 @@ def test_generate_cage_encloses_the_mesh_and_reports_what_pmvc_cage_prints(comb_
     # for a box or prism, which begins around every part).
     assert 0 < report["merge_distance"] < float("inf")
     # The gap report's keys, as pmvc cage's "gaps between parts" line has them
-    # (their meaning is tested in tests/autocage_shapes.rs).
+    # (their meaning is tested in tests/cagegen/autocage_shapes.rs).
     assert isinstance(report["gap_points"], int) and isinstance(report["gap_points_open"], int)
     for key in ("narrowest_open_gap", "widest_closed_gap"):
         assert report[key] is None or report[key] > 0

@@ -9,6 +9,7 @@ use super::EditorApp;
 use crate::app::actions::Action;
 use crate::app::binding;
 use crate::app::ctx::{PanelContext, Shown};
+use crate::app::files;
 use crate::app::model::Model;
 use crate::app::shortcuts::{pressed, Scope, Shortcut};
 use crate::app::ui::{generate_cage, menu, side_panel, toolbar};
@@ -96,7 +97,13 @@ impl eframe::App for EditorApp {
         }
         if let Some(screenshot) = &mut self.run.screenshot {
             let binding = self.binding.queue.is_busy();
-            screenshot.drive(&ctx, binding, self.panels.statistics.frames_mut());
+            let session = self.files.session_path.as_deref();
+            let inputs = files::open_inputs(self.model.document(), session);
+            let inputs = inputs
+                .into_iter()
+                .map(std::path::Path::to_path_buf)
+                .collect();
+            screenshot.drive(&ctx, binding, inputs, self.panels.statistics.frames_mut());
         }
         self.autosave_when_due(&ctx);
         let panes = self.views.viewport.pane_rects().into_iter().map(|(_, r)| r);

@@ -427,7 +427,24 @@ impl EditorApp {
         self.take_pose(path, checked)
     }
 
+    /// Whether `path` may be written by anything but Save session: never the
+    /// session file the scene came from (the mesh and cage are refused by the
+    /// writers in `files`).
+    fn refuse_overwriting_session(&mut self, path: &Path) -> bool {
+        let session = self.files.session_path.as_deref();
+        match files::refuse_overwriting_inputs(path, self.model.document(), session) {
+            Ok(()) => false,
+            Err(error) => {
+                self.error(error);
+                true
+            }
+        }
+    }
+
     pub(super) fn save_pose_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
         let saved = self.report(files::save_pose(path, self.model.document()));
         if saved {
             self.apply(Command::MarkSaved);
@@ -436,6 +453,9 @@ impl EditorApp {
     }
 
     pub(super) fn save_cage_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
         self.report(files::save_cage(path, self.model.document()))
     }
 
@@ -462,16 +482,25 @@ impl EditorApp {
     }
 
     pub(super) fn export_deformed_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
         let method = self.binding.active_method();
         self.report(files::export_deformed(path, self.model.document(), method))
     }
 
     pub(super) fn export_gltf_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
         let method = self.binding.active_method();
         self.report(files::export_gltf(path, self.model.document(), method))
     }
 
     pub(super) fn export_coloured_mesh_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
         let wanted = self.wanted_methods_now();
         let exported = self
             .views
@@ -480,16 +509,11 @@ impl EditorApp {
     }
 
     pub(super) fn save_image_now(&mut self, path: &Path) -> bool {
-        match files::refuse_overwriting_open_files(path, self.model.document()) {
-            Ok(()) => {
-                self.files.image_request.ask(path);
-                true
-            }
-            Err(error) => {
-                self.error(error);
-                false
-            }
+        if self.refuse_overwriting_session(path) {
+            return false;
         }
+        self.files.image_request.ask(path);
+        true
     }
 
     /// Ask for a file for `action` and carry it out: the system's dialog when it

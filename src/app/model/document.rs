@@ -396,10 +396,16 @@ impl Document {
             && id.split_twin.is_none_or(|split| split == set.options.quads);
         if fits {
             match id.split_twin {
-                None => self.weight_sets.insert(id.method, set),
-                Some(_) => self.twin_sets.insert(id.method, set),
+                None => {
+                    self.weight_sets.insert(id.method, set);
+                    // A twin is bound only to be compared with: the vertices
+                    // outside are those of the cage as the setting binds it.
+                    self.outside = outside;
+                }
+                Some(_) => {
+                    self.twin_sets.insert(id.method, set);
+                }
             };
-            self.outside = outside;
             self.changes.weights.insert(id);
         }
         fits

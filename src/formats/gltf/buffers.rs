@@ -129,12 +129,12 @@ impl<'a> Buffers<'a> {
         Ok(self.loaded[index].as_deref().unwrap_or_default())
     }
 
-    /// The first `length` bytes of the file `uri` names, which must be in the
-    /// glTF's folder or below it, links followed.
+    /// The first `length` bytes of the file `uri` names, which must be a
+    /// regular file in the glTF's folder or below it, links followed.
     fn external(&self, index: usize, uri: &str, length: usize) -> Result<Vec<u8>, String> {
         let refused = || {
             format!(
-                "buffer {index}: '{uri}' is not a file beside the glTF or in a folder below it; no other file is read"
+                "buffer {index} ({uri:?}): it is not a file beside the glTF or in a folder below it; no other file is read"
             )
         };
         let decoded = percent_decoded(uri).ok_or_else(refused)?;
@@ -150,23 +150,42 @@ impl<'a> Buffers<'a> {
             Some(parent) if !parent.as_os_str().is_empty() => parent,
             _ => Path::new("."),
         };
-        let cannot = |e: std::io::Error| format!("buffer {index}: cannot read {decoded}: {e}");
+        let cannot =
+            |e: std::io::Error| format!("buffer {index} ({decoded:?}): cannot read it: {e}");
         let file = folder.join(relative).canonicalize().map_err(cannot)?;
         let folder = folder.canonicalize().map_err(cannot)?;
         if !file.starts_with(&folder) {
             return Err(refused());
         }
-        let size = std::fs::metadata(&file).map_err(cannot)?.len();
+        // Before it is opened: opening a named pipe for reading waits for a
+        // writer, and a device may never end.
+        let not_a_file = |kind: &str| {
+            format!(
+                "buffer {index} ({decoded:?}): it is {kind}, not a regular file; buffers are read from regular files only"
+            )
+        };
+        let metadata = std::fs::metadata(&file).map_err(cannot)?;
+        if !metadata.is_file() {
+            return Err(not_a_file(file_kind(&metadata.file_type())));
+        }
+        let size = metadata.len();
         if size < length as u64 {
             return Err(format!(
-                "buffer {index}: {decoded} has {size} bytes, but its byteLength says {length}"
+                "buffer {index} ({decoded:?}): the file has {size} bytes, but its byteLength says {length}"
             ));
         }
-        check_memory(|| format!("buffer {index} ({decoded})"), length as u64)
+        check_memory(|| format!("buffer {index} ({decoded:?})"), length as u64)
             .map_err(|e| e.to_string())?;
+        let opened = open_without_waiting(&file).map_err(cannot)?;
+        // Replaced by something else since it was looked at.
+        let kind = opened.metadata().map_err(cannot)?.file_type();
+        if !kind.is_file() {
+            return Err(not_a_file(file_kind(&kind)));
+        }
         let mut bytes = Vec::with_capacity(length);
-        std::fs::File::open(&file)
-            .and_then(|f| f.take(length as u64).read_to_end(&mut bytes))
+        opened
+            .take(length as u64)
+            .read_to_end(&mut bytes)
             .map_err(cannot)?;
         Ok(bytes)
     }
@@ -237,6 +256,41 @@ impl<'a> Buffers<'a> {
     }
 }
 
+/// What a file that is not a regular file is, for a message.
+fn file_kind(kind: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a named pipe";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if kind.is_dir() {
+        "a folder"
+    } else {
+        "not a file"
+    }
+}
+
+/// `path` opened for reading; on Unix without waiting for a writer, should it
+/// have become a named pipe since it was looked at.
+fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32);
+    }
+    options.open(path)
+}
+
 /// The bytes of a base64 `data:` URI.
 fn data_uri(index: usize, uri: &str) -> Result<Vec<u8>, String> {
     let Some((header, payload)) = uri.split_once(',') else {
@@ -252,6 +306,11 @@ fn data_uri(index: usize, uri: &str) -> Result<Vec<u8>, String> {
         base64::engine::GeneralPurposeConfig::new()
             .with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
     );
+    check_memory(
+        || format!("buffer {index} (its data: URI)"),
+        (payload.len() as u64 / 4 + 1) * 3,
+    )
+    .map_err(|e| e.to_string())?;
     engine
         .decode(payload)
         .map_err(|e| format!("buffer {index}: its data: URI is not valid base64: {e}"))

@@ -63,15 +63,26 @@
 //! keeps per corner): a closed glTF surface reads as closed, so a cage may be
 //! glTF too, and welded vertices would have had the same weights and moved
 //! together anyway. Skins, morph targets and other meshes of the file are not
-//! read. Buffers come from the GLB's binary chunk, base64 `data:` URIs, or files
-//! in the glTF's folder or below it, never from elsewhere; every bound and size
-//! is checked, and an error names the file and the element (`accessor 3: …`).
+//! read. Buffers come from the GLB's binary chunk, base64 `data:` URIs, or
+//! regular files in the glTF's folder or below it, never from elsewhere (nor
+//! from a named pipe or a device). What the glTF says is checked, not
+//! trusted: its nodes must form a forest (no node its own ancestor, none with
+//! two parents), a TRIANGLES primitive must have whole triangles, every bound
+//! and size is checked, and the memory its JSON takes once parsed is predicted
+//! from the JSON's values before it is parsed. An error names the file and the
+//! element (`accessor 3: …`, `node 2 …`, `buffer 0 ("data.bin"): …`).
 
 mod buffers;
+mod hierarchy;
+mod json_size;
 mod layout;
 mod read;
 mod write;
 
+#[cfg(test)]
+mod fuzz_tests;
+#[cfg(test)]
+mod json_size_tests;
 #[cfg(test)]
 mod tests;
 

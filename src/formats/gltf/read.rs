@@ -4,6 +4,8 @@
 use super::super::io::{RoundTrip, MESH_FILE_LIMIT};
 use super::super::obj::{parse_obj, MAX_VERTICES};
 use super::buffers::{split_glb, Buffers};
+use super::hierarchy::check_hierarchy;
+use super::json_size::JsonSize;
 use super::MeshPick;
 use crate::budget::human_bytes;
 use crate::budget::{available_memory, bytes_for, check_memory, read_limited};
@@ -14,10 +16,6 @@ use gltf::mesh::Mode;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// Memory the document's JSON may take once parsed, per JSON object (an
-/// accessor, a node or a material takes a few hundred bytes as a struct).
-const BYTES_PER_OBJECT: u64 = 512;
 
 /// Memory reading a mesh takes per vertex and per index: the elements as read,
 /// the welded positions and their map, the OBJ text written from them and what
@@ -75,12 +73,9 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
     } else {
         (bytes, None)
     };
-    let objects = json.iter().filter(|&&b| b == b'{').count() as u64;
-    check_memory(
-        || format!("its glTF document ({objects} JSON objects)"),
-        bytes_for(objects, BYTES_PER_OBJECT),
-    )
-    .map_err(|e| out_of_memory(path, e))?;
+    // What serde will keep, refused before it allocates any of it.
+    let size = JsonSize::of(json);
+    check_memory(|| size.describe(), size.bytes).map_err(|e| out_of_memory(path, e))?;
     let root: gltf::json::Root = gltf::json::deserialize::from_slice(json)
         .map_err(|e| fail(format!("not glTF JSON: {e}")))?;
     if !root.asset.version.starts_with("2.") {
@@ -108,10 +103,12 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
 /// The document, checked by gltf-json's rules (every index in range, every
 /// enumeration known, required extensions supported) but one: POSITION's `min`
 /// and `max`, which the specification requires but nothing here reads, and
-/// some exporters leave out. Problems are reported as one line, the first
-/// three with where they are.
+/// some exporters leave out. Its nodes must form a forest, which gltf-json
+/// does not check. Problems are reported as one line, the first three with
+/// where they are.
 fn validated(root: gltf::json::Root) -> Result<gltf::Document, String> {
     use gltf::json::validation::{Error, Validate};
+    check_hierarchy(&root.nodes)?;
     // gltf-json 1.4 looks a POSITION accessor up without a bound check when
     // it checks its min and max: out of range, it would panic.
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -129,28 +126,38 @@ fn validated(root: gltf::json::Root) -> Result<gltf::Document, String> {
             }
         }
     }
+    // Only the problems shown are kept (with their paths, which are text):
+    // a file may have as many as it has indices.
     let mut problems = Vec::new();
+    let mut more = 0usize;
     root.validate(&root, gltf::json::Path::new, &mut |path, error| {
-        let path = path();
-        let bound = ["[\"POSITION\"].min", "[\"POSITION\"].max"]
-            .iter()
-            .any(|end| path.as_str().ends_with(end));
-        if !(bound && error == Error::Missing) {
-            problems.push((path, error));
+        if error == Error::Missing {
+            let path = path();
+            let bound = ["[\"POSITION\"].min", "[\"POSITION\"].max"]
+                .iter()
+                .any(|end| path.as_str().ends_with(end));
+            if bound {
+                return;
+            }
+        }
+        if problems.len() < 3 {
+            problems.push((path(), error));
+        } else {
+            more += 1;
         }
     });
     if problems.is_empty() {
         return Ok(gltf::Document::from_json_without_validation(root));
     }
     let mut text = String::from("invalid glTF: ");
-    for (k, (at, problem)) in problems.iter().take(3).enumerate() {
+    for (k, (at, problem)) in problems.iter().enumerate() {
         if k > 0 {
             text.push_str("; ");
         }
         let _ = write!(text, "{at}: {}", problem.to_string().to_lowercase());
     }
-    if problems.len() > 3 {
-        let _ = write!(text, "; and {} more", problems.len() - 3);
+    if more > 0 {
+        let _ = write!(text, "; and {more} more");
     }
     Err(text)
 }
@@ -239,7 +246,8 @@ fn world_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
     };
     let mut transform = local_transform(first);
     let mut at = first.index();
-    // A hierarchy with a cycle (invalid glTF) stops after every node once.
+    // The hierarchy is a forest (`check_hierarchy`): the walk reaches a root
+    // within as many steps as there are nodes.
     for _ in 0..nodes.len() {
         let Some(parent) = parents[at] else { break };
         transform = local_transform(&nodes[parent]) * transform;
@@ -299,6 +307,25 @@ fn read_primitive(
             position.data_type(),
             position.dimensions()
         ));
+    }
+    if primitive.mode() == Mode::Triangles {
+        match primitive.indices() {
+            Some(indices) if indices.count() % 3 != 0 => {
+                return Err(at(format!(
+                    "accessor {} holds {} indices, not a multiple of 3 as TRIANGLES needs",
+                    indices.index(),
+                    indices.count()
+                )))
+            }
+            None if position.count() % 3 != 0 => {
+                return Err(at(format!(
+                    "accessor {index} (POSITION) holds {} vertices and there are no indices, \
+                     but TRIANGLES needs a multiple of 3",
+                    position.count()
+                )))
+            }
+            _ => {}
+        }
     }
     let positions = buffers.read(&position, |b| [0, 4, 8].map(|at| f32_at(b, at)))?;
     if let Some(k) = positions

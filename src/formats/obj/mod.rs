@@ -13,7 +13,7 @@
 //!
 //! This reader replaced tobj, which read a copy of the text with every `v` line
 //! rewritten as its ordinal, into a hash map per group. It accepts and refuses
-//! the same files, tobj's rules included (tests/obj_reader.rs compares the two on
+//! the same files, tobj's rules included (tests/geometry/obj_reader.rs compares the two on
 //! the bundled and shared meshes, hand-written cases and mutated files), and
 //! names the line in every message:
 //! - a `vt` line has two or three numbers;

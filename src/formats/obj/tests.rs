@@ -1,5 +1,5 @@
 //! Reading in pieces gives what reading the whole text at once gives (which
-//! tests/obj_reader.rs compares with tobj), wherever the pieces are cut.
+//! tests/geometry/obj_reader.rs compares with tobj), wherever the pieces are cut.
 
 use super::read_in_pieces;
 use std::path::Path;

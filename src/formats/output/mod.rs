@@ -347,10 +347,7 @@ impl PendingOutput {
         };
         match self.kind {
             Pending::Stream(device) => {
-                let file = std::fs::OpenOptions::new()
-                    .write(true)
-                    .open(&device)
-                    .map_err(wrap)?;
+                let file = open_stream(&device).map_err(wrap)?;
                 let mut buffered = std::io::BufWriter::new(file);
                 if seeks {
                     // A pipe cannot seek: build the bytes first.
@@ -438,6 +435,36 @@ pub fn write_atomically(
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
     PendingOutput::create(path)?.finish(write)
+}
+
+/// Open a device or named pipe for writing. Opening a named pipe that no
+/// program reads waits until one does: say so first, instead of hanging with
+/// no word.
+fn open_stream(device: &Path) -> std::io::Result<std::fs::File> {
+    #[cfg(unix)]
+    {
+        use rustix::fs::OFlags;
+        use std::os::unix::fs::OpenOptionsExt;
+        let without_waiting = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(OFlags::NONBLOCK.bits() as i32)
+            .open(device);
+        match without_waiting {
+            Ok(file) => {
+                let flags = rustix::fs::fcntl_getfl(&file)? - OFlags::NONBLOCK;
+                rustix::fs::fcntl_setfl(&file, flags)?;
+                return Ok(file);
+            }
+            Err(error) if error.raw_os_error() == Some(rustix::io::Errno::NXIO.raw_os_error()) => {
+                eprintln!(
+                    "pmvc: waiting for a program to read the named pipe {}",
+                    shown_path(device)
+                );
+            }
+            Err(_) => {}
+        }
+    }
+    std::fs::OpenOptions::new().write(true).open(device)
 }
 
 fn folder_of(path: &Path) -> &Path {

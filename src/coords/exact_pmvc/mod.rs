@@ -1,0 +1,427 @@
+//! Exact positive mean value coordinates: the PMVC integral (Lipman, Kopf,
+//! Cohen-Or and Levin 2007) over the cage as x sees it, in closed form, with
+//! no cube map ([`super::pmvc`] samples the same integral with one ray per
+//! texel of a cube map around x).
+//!
+//! # The integral
+//!
+//! PMVC are `wᵢ ∝ ∫ φᵢ(y(σ)) / |y(σ) − x| dσ` over the sphere of directions
+//! σ, with y(σ) the first cage point on the ray from x along σ and φᵢ the
+//! barycentric coordinates of y on its triangle. Split the sphere into the
+//! parts R that each triangle T = (v₀, v₁, v₂) shows first. On R,
+//! `Σₖ (vₖ − x) φₖ(y) / |y − x| = σ`, so the weights `wₖᴿ` of T's corners over
+//! R satisfy `Σₖ (vₖ − x) wₖᴿ = ∫_R σ dσ = m_R`, the mean vector of R, which for
+//! a convex spherical polygon is `½ Σₑ θₑ nₑ` (θₑ the arc of side e, nₑ the
+//! unit normal of its great circle, pointing in; Ju, Schaefer and Warren 2005).
+//! Off T's plane the `vₖ − x` are a basis, so `wᴿ = [v₀ − x, v₁ − x, v₂ − x]⁻¹ m_R`
+//! exactly: `wₖᴿ = (ûₖ₊₁ × ûₖ₊₂)·m_R / (|vₖ − x| det[û₀, û₁, û₂])` with ûₖ the
+//! unit directions of the corners. The weights are the sums of `wᴿ` over the
+//! visible pieces of every triangle, normalised to sum to one.
+//!
+//! # Visibility
+//!
+//! From a point strictly inside a cage that does not cross itself, the first
+//! hit of every ray leaves the volume, on a triangle x sees from its inner side
+//! (`det[û₀, û₁, û₂] > 0`, a *candidate*); the others neither show nor hide
+//! anything that shows, and are skipped, as [`super::pmvc::pmvc_weights_inside`]
+//! skips them. Two candidates whose cones overlap are in one depth order over
+//! the whole overlap: it is convex, hence connected, and the order could only
+//! change where they meet. So the part of T that x sees is T's cone less the
+//! cones of the candidates in front of it: convex pieces, each cut along the
+//! occluder's edge planes (Sutherland–Hodgman on directions, [`polygon`]).
+//! Whether s is in front of t is read from their planes when one lies wholly
+//! on one side of the other's plane, else from one ray through their overlap.
+//! Candidates are sorted by their distance from x; s is passed over when it is
+//! wholly farther than t (and so are all after it), when bounding cones around
+//! the two do not meet, or when an edge plane of one has the other wholly
+//! outside ([`visibility`]).
+//!
+//! # Rounding
+//!
+//! - Everything is computed relative to x: a scene moved 1e7 from the origin
+//!   gives the weights it gives at the origin, bit for bit when its
+//!   coordinates move exactly.
+//! - Sides of a plane are exact where they matter: a corner knows the cage
+//!   vertex or the two edge planes it lies on and is on them exactly, so
+//!   triangles that share an edge or a vertex meet with no sliver of overlap
+//!   or gap. A plane's side within its rounding is 0, which keeps collinear
+//!   cage edges (one plane, computed from two pairs of corners) from cutting
+//!   slivers out of each other.
+//! - A piece's mean vector uses the great circles through its own corners, so
+//!   a sliver whose corners lie on one circle integrates to about 0 whatever
+//!   their order (the sum of a fan of spherical triangles, whose shared
+//!   diagonals cancel).
+//! - A triangle seen nearly edge on has a thin cone whose mean vector is small
+//!   against the rounding of `½ Σ θₑ nₑ`, and the weights divide it by the small
+//!   det: below [`THIN`] its pieces are integrated by Gauss–Legendre quadrature
+//!   instead, a sum of positive terms accurate to its own size
+//!   ([`polygon::mean_vector_by_quadrature`]). Closed form alone, linear
+//!   precision at 1e-15 from the plane of a face of an L-shaped cage was off
+//!   by 1e-2; with quadrature it holds to 1e-16 at every distance.
+//! - x exactly in a triangle's plane: the triangle is no candidate; its cone
+//!   has no area, so it neither shows nor hides anything.
+//! - Weights a hair below 0 from rounding are clamped to 0 (each piece's are
+//!   non-negative in exact arithmetic).
+//!
+//! # What it does not take
+//!
+//! - Quads: [`ExactPmvcFailure::Quads`]. Bilinear patches are not integrated
+//!   here; the caller binds the triangulated cage (`cage.split_quads(..)`,
+//!   as `BindOptions::cage_to_bind` does for families that take triangles).
+//! - Points not strictly inside, where the visible pieces do not cover the
+//!   sphere to [`MAX_UNCOVERED_SHARE`]: [`ExactPmvcFailure::NotEnclosed`], and
+//!   the caller follows the outside policy (MVC), as it does when the cube map
+//!   loses rays. Points on the cage get the surface policy before this is
+//!   called ([`crate::geometry::classify_points`]).
+//! - Cages that cross themselves: the depth order above does not hold; the
+//!   result is undefined (though finite), as for the cube map's culling.
+//!
+//! # Measured
+//!
+//! The cube map converges to these weights as `R⁻¹` (its misjudged texels are
+//! those a visibility boundary or a triangle edge crosses, about R of the 6R²
+//! per boundary): on the comb, over 200 points, the mean of each point's
+//! largest weight error is 6.4e-4, 2.9e-4, 1.3e-4, 6.6e-5 and 3.3e-5 at
+//! R = 16, 32, 64, 128 and 256 (exponents 1.16, 1.17, 0.96, 0.98); the
+//! largest error 6.1e-3, 3.0e-3, 1.3e-3, 4.6e-4 and 3.2e-4.
+//!
+//! Cost per point, one thread, release build, CPU time, against the cube map
+//! for the same points (the artist cages of `../shared/data/qmvc`, quads split
+//! along the shorter diagonal, at about 2000 of their mesh's inside vertices;
+//! the procedural cages at points spread inside):
+//!
+//! | cage | triangles | exact | fragments (max) | cube 32² | cube 64² | cube 64² largest error |
+//! |---|---|---|---|---|---|---|
+//! | ManHead | 20 | 13 µs | 20 (27) | 12 µs | 43 µs | 4.7e-4 |
+//! | Bench | 44 | 28 µs | 30 (44) | 16 µs | 50 µs | 1.7e-3 |
+//! | comb | 60 | 53 µs | 40 (70) | 18 µs | 55 µs | 1.4e-3 |
+//! | FireHydrant | 92 | 95 µs | 71 (84) | 21 µs | 50 µs | 2.8e-3 |
+//! | Ogre | 232 | 200 µs | 93 (212) | 26 µs | 58 µs | 1.5e-3 |
+//! | Beast | 300 | 226 µs | 97 (235) | 30 µs | 69 µs | 5.0e-4 |
+//! | hand-size | 500 | 800 µs | 207 (370) | 64 µs | 133 µs | 2.4e-3 |
+//! | icosphere | 1280 | 2.9 ms | 1280 | 104 µs | 139 µs | 2.6e-5 |
+//!
+//! The time goes to the pairs of candidates: every candidate scans those not
+//! wholly farther than itself, which grows as the square of their number
+//! (Beast: 9754 pairs scanned per point, 2234 with bounding cones meeting, 316
+//! occluding; the icosphere, where every triangle is at about the same
+//! distance: 913,313 scanned), then to cutting pieces. A grid of directions
+//! listing the candidates by cube-map cell (to scan only those sharing a
+//! cell) halved the icosphere's time but doubled the hand's and Beast's,
+//! whose large triangles fill many cells; it is not used. Commands:
+//! `cargo test --release --no-default-features --lib coords::exact_pmvc::measure
+//! -- --ignored --nocapture --test-threads 1`.
+
+#[cfg(test)]
+mod measure;
+mod polygon;
+#[cfg(test)]
+mod tests;
+mod visibility;
+
+use crate::geometry::{closest_point_on_triangle, Cage};
+use glam::DVec3;
+use polygon::{mean_vector, mean_vector_by_quadrature, Corner, EdgePlane, Label};
+use std::f64::consts::PI;
+use visibility::{visible_pieces, Pieces};
+
+/// Why [`exact_pmvc_weights_inside`] gave no weights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ExactPmvcFailure {
+    /// The cage has quads, which this integration does not take as bilinear
+    /// patches: bind `cage.split_quads(..)` for the triangulated cage instead.
+    #[error("exact PMVC take cages of triangles only; split the cage's quads first")]
+    Quads,
+    /// The visible triangles do not cover every direction from the point to
+    /// within [`MAX_UNCOVERED_SHARE`]: the point is not strictly inside the
+    /// cage (on it, outside it, or in a defect of it).
+    #[error("the point is not enclosed by the cage")]
+    NotEnclosed,
+}
+
+/// Share of the sphere of directions that may be left uncovered (or covered
+/// twice) before a point is taken as not enclosed.
+pub const MAX_UNCOVERED_SHARE: f64 = 1e-6;
+
+/// What one evaluation did, for measurements.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExactPmvcStats {
+    /// Triangles that x sees from their inner side.
+    pub candidates: usize,
+    /// Of those, seen nearly edge on (integrated by quadrature).
+    pub thin: usize,
+    /// Candidate pairs (t, s) scanned: s not wholly farther than t.
+    pub scanned: usize,
+    /// Of those, pairs whose bounding cones overlap.
+    pub cones_overlapping: usize,
+    /// Of those, pairs where s overlaps t and is in front of it.
+    pub occluding: usize,
+    /// Pieces an occluder cut or hid.
+    pub splits: usize,
+    /// Visible convex pieces integrated.
+    pub fragments: usize,
+}
+
+/// Reusable buffers, so that binding allocates nothing per point once warm.
+#[derive(Debug, Default)]
+pub struct ExactPmvcScratch {
+    relative: Vec<DVec3>,
+    directions: Vec<DVec3>,
+    distances: Vec<f64>,
+    candidates: Vec<Candidate>,
+    cones: Vec<Cone>,
+    /// For sorting both by distance.
+    order: Vec<u32>,
+    sorted: Vec<Candidate>,
+    sorted_cones: Vec<Cone>,
+    /// The pieces of the triangle at hand: corners, and where each piece ends.
+    pieces: Pieces,
+    next: Pieces,
+    work: Vec<Corner>,
+    cut: Vec<Corner>,
+    sides: Vec<f64>,
+    stats: ExactPmvcStats,
+}
+
+impl ExactPmvcScratch {
+    /// What the last evaluation did.
+    pub fn stats(&self) -> ExactPmvcStats {
+        self.stats
+    }
+}
+
+/// A triangle that x sees from its inner side, set up at x.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    vertices: [u32; 3],
+    /// Side k runs from corner k to corner k + 1; the triangle's cone is where
+    /// all three are kept.
+    sides: [EdgePlane; 3],
+    /// `N = (p₁ − p₀) × (p₂ − p₀)` and `N·p₀` for the corners p relative to x:
+    /// a ray `t·d` meets the triangle's plane at `t = offset / (N·d)`.
+    normal: DVec3,
+    offset: f64,
+    /// `wₖ = weight_normals[k]·m` for a piece of mean vector m: `(ûₖ₊₁ × ûₖ₊₂) /
+    /// (|pₖ| det[û₀, û₁, û₂])`, since `Σ pₖ wₖ = m` (see the module doc).
+    weight_normals: [DVec3; 3],
+    /// The unit directions of its corners.
+    directions: [DVec3; 3],
+    /// The distance from x to the triangle, and to its farthest corner.
+    /// Candidates are sorted by the first, so that those after one nearer
+    /// than t's farthest corner are all wholly farther than t.
+    nearest: f64,
+    farthest: f64,
+    /// Seen nearly edge on ([`THIN`]): its pieces are integrated by quadrature.
+    thin: bool,
+}
+
+/// A triangle is thin, seen from x, when `det[û₀, û₁, û₂]` is below this times
+/// the square of the chords between its corners (a few times the sine of the
+/// angle at which x sees its plane). The closed form's mean vector is a sum
+/// of terms of the size of the arcs, accurate to their rounding, and the
+/// weights divide its component across the triangle by det: measured on the
+/// comb against fine quadrature (`measure::thin_threshold`), its error is
+/// about 6e-18 of the total weight over this ratio, 7e-14 at the threshold;
+/// below it quadrature ([`polygon::mean_vector_by_quadrature`]) takes over.
+const THIN: f64 = 1e-4;
+
+/// What the scan for a triangle's possible occluders reads of each
+/// candidate, kept apart so that the scan runs through little memory.
+#[derive(Clone, Copy, Debug)]
+struct Cone {
+    /// A cone around the triangle's directions: unit axis, cos and sin of its
+    /// half angle (−1 and 0 for a cone that may hold any direction).
+    axis: DVec3,
+    cos_radius: f64,
+    sin_radius: f64,
+    /// [`Candidate::nearest`].
+    nearest: f64,
+}
+
+impl Candidate {
+    fn holds(&self, v: u32) -> bool {
+        self.vertices.contains(&v)
+    }
+
+    /// Side of cage vertex `v` (relative position `p`) of this triangle's
+    /// plane: positive beyond it, as seen from x; 0 for its own corners.
+    fn plane_side(&self, v: u32, p: DVec3) -> f64 {
+        if self.holds(v) {
+            0.0
+        } else {
+            self.normal.dot(p) - self.offset
+        }
+    }
+
+    fn corners(&self) -> [Corner; 3] {
+        std::array::from_fn(|k| Corner {
+            direction: self.directions[k],
+            label: Label::Vertex(self.vertices[k]),
+            side: self.sides[k],
+        })
+    }
+}
+
+/// PMVC of `x`, integrated exactly: written to `out` (one value per cage
+/// vertex), for a point [`crate::geometry::classify_points`] found strictly
+/// inside a cage of triangles that does not intersect itself. See the module
+/// doc for the method and [`ExactPmvcFailure`] for when it gives none (then
+/// `out` is unspecified; the caller follows the outside policy, MVC).
+pub fn exact_pmvc_weights_inside(
+    x: DVec3,
+    cage: &Cage,
+    out: &mut [f64],
+    scratch: &mut ExactPmvcScratch,
+) -> Result<(), ExactPmvcFailure> {
+    if cage.has_quads() {
+        return Err(ExactPmvcFailure::Quads);
+    }
+    out.fill(0.0);
+    scratch.stats = ExactPmvcStats::default();
+    set_up(x, cage, scratch)?;
+    let count = scratch.candidates.len();
+    scratch.stats.candidates = count;
+    scratch.stats.thin = scratch.candidates.iter().filter(|c| c.thin).count();
+    let mut total_weight = 0.0;
+    let mut solid_angle = 0.0;
+    for t in 0..count {
+        visible_pieces(t, scratch);
+        let target = &scratch.candidates[t];
+        for piece in scratch.pieces.iter() {
+            let (mut mean, omega) = mean_vector(piece);
+            if target.thin {
+                mean = mean_vector_by_quadrature(piece);
+            }
+            solid_angle += omega;
+            for k in 0..3 {
+                // Non-negative in exact arithmetic: clamp the rounding.
+                let weight = target.weight_normals[k].dot(mean).max(0.0);
+                out[target.vertices[k] as usize] += weight;
+                total_weight += weight;
+            }
+        }
+        scratch.stats.fragments += scratch.pieces.ends.len();
+    }
+    let sphere = 4.0 * PI;
+    if (solid_angle - sphere).abs() > MAX_UNCOVERED_SHARE * sphere
+        || !(total_weight > 0.0 && total_weight.is_finite())
+    {
+        return Err(ExactPmvcFailure::NotEnclosed);
+    }
+    let inverse = 1.0 / total_weight;
+    for value in out.iter_mut() {
+        *value *= inverse;
+    }
+    Ok(())
+}
+
+/// Directions to the cage vertices and the candidates at x, nearest first.
+fn set_up(x: DVec3, cage: &Cage, scratch: &mut ExactPmvcScratch) -> Result<(), ExactPmvcFailure> {
+    scratch.relative.clear();
+    scratch.directions.clear();
+    scratch.distances.clear();
+    for &position in cage.positions() {
+        let p = position - x;
+        let distance = p.length();
+        if !(distance > 0.0 && distance.is_finite()) {
+            // On a cage vertex: the surface policy's case.
+            return Err(ExactPmvcFailure::NotEnclosed);
+        }
+        scratch.relative.push(p);
+        scratch.distances.push(distance);
+        scratch.directions.push(p / distance);
+    }
+    scratch.candidates.clear();
+    scratch.cones.clear();
+    let u = &scratch.directions;
+    for &vertices in cage.triangles() {
+        let [i0, i1, i2] = vertices.map(|v| v as usize);
+        let normals = [u[i1].cross(u[i2]), u[i2].cross(u[i0]), u[i0].cross(u[i1])];
+        let det = u[i0].dot(normals[0]);
+        // Seen from the outer side (never the first hit from inside), or
+        // edge on (x in its plane: rays graze it, it neither holds nor blocks).
+        if det <= 0.0 || det.is_nan() {
+            continue;
+        }
+        let p = [i0, i1, i2].map(|i| scratch.relative[i]);
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+        let offset = normal.dot(p[0]);
+        let distances = [i0, i1, i2].map(|i| scratch.distances[i]);
+        let weight_normals = std::array::from_fn(|k| normals[k] / (distances[k] * det));
+        let (axis, cos_radius) = bounding_cone([u[i0], u[i1], u[i2]]);
+        // Past a right angle the cone no longer bounds the arcs: take it all.
+        let (cos_radius, sin_radius) = if cos_radius > 0.0 {
+            (cos_radius, (1.0 - cos_radius * cos_radius).max(0.0).sqrt())
+        } else {
+            (-1.0, 0.0)
+        };
+        let sides = [
+            EdgePlane::new(vertices[0], vertices[1], u),
+            EdgePlane::new(vertices[1], vertices[2], u),
+            EdgePlane::new(vertices[2], vertices[0], u),
+        ];
+        let perimeter =
+            (u[i0] - u[i1]).length() + (u[i1] - u[i2]).length() + (u[i2] - u[i0]).length();
+        scratch.cones.push(Cone {
+            axis,
+            cos_radius,
+            sin_radius,
+            nearest: 0.0,
+        });
+        scratch.candidates.push(Candidate {
+            thin: det < THIN * perimeter * perimeter,
+            vertices,
+            sides,
+            normal,
+            offset,
+            weight_normals,
+            directions: [u[i0], u[i1], u[i2]],
+            // Shrunk by far more than its rounding, to stay a lower bound.
+            nearest: closest_point_on_triangle(DVec3::ZERO, p[0], p[1], p[2])
+                .0
+                .length()
+                * (1.0 - 1e-12),
+            farthest: distances[0].max(distances[1]).max(distances[2]),
+        });
+    }
+    // Both lists in the order of the candidates' distances.
+    scratch.order.clear();
+    scratch.order.extend(0..scratch.candidates.len() as u32);
+    let candidates = &scratch.candidates;
+    scratch.order.sort_by(|&a, &b| {
+        candidates[a as usize]
+            .nearest
+            .total_cmp(&candidates[b as usize].nearest)
+    });
+    scratch.sorted.clear();
+    scratch.sorted_cones.clear();
+    for &k in &scratch.order {
+        let candidate = scratch.candidates[k as usize];
+        scratch.sorted.push(candidate);
+        scratch.sorted_cones.push(Cone {
+            nearest: candidate.nearest,
+            ..scratch.cones[k as usize]
+        });
+    }
+    std::mem::swap(&mut scratch.candidates, &mut scratch.sorted);
+    std::mem::swap(&mut scratch.cones, &mut scratch.sorted_cones);
+    Ok(())
+}
+
+/// A cone around three directions: its unit axis and the cosine of its half
+/// angle. The tighter of the cone around their mean and those around the
+/// middle of a side that hold the third corner (the smallest for an obtuse
+/// or long thin triangle).
+fn bounding_cone(corners: [DVec3; 3]) -> (DVec3, f64) {
+    let cos_radius = |axis: DVec3| corners.iter().map(|&c| axis.dot(c)).fold(1.0, f64::min);
+    let mean = (corners[0] + corners[1] + corners[2]).normalize();
+    let mut best = (mean, cos_radius(mean));
+    for k in 0..3 {
+        let axis = (corners[k] + corners[(k + 1) % 3]).normalize();
+        let cos = cos_radius(axis);
+        if cos > best.1 {
+            best = (axis, cos);
+        }
+    }
+    best
+}

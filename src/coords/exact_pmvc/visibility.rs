@@ -1,0 +1,244 @@
+//! Which part of each candidate x sees first: its cone less the cones of the
+//! candidates in front of it, as convex pieces.
+
+use super::polygon::{clip, side_of, Corner, EdgePlane, Label};
+use super::{Candidate, Cone, ExactPmvcScratch};
+use glam::DVec3;
+
+#[derive(Debug, Default)]
+pub(super) struct Pieces {
+    pub(super) corners: Vec<Corner>,
+    pub(super) ends: Vec<usize>,
+}
+
+impl Pieces {
+    pub(super) fn clear(&mut self) {
+        self.corners.clear();
+        self.ends.clear();
+    }
+
+    pub(super) fn push(&mut self, piece: &[Corner]) {
+        self.corners.extend_from_slice(piece);
+        self.ends.push(self.corners.len());
+    }
+
+    pub(super) fn iter(&self) -> impl Iterator<Item = &[Corner]> {
+        let starts = std::iter::once(0).chain(self.ends.iter().copied());
+        starts
+            .zip(self.ends.iter().copied())
+            .map(|(start, end)| &self.corners[start..end])
+    }
+
+    pub(super) fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+}
+
+/// Whether the cones of two candidates may share a direction.
+#[inline]
+fn cones_overlap(a: &Cone, b: &Cone) -> bool {
+    if a.cos_radius + b.cos_radius <= 0.0 {
+        // The two half angles add up to π or more.
+        return true;
+    }
+    let cos_sum = a.cos_radius * b.cos_radius - a.sin_radius * b.sin_radius;
+    a.axis.dot(b.axis) >= cos_sum - 1e-9
+}
+
+/// How candidate s lies in front of candidate t, seen from x.
+enum Order {
+    /// s is nowhere in front of t (or they do not overlap).
+    Behind,
+    /// s is in front of t wherever both are seen.
+    Front,
+    /// Each straddles the other's plane: ask one ray through their overlap.
+    Probe,
+}
+
+/// Whether s is in front of t where both are seen, as far as the sides of
+/// their planes tell: s wholly beyond t's plane (seen from x) is behind it,
+/// wholly on x's side of it in front, and the same for t against s's plane.
+fn order(t: &Candidate, s: &Candidate, relative: &[DVec3]) -> Order {
+    let s_sides = s.vertices.map(|v| t.plane_side(v, relative[v as usize]));
+    if s_sides.iter().all(|&d| d >= 0.0) {
+        return Order::Behind;
+    }
+    if s_sides.iter().all(|&d| d <= 0.0) {
+        return Order::Front;
+    }
+    let t_sides = t.vertices.map(|v| s.plane_side(v, relative[v as usize]));
+    if t_sides.iter().all(|&d| d >= 0.0) {
+        return Order::Front;
+    }
+    if t_sides.iter().all(|&d| d <= 0.0) {
+        return Order::Behind;
+    }
+    Order::Probe
+}
+
+/// Fills `scratch.pieces` with the part of candidate t that x sees first:
+/// its cone less those of the candidates in front of it.
+pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
+    let ExactPmvcScratch {
+        relative,
+        directions,
+        candidates,
+        cones,
+        pieces,
+        next,
+        work,
+        cut,
+        sides,
+        stats,
+        ..
+    } = scratch;
+    let target = &candidates[t];
+    let target_cone = &cones[t];
+    pieces.clear();
+    pieces.push(&target.corners());
+    for (s, cone) in cones.iter().enumerate() {
+        if cone.nearest >= target.farthest {
+            // This one and all after it are wholly farther than t.
+            return;
+        }
+        stats.scanned += 1;
+        if s == t || !cones_overlap(target_cone, cone) {
+            continue;
+        }
+        stats.cones_overlapping += 1;
+        let occluder = &candidates[s];
+        // The cheaper tests first: depth by planes, then overlap.
+        let order = order(target, occluder, relative);
+        if matches!(order, Order::Behind) || triangles_separated(target, occluder, directions) {
+            continue;
+        }
+        if matches!(order, Order::Probe)
+            && !probe_in_front(target, occluder, directions, work, cut, sides)
+        {
+            continue;
+        }
+        next.clear();
+        stats.occluding += 1;
+        for piece in pieces.iter() {
+            if subtract(piece, occluder, directions, next, work, cut, sides) {
+                stats.splits += 1;
+            }
+        }
+        std::mem::swap(pieces, next);
+        if pieces.is_empty() {
+            return;
+        }
+    }
+}
+
+/// Whether s is in front of t over the overlap of their cones, by one ray
+/// through it; false when they do not overlap.
+fn probe_in_front(
+    t: &Candidate,
+    s: &Candidate,
+    directions: &[DVec3],
+    work: &mut Vec<Corner>,
+    cut: &mut Vec<Corner>,
+    sides: &mut Vec<f64>,
+) -> bool {
+    work.clear();
+    work.extend_from_slice(&t.corners());
+    for plane in &s.sides {
+        sides.clear();
+        sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
+        cut.clear();
+        if !clip(work, sides, plane, directions, cut) {
+            return false;
+        }
+        std::mem::swap(work, cut);
+    }
+    let d: DVec3 = work.iter().map(|c| c.direction).sum();
+    // t_s < t_t, with t = offset / (N·d) and both N·d > 0 inside both cones.
+    s.offset * d.dot(t.normal) < t.offset * d.dot(s.normal)
+}
+
+/// Appends to `out` the parts of `piece` outside the cone of `occluder`, cut
+/// along its sides in turn. Returns whether the two overlapped (the piece was
+/// cut or hidden).
+fn subtract(
+    piece: &[Corner],
+    occluder: &Candidate,
+    directions: &[DVec3],
+    out: &mut Pieces,
+    work: &mut Vec<Corner>,
+    cut: &mut Vec<Corner>,
+    sides: &mut Vec<f64>,
+) -> bool {
+    if separated(piece, occluder, directions) {
+        out.push(piece);
+        return false;
+    }
+    work.clear();
+    work.extend_from_slice(piece);
+    for plane in &occluder.sides {
+        sides.clear();
+        sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
+        if sides.iter().all(|&d| d >= 0.0) {
+            continue;
+        }
+        if sides.iter().all(|&d| d <= 0.0) {
+            out.push(work);
+            return true;
+        }
+        // The part outside this side is kept; the rest goes on to the next.
+        let outside = plane.flipped();
+        for d in sides.iter_mut() {
+            *d = -*d;
+        }
+        if clip(work, sides, &outside, directions, &mut out.corners) {
+            out.ends.push(out.corners.len());
+        }
+        for d in sides.iter_mut() {
+            *d = -*d;
+        }
+        cut.clear();
+        if !clip(work, sides, plane, directions, cut) {
+            return true;
+        }
+        std::mem::swap(work, cut);
+    }
+    true
+}
+
+/// Whether a side of either triangle has the other wholly on its outer side:
+/// then their cones do not overlap.
+fn triangles_separated(t: &Candidate, s: &Candidate, directions: &[DVec3]) -> bool {
+    if !t.vertices.iter().any(|v| s.holds(*v)) {
+        // No corner in common: no side is exactly 0 by its label.
+        let outside = |plane: &EdgePlane, corners: &[DVec3; 3]| {
+            corners
+                .iter()
+                .all(|&d| plane.normal.dot(d) <= plane.tolerance)
+        };
+        return t.sides.iter().any(|plane| outside(plane, &s.directions))
+            || s.sides.iter().any(|plane| outside(plane, &t.directions));
+    }
+    let outside = |plane: &EdgePlane, corners: &[u32; 3]| {
+        corners
+            .iter()
+            .all(|&v| side_of(directions[v as usize], Label::Vertex(v), plane) <= 0.0)
+    };
+    t.sides.iter().any(|plane| outside(plane, &s.vertices))
+        || s.sides.iter().any(|plane| outside(plane, &t.vertices))
+}
+
+/// Whether a side of either polygon has the other wholly on its outer side.
+fn separated(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bool {
+    let by_occluder = occluder.sides.iter().any(|plane| {
+        piece
+            .iter()
+            .all(|c| side_of(c.direction, c.label, plane) <= 0.0)
+    });
+    by_occluder
+        || piece.iter().any(|corner| {
+            occluder
+                .vertices
+                .iter()
+                .all(|&v| side_of(directions[v as usize], Label::Vertex(v), &corner.side) <= 0.0)
+        })
+}

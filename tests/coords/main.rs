@@ -1,0 +1,19 @@
+//! Coordinates: MVC, PMVC, harmonic and Green coordinates against references and
+//! their properties, far-field exactness, origin offsets, weights metadata and
+//! the figures the docs quote. Builds without features
+//! (`cargo test --no-default-features --test coords`); the parts that run the
+//! `pmvc` binary need `editor`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod coords_properties;
+mod coords_reference;
+mod doc_figures;
+mod far_field;
+mod green;
+mod green_family;
+mod green_gallery;
+mod harmonic;
+mod origin_offsets;
+mod weights_metadata;
