@@ -80,6 +80,8 @@ mod read;
 mod write;
 
 #[cfg(test)]
+mod fuzz_mutations;
+#[cfg(test)]
 mod fuzz_tests;
 #[cfg(test)]
 mod json_size_tests;
