@@ -115,7 +115,7 @@ pub struct MethodChoice {
     /// Coordinates to compute.
     #[arg(long, value_enum, default_value_t = crate::coords::Method::Pmvc)]
     pub method: crate::coords::Method,
-    /// PMVC cube-map resolution: texels along one face edge (1–1024).
+    /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated in closed form, on the CPU, on triangles (quads are split along their shorter diagonal unless --triangulate says otherwise).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
     /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
@@ -231,7 +231,7 @@ pub struct CheckArgs {
     /// longest axis).
     #[arg(long, value_name = "POSE.obj")]
     pub deformed_cage: Option<PathBuf>,
-    /// PMVC cube-map resolution for that measurement (1–1024).
+    /// PMVC cube-map resolution for that measurement (1–1024), or `exact`.
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
 }
@@ -250,7 +250,7 @@ pub struct EditArgs {
     /// A deformed cage with the same vertex count, applied after binding.
     #[arg(long, value_name = "POSE.obj")]
     pub pose: Option<PathBuf>,
-    /// PMVC cube-map resolution (1–1024).
+    /// PMVC cube-map resolution (1–1024), or `exact` (no cube map).
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<u32>,
     /// Harmonic grid: cells along the cage's longest side (4–2048).

@@ -14,11 +14,7 @@ pub(super) fn parse_grid(text: &str) -> Result<u32, String> {
 }
 
 fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
-    let value: u64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a whole number"))?;
-    parameter.validate(value).map_err(|error| error.to_string())
+    parameter.spec().parse(text)
 }
 
 /// `--difference-limit`: a percentage of the cage diagonal, with or without the

@@ -26,6 +26,7 @@ pub mod family;
 pub mod green;
 pub mod harmonic;
 pub mod mvc;
+pub mod parameter_values;
 pub mod pmvc;
 pub mod qmvc;
 pub mod quality;
@@ -35,10 +36,11 @@ pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass, PointClasses};
 pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
-    FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
-    DEFAULT_RESOLUTION,
+    FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
+    WeightsId, DEFAULT_RESOLUTION, EXACT_RESOLUTION,
 };
 use glam::DVec3;
+pub use pmvc::PmvcIntegration;
 pub use quality::WeightQuality;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -139,12 +141,21 @@ impl BindOptions {
         crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
-    /// How the cage's quads are split for this bind, if they are.
+    /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
+    pub fn pmvc_exact(&self) -> bool {
+        self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
+    }
+
+    /// How the cage's quads are split for this bind, if they are. Exact PMVC
+    /// integrates triangles only, so quads are split as for Green coordinates.
     pub fn split_applied(&self, cage: &Cage) -> Option<QuadSplit> {
         if !cage.has_quads() {
             return None;
         }
         match (self.quads, self.method.spec().quads) {
+            (QuadSplit::None, QuadSupport::Patches { .. }) if self.pmvc_exact() => {
+                Some(QuadSplit::Shorter)
+            }
             (QuadSplit::None, QuadSupport::Patches { .. }) => None,
             (QuadSplit::None, QuadSupport::Triangles) => Some(QuadSplit::Shorter),
             (split, _) => Some(split),
@@ -170,6 +181,11 @@ impl BindOptions {
         let split = self.split_applied(cage)?;
         let count = cage.quads().len();
         let spec = self.method.spec();
+        if self.pmvc_exact() && self.quads == QuadSplit::None {
+            return Some(format!(
+                "notice: exact PMVC integrate triangles: the cage's {count} quads were split along the shorter diagonal (--triangulate longer for the other one)"
+            ));
+        }
         Some(match spec.quads {
             QuadSupport::Triangles => format!(
                 "notice: {} are bound on triangles: the cage's {count} quads were split along the {} diagonal ({})",
@@ -488,7 +504,7 @@ pub fn bind_rows<T: WeightValue>(
     if cols == 0 || rows.is_empty() {
         return Ok(());
     }
-    let table = cubemap::TexelTable::new(options.resolution.max(1));
+    let integration = PmvcIntegration::of(options);
     let green_cage = (options.method == Method::Green).then(|| green::GreenCage::new(cage));
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
@@ -513,7 +529,7 @@ pub fn bind_rows<T: WeightValue>(
                             classes[i],
                             cage,
                             options.method,
-                            &table,
+                            &integration,
                             row_f64,
                             mvc_scratch,
                             pmvc_scratch,
@@ -546,7 +562,7 @@ pub fn weights_at(
     class: PointClass,
     cage: &Cage,
     method: Method,
-    table: &cubemap::TexelTable,
+    integration: &PmvcIntegration,
     out: &mut [f64],
     mvc_scratch: &mut mvc::MvcScratch,
     pmvc_scratch: &mut pmvc::PmvcScratch,
@@ -591,7 +607,7 @@ pub fn weights_at(
                 mvc::mvc_weights(x, cage, out, mvc_scratch)
             }
             Method::Pmvc => {
-                if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
+                if !integration.weights_inside(x, cage, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the
                     // surface or in a cage defect). Follow the outside policy.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);

@@ -40,16 +40,30 @@ pub(super) fn method_from(id: &str) -> PyResult<Method> {
 /// A parameter's value from Python, checked by its spec's one `validate`.
 pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u32> {
     let spec = parameter.spec();
+    if let Ok(name) = value.extract::<String>() {
+        return spec
+            .parse(&name)
+            .map_err(|cause| error(Kind::Parameter, format!("{}: {cause}", parameter.id())));
+    }
     let value: i128 = value.extract().map_err(|_| {
+        let names: Vec<String> = spec
+            .named
+            .iter()
+            .map(|n| format!(" or \"{}\"", n.name))
+            .collect();
         error(
             Kind::Parameter,
-            format!("{} must be an integer, not {value}", parameter.id()),
+            format!(
+                "{} must be an integer{}, not {value}",
+                parameter.id(),
+                names.concat()
+            ),
         )
     })?;
     // Below zero or past u64 it is out of range all the same; the spec's
     // message gives the range.
     let clamped = u64::try_from(value).unwrap_or(u64::MAX);
-    spec.validate(clamped).map_err(|cause| {
+    spec.validate_number(clamped).map_err(|cause| {
         let message = cause
             .to_string()
             .replacen(&clamped.to_string(), &value.to_string(), 1);

@@ -142,7 +142,8 @@ fn choose_backend(
 /// bind --dtype f64``.
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
-/// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
+/// cube-map resolution (or ``"exact"``: no cube map, the visible cage
+/// integrated in closed form on the CPU), ``grid`` harmonic coordinates' grid (each read only by
 /// its family). A cage's quads are bilinear patches (MVC on them is QMVC);
 /// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
 /// first, as before quads were patches (Green coordinates always bind on

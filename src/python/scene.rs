@@ -534,7 +534,16 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             entry.set_item("default", parameter.default)?;
             entry.set_item("min", parameter.min)?;
             entry.set_item("max", parameter.max)?;
-            entry.set_item("choices", parameter.choices.to_vec())?;
+            let choices = PyList::empty(py);
+            for &choice in parameter.choices {
+                match parameter.name_of(choice) {
+                    Some(name) => choices.append(name)?,
+                    None => choices.append(choice)?,
+                }
+            }
+            entry.set_item("choices", choices)?;
+            let named: Vec<&str> = parameter.named.iter().map(|n| n.name).collect();
+            entry.set_item("named", named)?;
             parameters.append(entry)?;
         }
         family.set_item("parameters", parameters)?;

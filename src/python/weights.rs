@@ -233,8 +233,16 @@ impl PyWeights {
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let parameters = PyDict::new(py);
-        for (name, value) in &self.metadata.parameters {
-            parameters.set_item(name, value)?;
+        for (name, &value) in &self.metadata.parameters {
+            // A named value ("exact") as its name, as W.json writes it.
+            let named = crate::coords::Parameter::ALL
+                .into_iter()
+                .find(|p| p.id() == name)
+                .and_then(|p| p.spec().name_of(value));
+            match named {
+                Some(named) => parameters.set_item(name, named)?,
+                None => parameters.set_item(name, value)?,
+            }
         }
         Ok(parameters)
     }

@@ -289,8 +289,8 @@ fn fill_boundary_and_outside(
     weights: &mut Weights,
 ) {
     let columns = weights.cols.max(1);
-    // MVC reads no cube map; the table is only there to satisfy the signature.
-    let table = super::cubemap::TexelTable::new(1);
+    // MVC reads no cube map; PMVC's integration is only there for the signature.
+    let integration = super::PmvcIntegration::Exact;
     weights
         .values
         .par_chunks_mut(columns)
@@ -310,7 +310,7 @@ fn fill_boundary_and_outside(
                     class,
                     cage,
                     super::Method::Mvc,
-                    &table,
+                    &integration,
                     row_f64,
                     mvc_scratch,
                     pmvc_scratch,

@@ -122,6 +122,7 @@ pub struct WeightsMetadata {
     pub method: String,
     pub method_name: String,
     /// The family's own parameters and their values (none for MVC and Green).
+    #[serde(with = "crate::coords::parameter_values")]
     pub parameters: BTreeMap<String, u32>,
     /// `--triangulate` as asked: "none" (quads stay bilinear patches), "shorter"
     /// or "longer". Files from before quads were patches have none and read as

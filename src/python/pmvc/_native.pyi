@@ -147,7 +147,7 @@ def bind(
     points: ArrayLike,
     cage: CageLike,
     method: str = "pmvc",
-    resolution: int = 32,
+    resolution: Union[int, str] = 32,
     grid: int = 64,
     backend: str = "auto",
     progress: Optional[Progress] = None,
@@ -158,7 +158,7 @@ def bind(
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
-    ``resolution`` is PMVC's cube-map resolution, ``grid`` harmonic
+    ``resolution`` is PMVC's cube-map resolution (or ``"exact"``), ``grid`` harmonic
     coordinates' grid; each is read only by its family and checked against its
     range. Quads are bilinear patches (MVC on them is QMVC) unless
     ``triangulate`` is "shorter" or "longer", which splits them along that
