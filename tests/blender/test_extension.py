@@ -1,0 +1,40 @@
+"""The extension installs from its .zip as Blender's Install from Disk does."""
+
+from pathlib import Path
+
+import bpy
+
+import pmvc
+from conftest import FAMILIES
+
+
+def test_the_extension_is_installed_enabled_and_brings_its_wheel(extension):
+    assert "bl_ext.user_default.pmvc" in {a.module for a in bpy.context.preferences.addons}
+    assert (extension / "user_default" / "pmvc" / "blender_manifest.toml").is_file()
+    # Blender unpacked the bundled wheel into the extensions' site-packages.
+    unpacked = list(Path(extension).glob(".local/lib/python*/site-packages/pmvc/blender/__init__.py"))
+    assert unpacked, "the bundled pmvc-cage wheel was not installed"
+
+
+def test_the_method_enum_lists_every_family_of_the_package():
+    items = bpy.ops.pmvc.bind.get_rna_type().properties["method"].enum_items.keys()
+    assert list(items) == [f.upper() for f in FAMILIES]
+    assert {"MVC", "PMVC", "HARMONIC", "GREEN"} <= set(items)
+
+
+def test_operators_are_registered_and_undoable():
+    for name in ("bind", "unbind", "rebind", "bake_shape_key", "show_coordinate"):
+        operator = getattr(bpy.ops.pmvc, name)
+        assert {"REGISTER", "UNDO"} <= set(operator.get_rna_type().bl_options if hasattr(operator.get_rna_type(), "bl_options") else _options(operator)), name
+
+
+def _options(operator):
+    cls = getattr(bpy.types, operator.idname(), None)
+    return cls.bl_options if cls else set()
+
+
+def test_the_panels_are_registered():
+    assert hasattr(bpy.types, "PMVC_PT_object") and hasattr(bpy.types, "PMVC_PT_sidebar")
+    assert bpy.types.PMVC_PT_object.bl_context == "object"
+    assert bpy.types.PMVC_PT_sidebar.bl_space_type == "VIEW_3D"
+    assert pmvc.blender is not None
