@@ -96,8 +96,10 @@ def select(mesh_obj, *others):
 
 
 def coordinates(mesh):
-    out = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-    mesh.vertices.foreach_get("co", out)
+    """float64 (n, 3) of a mesh's vertices or a shape key's points."""
+    items = mesh.data if isinstance(mesh, bpy.types.ShapeKey) else mesh.vertices
+    out = np.empty(len(items) * 3, dtype=np.float32)
+    items.foreach_get("co", out)
     return out.reshape(-1, 3).astype(np.float64)
 
 
