@@ -61,6 +61,16 @@ def comb():
     return link_mesh("comb", points, faces), link_mesh("comb cage", cage_vertices, cage_faces)
 
 
+def middle_tip(vertices):
+    """The comb cage's vertices at the top of its middle finger, and the finger's
+    width (tests/python/study.py's pose)."""
+    top = vertices[:, 1].max()
+    tips = np.flatnonzero(vertices[:, 1] > top - 1e-9)
+    fingers = np.unique(np.round(vertices[tips, 0], 9)).reshape(-1, 2)
+    left, right = fingers[len(fingers) // 2]
+    return tips[(vertices[tips, 0] > left - 1e-9) & (vertices[tips, 0] < right + 1e-9)], right - left
+
+
 def box(nx, ny, nz, size=(1.0, 1.0, 1.0), center=(0.0, 0.0, 0.0)):
     """A closed box of quads, nx by ny by nz cells, outward-facing."""
     import bmesh

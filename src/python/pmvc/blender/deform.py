@@ -105,6 +105,10 @@ def posed_cage(obj, cage_obj, depsgraph):
     return to_mesh_space(evaluated_obj, evaluated_cage_obj, coordinates)
 
 
+class NotInDepsgraph(ValueError):
+    """The cage is not evaluated in this depsgraph (disabled in renders, say)."""
+
+
 def current_pose(obj, depsgraph, changed_only=False):
     """(binding, posed cage in the mesh's space) as ``depsgraph`` has it
     (posed None when ``changed_only`` and the cage did not move since the last
@@ -115,9 +119,12 @@ def current_pose(obj, depsgraph, changed_only=False):
         raise ValueError("its cage object was deleted")
     if len(obj.data.vertices) != len(binding.points):
         raise ValueError(f"it has {len(obj.data.vertices)} vertices, it was bound with {len(binding.points)}: unbind and bind again")
+    if not cage_obj.evaluated_get(depsgraph).is_evaluated:
+        raise NotInDepsgraph(f"its cage {cage_obj.name} is not in this view layer or render")
     posed = posed_cage(obj, cage_obj, depsgraph)
     if posed.shape != binding.rest.shape:
-        raise ValueError(f"its cage {cage_obj.name} has {len(posed)} vertices, it was bound with {len(binding.rest)}: rebind")
+        raise ValueError(f"its cage {cage_obj.name} has {len(posed)} vertices, it was bound with {len(binding.rest)} "
+                         "(a modifier on the cage that adds vertices, or an edit): rebind")
     if changed_only and binding.last_posed is not None and np.array_equal(posed, binding.last_posed):
         return binding, None
     return binding, posed
@@ -132,6 +139,8 @@ def update_object(obj, depsgraph):
         if posed is None:
             return
         offsets = binding.offsets(posed)
+    except NotInDepsgraph:
+        return  # keep the offsets of the depsgraph that has it
     except (pmvc.PmvcError, ValueError, KeyError, TypeError, RuntimeError) as error:
         status[obj.name] = str(error)
         return
