@@ -122,3 +122,8 @@ def test_several_meshes_follow_one_cage_and_objects_may_be_moved_apart():
     want, diagonal = expected(points, rest, faces, posed, "pmvc")
     assert relative_error(evaluated(twin), want, diagonal) < TOLERANCE
     assert np.abs(evaluated(twin) - points).max() > 0.01
+    # Moving the cage object moves the meshes bound to it.
+    before = evaluated(mesh_obj)
+    cage_obj.location.z += 0.75
+    bpy.context.view_layer.update()
+    assert np.abs(evaluated(mesh_obj) - (before + [0, 0, 0.75])).max() < TOLERANCE * diagonal

@@ -164,3 +164,23 @@ def test_a_blend_opens_without_the_add_on(tmp_path):
     assert result.returncode == 0, result.stdout + result.stderr
     assert "opened fine" in result.stdout
     assert "Traceback" not in result.stderr and "Error" not in result.stdout, result.stdout + result.stderr
+
+
+def test_a_bind_cancelled_from_its_progress_changes_nothing():
+    """Esc in the interface sets a flag the progress callback raises on; the
+    modal operator itself needs a window, so its worker's path is run here."""
+    from pmvc.blender import binding, operators
+
+    mesh_obj, cage_obj = comb()
+    rest = coordinates(mesh_obj.data)
+    points, cage = binding.inputs(mesh_obj, cage_obj, bpy.context.evaluated_depsgraph_get())
+    calls = []
+
+    def progress(done, total):
+        calls.append(done)
+        raise operators.Cancelled()
+
+    with pytest.raises(operators.Cancelled):
+        binding.run_bind(points, cage, "pmvc", {"resolution": 256}, progress)
+    assert calls and "_pmvc" not in mesh_obj and len(mesh_obj.modifiers) == 0
+    assert np.array_equal(evaluated(mesh_obj), rest)

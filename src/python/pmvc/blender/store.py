@@ -37,7 +37,9 @@ class Binding:
         # 26,155 x 118 on 2 cores); against `pmvc deform`'s float64 sums that
         # is 7e-8 of Ogre's cage diagonal at its target pose, the size of
         # the float32 rounding of the positions Blender stores.
-        self.matrix = np.ascontiguousarray(weights.matrix[:, :m]) if self.linear else None
+        # Column-major, so that the columns of the cage vertices that moved
+        # (one, while a vertex is dragged) are read alone.
+        self.matrix = np.asfortranarray(weights.matrix[:, :m]) if self.linear else None
         self.last_posed = None
 
     def offsets(self, posed):
@@ -45,7 +47,11 @@ class Binding:
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
             return np.zeros_like(self.points)
         if self.linear:
-            return (self.matrix @ (posed - self.rest).astype(np.float32)).astype(np.float64)
+            moves = (posed - self.rest).astype(np.float32)
+            moved = np.flatnonzero(moves.any(axis=1))
+            if len(moved) < len(moves) // 2:
+                return (self.matrix[:, moved] @ moves[moved]).astype(np.float64)
+            return (self.matrix @ moves).astype(np.float64)
         return pmvc.deform(self.points, self.cage, posed, weights=self.weights) - self.points
 
 
