@@ -126,8 +126,9 @@ class _Binder:
 
 
 def _parameter_annotations():
-    annotations = {"method": EnumProperty(name="Method", items=method_items(), default="PMVC" if any(
-        f["id"] == "pmvc" for f in binding.families()) else None)}
+    items = method_items()
+    default = "PMVC" if any(item[0] == "PMVC" for item in items) else items[0][0]
+    annotations = {"method": EnumProperty(name="Method", items=items, default=default)}
     for pid, spec in binding.parameter_specs().items():
         annotations[pid] = IntProperty(name=spec.get("label", pid), default=spec["default"],
                                        min=spec["min"], max=spec["max"])

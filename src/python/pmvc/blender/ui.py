@@ -7,7 +7,9 @@ from . import binding, deform, operators, store
 
 
 def settings_class():
-    annotations = {"method": EnumProperty(name="Method", items=operators.method_items())}
+    items = operators.method_items()
+    default = "PMVC" if any(item[0] == "PMVC" for item in items) else items[0][0]
+    annotations = {"method": EnumProperty(name="Method", items=items, default=default)}
     for pid, spec in binding.parameter_specs().items():
         annotations[pid] = IntProperty(name=spec.get("label", pid), default=spec["default"],
                                        min=spec["min"], max=spec["max"])
