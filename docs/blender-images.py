@@ -3,6 +3,9 @@ background mode) with the add-on, on the bundled comb:
 
     target/blender-venv/bin/python docs/blender-images.py docs/images
 
+blender-posed-ogre.png: the shared Ogre (../shared/data/qmvc, GPL-3; skipped
+where it is missing) bound with PMVC, its artist cage at its target pose, and
+the Ogre at rest beside it.
 blender-posed-comb.png: the comb bound with PMVC, its cage (wireframe) with the
 middle finger's tip pulled up, as the evaluated mesh shows it.
 blender-coordinate-pmvc.png, blender-coordinate-mvc.png: the coordinate of one
@@ -124,10 +127,53 @@ def coordinate(out, method, vertex):
     render(out / f"blender-coordinate-{method.lower()}.png")
 
 
+def ogre(out):
+    """The shared Ogre (../shared/data/qmvc, GPL-3) bound with PMVC to its artist
+    cage, at the cage's target pose, beside it at rest."""
+    shared = ROOT.parent / "shared" / "data" / "qmvc"
+    files = [shared / f"Ogre{suffix}.obj" for suffix in ("", "_Cage", "_Cage_Deformed")]
+    if not all(f.exists() for f in files):
+        print(f"Ogre: not rendered ({shared} missing)")
+        return
+    points, faces = pmvc.load_mesh(str(files[0]))
+    rest, cage_faces = pmvc.load_mesh(str(files[1]))
+    target, _ = pmvc.load_mesh(str(files[2]))
+    bpy.ops.wm.read_homefile(use_empty=True)
+    sc = bpy.context.scene
+    sc.render.engine = "BLENDER_WORKBENCH"
+    sc.render.resolution_x, sc.render.resolution_y = 640, 400
+    sc.render.image_settings.color_mode = "RGB"
+    sc.display.shading.light = "STUDIO"
+    sc.display.shading.color_type = "OBJECT"
+    sc.world = bpy.data.worlds.new("w")
+    sc.world.color = (1, 1, 1)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 92.0
+    camera.location = (22.0, 17.5, 100.0)
+    sc.collection.objects.link(camera)
+    sc.camera = camera
+    posed_obj, cage_obj = link("Ogre", points, faces), link("Ogre cage", rest, cage_faces)
+    for obj in sc.objects:
+        obj.select_set(obj in (posed_obj, cage_obj))
+    bpy.context.view_layer.objects.active = posed_obj
+    bpy.ops.pmvc.bind(method="PMVC")
+    cage_obj.data.vertices.foreach_set("co", np.asarray(target, np.float32).ravel())
+    cage_obj.data.update()
+    show_wire(cage_obj, 0.12).color = (0.1, 0.1, 0.1, 1)
+    at_rest = link("Ogre at rest", points, faces)
+    at_rest.location.x = 44.0
+    for obj, colour in ((posed_obj, (0.55, 0.7, 0.45, 1)), (at_rest, (0.7, 0.7, 0.7, 1))):
+        obj.color = colour
+    bpy.context.view_layer.update()
+    render(out / "blender-posed-ogre.png")
+
+
 def main():
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/images")
     pmvc.blender.register()
     posed(out)
+    ogre(out)
     # The cage vertex whose MVC coordinate is the most negative somewhere.
     points, _ = pmvc.load_mesh(str(ROOT / "assets" / "comb_mesh.obj"))
     mvc = pmvc.bind(points, pmvc.Cage.load(str(ROOT / "assets" / "comb_cage.obj")), method="mvc").matrix
