@@ -37,7 +37,7 @@ def test_unbind_restores_the_rest_positions_exactly():
     assert np.array_equal(evaluated(mesh_obj), rest)
     assert np.array_equal(coordinates(mesh_obj.data), rest)
     assert len(mesh_obj.modifiers) == 0 and ".pmvc_offset" not in mesh_obj.data.attributes
-    assert "_pmvc" not in mesh_obj
+    assert "_pmvc" not in mesh_obj and not [t for t in bpy.data.texts if t.name.startswith(".pmvc")]
     pull(cage_obj)  # the cage no longer moves it
     assert np.array_equal(evaluated(mesh_obj), rest)
 
@@ -47,6 +47,7 @@ def test_rebind_takes_the_cage_as_it_is_as_rest():
     points = coordinates(mesh_obj.data)
     pull(cage_obj)
     assert bpy.ops.pmvc.rebind() == {"FINISHED"}
+    assert len([t for t in bpy.data.texts if t.name.startswith(".pmvc")]) == 1  # the old one went
     bpy.context.view_layer.update()
     assert np.array_equal(evaluated(mesh_obj), points)  # the new rest: unmoved
     rest = coordinates(cage_obj.data)

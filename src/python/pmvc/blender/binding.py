@@ -85,7 +85,7 @@ def apply(context, obj, cage_obj, points, cage, weights, method, parameters):
     """Store the binding on ``obj`` and deform it for the cage as it is."""
     if len(obj.data.vertices) != len(points):
         raise InputProblem(f"the mesh {obj.name!r} changed while it was being bound: bind again")
-    store.forget(obj)
+    store.remove(obj)  # a rebind: the previous binding's data goes
     store.save(obj, cage_obj, points, cage, weights, method.lower(), parameters)
     deform.attach(obj)
     deform.update_object(obj, context.evaluated_depsgraph_get())

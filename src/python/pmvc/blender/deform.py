@@ -125,7 +125,8 @@ def current_pose(obj, depsgraph, changed_only=False):
     if posed.shape != binding.rest.shape:
         raise ValueError(f"its cage {cage_obj.name} has {len(posed)} vertices, it was bound with {len(binding.rest)} "
                          "(a modifier on the cage that adds vertices, or an edit): rebind")
-    if changed_only and binding.last_posed is not None and np.array_equal(posed, binding.last_posed):
+    last = binding.last_posed.get(obj.name_full)
+    if changed_only and last is not None and np.array_equal(posed, last):
         return binding, None
     return binding, posed
 
@@ -150,7 +151,7 @@ def update_object(obj, depsgraph):
         return
     attribute.data.foreach_set("vector", offsets.astype(np.float32).ravel())
     obj.data.update_tag()
-    binding.last_posed = posed
+    binding.last_posed[obj.name_full] = posed
     status.pop(obj.name, None)
 
 

@@ -1,6 +1,13 @@
-"""Where a binding lives: in the bound object's hidden ID property ``_pmvc``,
-so that it is saved with the .blend and restored by undo, and a cache of the
-arrays rebuilt from it (keyed by a token that changes with every bind)."""
+"""Where a binding lives: the bound object's hidden ID property ``_pmvc``
+(family, parameters, the cage object, a token) and, for the arrays, the ID
+properties of a hidden Text data-block it points to (``.pmvc <object>``, with a
+fake user). Both are saved with the .blend and restored by undo. The arrays
+are not on the object because Blender copies an object's ID properties each
+time it evaluates it (36 MB per cage move for Ogre's Green weights); a Text is
+never evaluated. A cache holds the arrays rebuilt from it, keyed by a token
+that changes with every bind."""
+
+import bpy
 
 import json
 import uuid
@@ -32,27 +39,60 @@ class Binding:
         self.layout = weights.metadata.get("columns_layout", "cage_vertices")
         self.linear = self.layout == "cage_vertices"
         m = len(self.rest)
+        # Green coordinates: φ for the cage vertices, then ψ for the triangles
+        # (docs/python.md, "Green coordinates' columns"); other layouts go
+        # through the package's deform.
+        self.green = self.layout == "cage_vertices_then_triangles" and weights.triangles is not None
+        if self.green:
+            self.triangles = np.asarray(weights.triangles, dtype=np.int64)
+            u, w = self._edges(self.rest)
+            self.u2, self.w2, self.uw = (u * u).sum(1), (w * w).sum(1), (u * w).sum(1)
+            cross = np.cross(u, w)
+            self.area = np.linalg.norm(cross, axis=1) / 2
+            self.normals = cross / np.linalg.norm(cross, axis=1)[:, None]
+            self.psi = np.ascontiguousarray(weights.matrix[:, m:])
         # Rows times the cage's moves in float32 (the weights' own type, half
-        # the memory traffic of float64: 3.7 ms instead of 9 ms for Ogre's
-        # 26,155 x 118 on 2 cores); against `pmvc deform`'s float64 sums that
-        # is 7e-8 of Ogre's cage diagonal at its target pose, the size of
-        # the float32 rounding of the positions Blender stores.
-        # Column-major, so that the columns of the cage vertices that moved
-        # (one, while a vertex is dragged) are read alone.
-        self.matrix = np.asfortranarray(weights.matrix[:, :m]) if self.linear else None
-        self.last_posed = None
+        # the memory traffic of float64); against `pmvc deform`'s float64
+        # sums that is 1e-7 of Ogre's cage diagonal at its target pose, the
+        # size of the float32 rounding of the positions Blender stores.
+        self.matrix = np.ascontiguousarray(weights.matrix[:, :m]) if self.linear or self.green else None
+        #: Object name -> the cage pose its offsets were last written for.
+        self.last_posed = {}
+
+    def _edges(self, vertices):
+        corners = vertices[self.triangles]
+        return corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
 
     def offsets(self, posed):
         """The move of every point for the cage at ``posed`` (mesh space)."""
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
             return np.zeros_like(self.points)
-        if self.linear:
+        if self.linear or self.green:
             moves = (posed - self.rest).astype(np.float32)
-            moved = np.flatnonzero(moves.any(axis=1))
-            if len(moved) < len(moves) // 2:
-                return (self.matrix[:, moved] @ moves[moved]).astype(np.float64)
-            return (self.matrix @ moves).astype(np.float64)
+            moved = moves.any(axis=1)
+            out = _product(self.matrix, moves, moved)
+            if self.green:
+                u, w = self._edges(posed)
+                stretch = np.sqrt((u * u).sum(1) * self.w2 - 2 * (u * w).sum(1) * self.uw + (w * w).sum(1) * self.u2)
+                stretch /= np.sqrt(8.0) * self.area
+                cross = np.cross(u, w)
+                turned = stretch[:, None] * cross / np.linalg.norm(cross, axis=1)[:, None] - self.normals
+                # A triangle none of whose corners moved adds nothing (its
+                # term is 0 up to rounding).
+                out += _product(self.psi, turned.astype(np.float32), moved[self.triangles].any(axis=1))
+            return out.astype(np.float64)
         return pmvc.deform(self.points, self.cage, posed, weights=self.weights) - self.points
+
+
+def _product(matrix, values, mask):
+    """matrix @ values over the rows of ``values`` that ``mask`` keeps: only
+    those columns are read when they are few (a dragged vertex)."""
+    columns = np.flatnonzero(mask)
+    if len(columns) == 0:
+        return np.zeros((matrix.shape[0], 3), dtype=np.float32)
+    if len(columns) < len(mask) // 2:
+        return matrix[:, columns] @ values[columns]
+    return matrix @ values
 
 
 def is_bound(obj):
@@ -75,11 +115,10 @@ def save(obj, cage_obj, points, cage, weights, method, parameters):
     faces = [list(map(int, f)) for f in cage.faces]
     metadata = weights.__reduce__()[1][2]
     token = uuid.uuid4().hex
-    obj[KEY] = {
-        "format": FORMAT,
-        "token": token,
-        "method": method,
-        "parameters": json.dumps(parameters),
+    holder = bpy.data.texts.new(f".pmvc {obj.name}")
+    holder.use_fake_user = True
+    holder.write(f"pmvc binding of {obj.name} (its weights are this data-block's ID properties)\n")
+    holder[KEY] = {
         "rows": matrix.shape[0],
         "columns": matrix.shape[1],
         "matrix": matrix.ravel(),
@@ -90,7 +129,14 @@ def save(obj, cage_obj, points, cage, weights, method, parameters):
         "face_corners": np.array([i for f in faces for i in f], dtype=np.int32),
         "points": np.ascontiguousarray(points, dtype=np.float64).ravel(),
     }
+    obj[KEY] = {
+        "format": FORMAT,
+        "token": token,
+        "method": method,
+        "parameters": json.dumps(parameters),
+    }
     obj[KEY]["cage"] = cage_obj
+    obj[KEY]["data"] = holder
     binding = Binding(token, weights, cage, points, method, parameters)
     _cache[token] = binding
     return binding
@@ -100,13 +146,17 @@ def load(obj):
     """The Binding of ``obj`` (from the cache, or rebuilt from the property).
 
     Raises pmvc.PmvcError or ValueError when the stored binding is unsound."""
-    group = obj[KEY]
-    token = group["token"]
+    settings = obj[KEY]
+    token = settings["token"]
     binding = _cache.get(token)
     if binding is not None:
         return binding
-    if group.get("format") != FORMAT:
-        raise ValueError(f"{obj.name}: binding format {group.get('format')} is not {FORMAT}")
+    if settings.get("format") != FORMAT:
+        raise ValueError(f"{obj.name}: binding format {settings.get('format')} is not {FORMAT}")
+    holder = settings.get("data")
+    if holder is None or KEY not in holder:
+        raise ValueError(f"{obj.name}: its binding's data-block was deleted: bind again")
+    group = holder[KEY]
     rows, columns = int(group["rows"]), int(group["columns"])
     matrix = np.frombuffer(group["matrix"], dtype=np.float32).reshape(rows, columns).copy()
     classes = np.frombuffer(bytes(group["classes"]), dtype=np.int8).copy()
@@ -120,7 +170,7 @@ def load(obj):
         start += size
     cage = pmvc.Cage(rest, faces)
     points = np.frombuffer(group["points"], dtype=np.float64).reshape(-1, 3).copy()
-    binding = Binding(token, weights, cage, points, group["method"], json.loads(group["parameters"]))
+    binding = Binding(token, weights, cage, points, settings["method"], json.loads(settings["parameters"]))
     _cache[token] = binding
     return binding
 
@@ -137,10 +187,16 @@ def forget(obj=None):
 def forget_poses():
     """After undo or load: the next update rewrites every offset."""
     for binding in _cache.values():
-        binding.last_posed = None
+        binding.last_posed.clear()
 
 
 def remove(obj):
+    """Remove ``obj``'s binding, and its data-block unless another object uses it."""
     forget(obj)
-    if KEY in obj:
-        del obj[KEY]
+    if KEY not in obj:
+        return
+    holder = obj[KEY].get("data")
+    del obj[KEY]
+    if holder is not None and not any(
+            KEY in other and other[KEY].get("data") == holder for other in bpy.data.objects if other != obj):
+        bpy.data.texts.remove(holder)
