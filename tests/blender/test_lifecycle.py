@@ -87,6 +87,15 @@ def test_export_weights_writes_what_pmvc_bind_writes(tmp_path):
     assert json.loads((tmp_path / "W.json").read_text())["method"] == "harmonic"
 
 
+def test_green_weights_are_exported_as_npz_as_pmvc_bind_writes_them(tmp_path, capfd):
+    mesh_obj, cage_obj = bound_comb("green")
+    assert bpy.ops.pmvc.export_weights(filepath=str(tmp_path / "W.npy")) == {"FINISHED"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["W.classes.npy", "W.json", "W.npz"]
+    assert "W.npz" in capfd.readouterr().out
+    loaded = pmvc.load_weights(str(tmp_path / "W.npz"))
+    assert loaded.matrix.shape == (7456, 40 + 76)
+
+
 def test_show_coordinate_makes_a_vertex_group_and_reports_the_minimum(capfd):
     mesh_obj, cage_obj = bound_comb("mvc")
     capfd.readouterr()

@@ -204,17 +204,20 @@ class PMVC_OT_export_weights(bpy.types.Operator, ExportHelper):
     bl_options = {"REGISTER"}
 
     filename_ext = ".npy"
-    filter_glob: StringProperty(default="*.npy;*.npz", options={"HIDDEN"})
+    filter_glob: StringProperty(default="*.npy;*.npz", options={"HIDDEN"})  # Green: .npz
 
     def execute(self, context):
         try:
             obj = bound_object(context)
             weights = store.load(obj).weights
-            pmvc.save_weights(self.filepath, weights)
+            path = self.filepath
+            if weights.triangles is not None and path.lower().endswith(".npy"):
+                path = path[:-4] + ".npz"  # Green's φ and ψ, as `pmvc bind` writes them
+            pmvc.save_weights(path, weights)
         except REFUSED as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"{obj.name}: weights written to {self.filepath} (with .classes.npy and .json)")
+        self.report({"INFO"}, f"{obj.name}: weights written to {path} (with .classes.npy and .json)")
         return {"FINISHED"}
 
 

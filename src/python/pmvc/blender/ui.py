@@ -1,7 +1,7 @@
 """The pmvc panel, in the object properties of a mesh and in the 3D view's sidebar."""
 
 import bpy
-from bpy.props import EnumProperty, IntProperty, PointerProperty
+from bpy.props import EnumProperty, IntProperty
 
 from . import binding, deform, operators, store
 
