@@ -28,8 +28,8 @@ def test_an_open_cage_is_refused_with_the_command_lines_words():
     vertices, faces = box(4, 4, 4, size=(1.0, 1.0, 3.0), center=(0, 0, 1.5))
     open_cage = link_mesh("open cage", vertices, faces[1:])
     select(mesh_obj, open_cage)
-    message = refused(bpy.ops.pmvc.bind, "open cage", method="PMVC")
-    assert "boundary" in message or "closed" in message or "open" in message
+    message = refused(bpy.ops.pmvc.bind, "cage 'open cage': the cage is not closed", method="PMVC")
+    assert "Blender's indices are one less" in message
     untouched(mesh_obj, rest)
 
 
@@ -38,7 +38,7 @@ def test_a_cage_with_no_volume_is_refused():
     rest = coordinates(mesh_obj.data)
     flat = link_mesh("flat cage", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3), (3, 2, 1, 0)])
     select(mesh_obj, flat)
-    refused(bpy.ops.pmvc.bind, "flat cage", method="MVC")
+    refused(bpy.ops.pmvc.bind, "cage 'flat cage': the cage encloses no volume", method="MVC")
     untouched(mesh_obj, rest)
 
 

@@ -72,7 +72,10 @@ def inputs(obj, cage_obj, depsgraph):
     try:
         cage = pmvc.Cage(coordinates, faces)
     except pmvc.PmvcError as error:
-        raise InputProblem(f"cage {cage_obj.name!r}: {error}") from error
+        message = str(error).removeprefix("cage: ")
+        if "counted from 1" in message:
+            message += "; Blender's indices are one less"
+        raise InputProblem(f"cage {cage_obj.name!r}: {message}") from error
     return points, cage
 
 

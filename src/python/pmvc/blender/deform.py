@@ -145,6 +145,9 @@ def update_object(obj, depsgraph):
     except (pmvc.PmvcError, ValueError, KeyError, TypeError, RuntimeError) as error:
         status[obj.name] = str(error)
         return
+    except Exception as error:  # a handler's traceback would repeat at every update
+        status[obj.name] = f"pmvc could not update it: {type(error).__name__}: {error}"
+        return
     attribute = obj.data.attributes.get(store.OFFSET)
     if attribute is None or attribute.domain != "POINT" or attribute.data_type != "FLOAT_VECTOR":
         status[obj.name] = "its offset attribute is missing: bind again"
