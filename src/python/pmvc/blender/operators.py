@@ -12,7 +12,8 @@ import pmvc
 
 from . import binding, deform, store
 
-REFUSED = (pmvc.PmvcError, binding.InputProblem, ValueError, KeyError, TypeError, RuntimeError)
+# ReferenceError: an object deleted while a bind ran in the background.
+REFUSED = (pmvc.PmvcError, binding.InputProblem, ValueError, KeyError, TypeError, RuntimeError, ReferenceError)
 
 
 class Cancelled(Exception):
