@@ -57,6 +57,10 @@ class _Binder:
     def invoke(self, context, _event):
         if bpy.app.background:
             return self.execute(context)
+        return self.start(context)
+
+    def start(self, context):
+        """Start the bind in a worker thread; modal() follows it."""
         try:
             job = self.prepare(context)
         except REFUSED as error:
