@@ -34,3 +34,19 @@ def test_the_panels_are_registered():
     assert bpy.types.PMVC_PT_object.bl_context == "object"
     assert bpy.types.PMVC_PT_sidebar.bl_space_type == "VIEW_3D"
     assert pmvc.blender is not None
+
+
+def test_blenders_own_validator_accepts_the_zip():
+    """Blender's extension command line (`blender --command extension validate`)
+    checks the manifest more strictly than installing does (a tagline of 78
+    characters installed, and fails here)."""
+    import subprocess
+    import sys
+
+    from conftest import extension_zip
+
+    script = Path(bpy.utils.system_resource("SCRIPTS")) / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py"
+    assert script.is_file(), script
+    result = subprocess.run([sys.executable, str(script), "validate", extension_zip()],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0 and "Success" in result.stdout, result.stdout + result.stderr
