@@ -131,6 +131,22 @@ def test_reverting_to_the_state_before_bind_unbinds(tmp_path):
     assert np.array_equal(evaluated(mesh_obj), rest)
 
 
+def test_reverting_to_the_state_before_a_bake_keeps_the_binding(tmp_path):
+    mesh_obj, cage_obj = bound_comb()
+    pull(cage_obj)
+    posed = evaluated(mesh_obj)
+    before = str(tmp_path / "before.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=before)
+    bpy.ops.pmvc.bake_shape_key(name="pose")
+    bpy.ops.wm.open_mainfile(filepath=before)
+    mesh_obj, cage_obj = bpy.data.objects["comb"], bpy.data.objects["comb cage"]
+    assert mesh_obj.data.shape_keys is None and "_pmvc" in mesh_obj
+    bpy.context.view_layer.update()
+    assert np.array_equal(evaluated(mesh_obj), posed)
+    pull(cage_obj, 3)  # still bound: it follows
+    assert np.abs(evaluated(mesh_obj) - posed).max() > 1e-3
+
+
 def test_save_reload_and_deform_again(tmp_path):
     mesh_obj, cage_obj = quad_scene()
     points, rest = coordinates(mesh_obj.data), coordinates(cage_obj.data)
