@@ -127,3 +127,27 @@ def test_several_meshes_follow_one_cage_and_objects_may_be_moved_apart():
     cage_obj.location.z += 0.75
     bpy.context.view_layer.update()
     assert np.abs(evaluated(mesh_obj) - (before + [0, 0, 0.75])).max() < TOLERANCE * diagonal
+
+
+def test_float64_weights_are_kept_and_applied_as_float64():
+    """Where the package binds float64 weights (`dtype=numpy.float64`), a
+    binding stored with them deforms with them, saved and reloaded."""
+    import pmvc
+    from pmvc.blender import binding, store
+
+    mesh_obj, cage_obj = comb()
+    points, cage = binding.inputs(mesh_obj, cage_obj, bpy.context.evaluated_depsgraph_get())
+    try:
+        weights = pmvc.bind(points, cage, method="mvc", dtype=np.float64)
+    except TypeError:
+        pytest.skip("this pmvc-cage has no float64 weights")
+    binding.apply(bpy.context, mesh_obj, cage_obj, points, cage, weights, "mvc", {})
+    store.forget()  # rebuilt from the stored arrays
+    assert store.load(mesh_obj).weights.matrix.dtype == np.float64
+    rest = coordinates(cage_obj.data)
+    cage_obj.data.vertices[0].co.z += 0.5
+    cage_obj.data.update()
+    bpy.context.view_layer.update()
+    want = pmvc.deform(points, cage, coordinates(cage_obj.data), weights=weights)
+    assert relative_error(evaluated(mesh_obj), want, cage.diagonal) < TOLERANCE
+    assert np.abs(evaluated(mesh_obj) - points).max() > 1e-3 and not np.array_equal(rest, coordinates(cage_obj.data))

@@ -51,8 +51,8 @@ class Binding:
             self.area = np.linalg.norm(cross, axis=1) / 2
             self.normals = cross / np.linalg.norm(cross, axis=1)[:, None]
             self.psi = np.ascontiguousarray(weights.matrix[:, m:])
-        # Rows times the cage's moves in float32 (the weights' own type, half
-        # the memory traffic of float64); against `pmvc deform`'s float64
+        # Rows times the cage's moves in the weights' own type: float32 (half
+        # the memory traffic of float64) unless bound as float64; against `pmvc deform`'s float64
         # sums that is 1e-7 of Ogre's cage diagonal at its target pose, the
         # size of the float32 rounding of the positions Blender stores.
         self.matrix = np.ascontiguousarray(weights.matrix[:, :m]) if self.linear or self.green else None
@@ -68,7 +68,7 @@ class Binding:
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
             return np.zeros_like(self.points)
         if self.linear or self.green:
-            moves = (posed - self.rest).astype(np.float32)
+            moves = (posed - self.rest).astype(self.matrix.dtype)
             moved = moves.any(axis=1)
             out = _product(self.matrix, moves, moved)
             if self.green:
@@ -79,7 +79,7 @@ class Binding:
                 turned = stretch[:, None] * cross / np.linalg.norm(cross, axis=1)[:, None] - self.normals
                 # A triangle none of whose corners moved adds nothing (its
                 # term is 0 up to rounding).
-                out += _product(self.psi, turned.astype(np.float32), moved[self.triangles].any(axis=1))
+                out += _product(self.psi, turned.astype(self.psi.dtype), moved[self.triangles].any(axis=1))
             return out.astype(np.float64)
         return pmvc.deform(self.points, self.cage, posed, weights=self.weights) - self.points
 
@@ -89,7 +89,7 @@ def _product(matrix, values, mask):
     those columns are read when they are few (a dragged vertex)."""
     columns = np.flatnonzero(mask)
     if len(columns) == 0:
-        return np.zeros((matrix.shape[0], 3), dtype=np.float32)
+        return np.zeros((matrix.shape[0], 3), dtype=matrix.dtype)
     if len(columns) < len(mask) // 2:
         return matrix[:, columns] @ values[columns]
     return matrix @ values
@@ -111,7 +111,7 @@ def summary(obj):
 
 def save(obj, cage_obj, points, cage, weights, method, parameters):
     """Store a new binding on ``obj``; returns its Binding."""
-    matrix = np.ascontiguousarray(weights.matrix, dtype=np.float32)
+    matrix = np.ascontiguousarray(weights.matrix)  # float32, or float64 where bound so
     faces = [list(map(int, f)) for f in cage.faces]
     metadata = weights.__reduce__()[1][2]
     token = uuid.uuid4().hex
@@ -121,6 +121,7 @@ def save(obj, cage_obj, points, cage, weights, method, parameters):
     holder[KEY] = {
         "rows": matrix.shape[0],
         "columns": matrix.shape[1],
+        "dtype": matrix.dtype.name,
         "matrix": matrix.ravel(),
         "classes": np.ascontiguousarray(weights.classes, dtype=np.int8).tobytes(),
         "metadata": metadata,
@@ -158,7 +159,8 @@ def load(obj):
         raise ValueError(f"{obj.name}: its binding's data-block was deleted: bind again")
     group = holder[KEY]
     rows, columns = int(group["rows"]), int(group["columns"])
-    matrix = np.frombuffer(group["matrix"], dtype=np.float32).reshape(rows, columns).copy()
+    dtype = {"float32": np.float32, "float64": np.float64}[group.get("dtype", "float32")]
+    matrix = np.frombuffer(group["matrix"], dtype=dtype).reshape(rows, columns).copy()
     classes = np.frombuffer(bytes(group["classes"]), dtype=np.int8).copy()
     weights = _native._restore_weights(matrix, classes, group["metadata"], None)
     rest = np.frombuffer(group["rest"], dtype=np.float64).reshape(-1, 3).copy()
