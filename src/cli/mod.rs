@@ -23,6 +23,7 @@ macro_rules! warn_line {
 }
 
 mod bench;
+mod bench_exact;
 mod bind;
 mod cage;
 mod commands;
