@@ -14,10 +14,10 @@ use super::session::{self, SessionSettings};
 use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
 use crate::formats::{
-    load_cage, load_mesh, refuse_same_file, write_cage_and_pose, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, MeshFile,
+    load_cage, load_mesh, refuse_same_file, write_atomically, write_cage_and_pose,
+    write_deformed_mesh, write_mesh_with_normals, write_polygons_obj_to, MeshFile,
 };
-use crate::geometry::{subdivide_midpoint, TriMesh};
+use crate::geometry::{polygons_of, subdivide_midpoint, TriMesh};
 use crate::render::OrbitCamera;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -345,7 +345,8 @@ pub fn refuse_overwriting_inputs(
     refuse_same_file(path, &open_inputs(current, session)).map_err(|error| error.to_string())
 }
 
-/// Write the pose as a cage-shaped OBJ.
+/// Write the pose as an OBJ with the cage's faces as read (quads stay quads),
+/// as `pmvc deform` reads poses and Save cage writes them.
 pub fn save_pose(path: &Path, current: &Document) -> Result<String, String> {
     refuse_overwriting_open_files(path, current)?;
     let cage = current.cage();
@@ -354,7 +355,11 @@ pub fn save_pose(path: &Path, current: &Document) -> Result<String, String> {
         triangles: cage.triangles().to_vec(),
         triangle_faces: cage.triangle_faces().to_vec(),
     };
-    write_obj(path, &posed).map_err(|error| error.to_string())?;
+    let faces = polygons_of(&posed);
+    write_atomically(path, |out| {
+        write_polygons_obj_to(out, &posed.positions, &faces)
+    })
+    .map_err(|error| error.to_string())?;
     Ok(format!("saved pose {}", shown_path(path)))
 }
 
