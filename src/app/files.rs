@@ -403,10 +403,25 @@ pub fn save_session(
     Ok(format!("saved session {}", shown_path(path)))
 }
 
-/// Write the mesh deformed with `method` as glTF: the current pose as the base
-/// shape, each named pose as a morph target named after it, and the timeline's
-/// keys, when it has two or more, as the animation.
-pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<String, String> {
+/// The base shape of a glTF export (Blender's Basis shape key).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GltfBase {
+    /// The mesh as read: an import lands where the original was.
+    Rest,
+    /// The mesh deformed with the current pose (File > Export glTF, pose as base).
+    Pose,
+}
+
+/// Write the mesh deformed with `method` as glTF: `base` as the base shape,
+/// each named pose as a morph target named after it, and the timeline's keys,
+/// when it has two or more, as the animation, which starts at the base (a key
+/// at 0 s with every weight 0) unless a pose is keyed at 0 s.
+pub fn export_gltf(
+    path: &Path,
+    current: &Document,
+    method: Method,
+    base_shape: GltfBase,
+) -> Result<String, String> {
     use crate::formats::gltf::{write_gltf, AnimationKey, GltfPose, GltfScene};
     refuse_overwriting_open_files(path, current)?;
     if current.weights(method).is_none() {
@@ -416,7 +431,10 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
             method.name()
         ));
     }
-    let base = current.deformed_positions(method);
+    let base = match base_shape {
+        GltfBase::Rest => current.mesh().positions.clone(),
+        GltfBase::Pose => current.deformed_positions(method),
+    };
     let named = current.named_poses();
     let deformed: Vec<Vec<DVec3>> = named
         .iter()
@@ -430,13 +448,19 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
             positions,
         })
         .collect();
-    let keys: Vec<AnimationKey> = crate::app::timeline::keys(named)
-        .into_iter()
-        .map(|(seconds, index)| AnimationKey {
-            seconds: seconds as f32,
-            pose: Some(index),
-        })
-        .collect();
+    let timeline = crate::app::timeline::keys(named);
+    let mut keys: Vec<AnimationKey> = Vec::with_capacity(timeline.len() + 1);
+    if timeline.first().is_some_and(|&(seconds, _)| seconds > 0.0) {
+        keys.push(AnimationKey {
+            seconds: 0.0,
+            pose: None,
+        });
+    }
+    keys.extend(timeline.iter().map(|&(seconds, index)| AnimationKey {
+        seconds: seconds as f32,
+        pose: Some(index),
+    }));
+    let animated = timeline.len() >= 2;
     let made;
     let mesh = match current.mesh_file() {
         Some(file) => file,
@@ -454,16 +478,20 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
         mesh,
         base: &base,
         poses: &poses,
-        animation: (keys.len() >= 2).then_some(keys.as_slice()),
+        animation: animated.then_some(keys.as_slice()),
     };
     write_gltf(path, &scene).map_err(|error| error.to_string())?;
-    let animated = if keys.len() >= 2 {
+    let animated = if animated {
         format!(", an animation of {} keys", keys.len())
     } else {
         String::new()
     };
+    let base_shape = match base_shape {
+        GltfBase::Rest => "the rest mesh",
+        GltfBase::Pose => "the current pose",
+    };
     Ok(format!(
-        "exported {} ({}, {} morph target(s){animated})",
+        "exported {} ({}, {base_shape} as its base, {} morph target(s){animated})",
         shown_path(path),
         method.name(),
         poses.len()
