@@ -502,12 +502,17 @@ pub fn export_gltf(
 pub fn export_deformed(path: &Path, current: &Document, method: Method) -> Result<String, String> {
     refuse_overwriting_open_files(path, current)?;
     let positions = current.deformed_positions(method);
-    match current.mesh_file() {
+    let moved = match current.mesh_file() {
         Some(file) => write_deformed_mesh(file, &positions, path),
-        None => write_mesh_with_normals(path, &positions, &current.mesh().triangles),
+        None => write_mesh_with_normals(path, &positions, &current.mesh().triangles)
+            .map(|()| Vec::new()),
     }
     .map_err(|error| error.to_string())?;
-    Ok(format!("exported {}", shown_path(path)))
+    let mut done = format!("exported {}", shown_path(path));
+    for library in moved {
+        done.push_str(&format!("; {library}"));
+    }
+    Ok(done)
 }
 
 /// The name a new session file is offered: the mesh's, as

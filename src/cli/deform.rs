@@ -178,7 +178,9 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             },
         )?;
     } else {
-        crate::formats::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+        for library in crate::formats::write_deformed_mesh(&input.mesh, &deformed, &args.out)? {
+            warn_line!("pmvc: {}: note: {library}", shown_path(&args.out));
+        }
     }
     let source = match (&args.weights, &stored) {
         (Some(path), Some(stored)) if stored.metadata.is_some() => format!(

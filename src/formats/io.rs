@@ -2,6 +2,7 @@
 //! [`super::write_atomically`].
 
 use super::error::{CageLoadError, WriteError};
+use super::mtllib::{LibraryPaths, MovedLibrary};
 use super::npy::points::read_points_npy;
 use super::obj::MAX_VERTICES;
 use super::output::write_atomically;
@@ -305,17 +306,21 @@ pub fn write_cage_and_pose(
 /// vertex, written before the first face under a comment that says so), and
 /// every face corner refers to its vertex's normal. Comments that speak of
 /// normals (MeshLab's "# 39028 vertices, 0 vertices normals") would then be
-/// wrong, so they are left out.
+/// wrong, so they are left out. Written to another folder than the source's,
+/// `mtllib` lines name their libraries by paths that resolve from there
+/// ([`super::mtllib`]): what comes back says which, for the caller to tell.
 pub fn write_deformed_mesh(
     file: &MeshFile,
     positions: &[DVec3],
     path: &Path,
-) -> Result<(), WriteError> {
+) -> Result<Vec<MovedLibrary>, WriteError> {
     assert_eq!(
         positions.len(),
         file.mesh.positions.len(),
         "one position per mesh vertex"
     );
+    let libraries = LibraryPaths::new(&file.path, path);
+    let mut moved = Vec::new();
     match (&file.format, &file.obj_text) {
         // A glTF's text is OBJ written from it.
         (MeshFormat::Obj | MeshFormat::Gltf, Some(text)) => write_atomically(path, |out| {
@@ -336,6 +341,13 @@ pub fn write_deformed_mesh(
                     }
                     // Stale after the deformation: recomputed below.
                     Some("vn") => {}
+                    Some("mtllib") if libraries.is_some() => {
+                        let names = line.trim_start()["mtllib".len()..].trim();
+                        let paths = libraries.as_ref().expect("checked by the guard");
+                        let (line, libraries) = paths.rewrite(names);
+                        moved.extend(libraries);
+                        writeln!(out, "{line}")?
+                    }
                     Some(first) if first.starts_with('#') && speaks_of_normals(line) => {}
                     Some("f") => {
                         if !normals_written {
@@ -363,9 +375,10 @@ pub fn write_deformed_mesh(
                 }
             }
             Ok(())
-        }),
-        _ => write_mesh_with_normals(path, positions, &file.mesh.triangles),
+        })?,
+        _ => write_mesh_with_normals(path, positions, &file.mesh.triangles)?,
     }
+    Ok(moved)
 }
 
 /// Write an OBJ of `positions` and `triangles` with recomputed vertex normals

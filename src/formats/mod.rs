@@ -11,6 +11,7 @@ mod error;
 pub mod gltf;
 mod io;
 pub mod metadata;
+mod mtllib;
 pub mod npy;
 pub mod npz;
 mod obj;
@@ -24,6 +25,7 @@ pub use io::{
     cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
     write_mesh_with_normals, write_obj, write_obj_to, write_polygons_obj_to,
 };
+pub use mtllib::MovedLibrary;
 pub use npy::points::write_points_npy;
 pub use output::{
     extension_warning, refuse_same_file, refuse_unwritable, remove_unfinished_outputs,

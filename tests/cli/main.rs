@@ -21,3 +21,4 @@ mod gltf;
 #[cfg(unix)]
 mod outputs;
 mod pipeline_cache;
+mod round_trip;
