@@ -470,6 +470,7 @@ pub fn export_gltf(
                 format: crate::formats::MeshFormat::Obj,
                 mesh: (**current.mesh()).clone(),
                 obj_text: None,
+                node_transform: None,
             };
             &made
         }

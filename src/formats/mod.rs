@@ -58,6 +58,10 @@ pub struct MeshFile {
     /// glTF file, OBJ text written from its mesh (positions, texture coordinates,
     /// primitives as groups), which is what was parsed.
     pub obj_text: Option<String>,
+    /// For a glTF mesh, the world transform of the node it was read through,
+    /// already applied to `mesh.positions`: a glTF export puts it back on its
+    /// node. `None` for other formats and for the identity.
+    pub node_transform: Option<glam::DMat4>,
 }
 
 /// What `path` is when it is not a regular file ("a named pipe", "a device",

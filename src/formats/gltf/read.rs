@@ -86,7 +86,8 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
     }
     let document = validated(root).map_err(fail)?;
     let mesh = picked(&document, pick).map_err(fail)?;
-    let text = obj_text(path, &document, &mesh, bin).map_err(|e| match e {
+    let transform = world_transform(&document, mesh.index());
+    let text = obj_text(path, &document, &mesh, transform, bin).map_err(|e| match e {
         Refused::Invalid(message) => fail(message),
         Refused::Memory(e) => out_of_memory(path, e),
         Refused::TooManyVertices(count) => LoadError::TooLarge {
@@ -97,6 +98,7 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
     })?;
     let mut file = parse_obj(path, text)?;
     file.format = MeshFormat::Gltf;
+    file.node_transform = (transform != DMat4::IDENTITY).then_some(transform);
     Ok(file)
 }
 
@@ -434,6 +436,7 @@ fn obj_text(
     path: &Path,
     document: &gltf::Document,
     mesh: &gltf::Mesh,
+    transform: DMat4,
     bin: Option<&[u8]>,
 ) -> Result<String, Refused> {
     let mesh_index = mesh.index();
@@ -453,7 +456,6 @@ fn obj_text(
         bytes_for(vertices, BYTES_PER_VERTEX).saturating_add(bytes_for(corners, BYTES_PER_INDEX)),
     )
     .map_err(Refused::Memory)?;
-    let transform = world_transform(document, mesh_index);
     let mirrored = transform.determinant() < 0.0;
     let mut buffers = Buffers::new(path, document, bin);
     let mut welded: HashMap<[u64; 3], u32> = HashMap::new();

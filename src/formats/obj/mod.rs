@@ -54,6 +54,7 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
         format: MeshFormat::Obj,
         mesh,
         obj_text: Some(text),
+        node_transform: None,
     })
 }
 
