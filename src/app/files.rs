@@ -14,7 +14,7 @@ use super::session::{self, SessionSettings};
 use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
 use crate::formats::{
-    load_cage, load_mesh, refuse_same_file, write_atomically, write_cage_and_pose,
+    load_cage_object, load_mesh, refuse_same_file, write_atomically, write_cage_and_pose,
     write_deformed_mesh, write_mesh_with_normals, write_polygons_obj_to, MeshFile,
 };
 use crate::geometry::{polygons_of, subdivide_midpoint, TriMesh};
@@ -135,8 +135,11 @@ pub fn open_session(path: &Path) -> Result<SceneChange, String> {
 
 /// A mesh and its cage together.
 pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, String> {
-    let mesh = load_mesh(mesh_path).map_err(|error| error.to_string())?;
-    let (cage, report) = load_cage(cage_path).map_err(|error| error.to_string())?;
+    let mut mesh = load_mesh(mesh_path).map_err(|error| error.to_string())?;
+    let (cage, report, cage_note) =
+        load_cage_object(cage_path, None).map_err(|error| error.to_string())?;
+    let mut notes = object_note(mesh_path, mesh.object_note.take());
+    notes.extend(object_note(cage_path, cage_note));
     let document = Document::new(file_title(mesh_path), mesh.mesh.clone(), cage)
         .with_files(Some(mesh), Some(cage_path.to_owned()));
     let action = format!(
@@ -149,8 +152,16 @@ pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, Stri
             mesh: mesh_path.to_owned(),
             cage: cage_path.to_owned(),
         });
-    change.notes = report.messages();
+    notes.extend(report.messages());
+    change.notes = notes;
     Ok(change)
+}
+
+/// A file's note of which of its objects was read, as a notice naming it.
+fn object_note(path: &Path, note: Option<String>) -> Vec<String> {
+    note.map(|note| format!("{}: {note}", shown_path(path)))
+        .into_iter()
+        .collect()
 }
 
 /// The mesh replaced (the cage kept) or the cage replaced (the mesh kept). A
@@ -158,21 +169,24 @@ pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, Stri
 pub fn open_file(role: FileRole, path: &Path, current: &Document) -> Result<SceneChange, String> {
     let (document, notes) = match role {
         FileRole::Mesh => {
-            let file = load_mesh(path).map_err(|error| error.to_string())?;
+            let mut file = load_mesh(path).map_err(|error| error.to_string())?;
             if !cage_reaches(current.cage(), &file.mesh) {
                 return mesh_in_box(path, file);
             }
+            let notes = object_note(path, file.object_note.take());
             let document = Document::new(
                 file_title(path),
                 file.mesh.clone(),
                 (**current.cage()).clone(),
             )
             .with_files(Some(file), current.cage_path().map(Into::into));
-            (document, Vec::new())
+            (document, notes)
         }
         FileRole::Cage => {
-            let (cage, report) = load_cage(path).map_err(|error| error.to_string())?;
-            let notes = report.messages();
+            let (cage, report, note) =
+                load_cage_object(path, None).map_err(|error| error.to_string())?;
+            let mut notes = object_note(path, note);
+            notes.extend(report.messages());
             let rest = cage.positions().to_vec();
             (current.with_cage(cage, Some(path.to_owned()), rest), notes)
         }
@@ -199,7 +213,8 @@ pub fn open_mesh_alone(path: &Path) -> Result<SceneChange, String> {
 
 /// `file`, read from `path`, in a loose box cage, with the Generate cage
 /// window offering a real one.
-fn mesh_in_box(path: &Path, file: MeshFile) -> Result<SceneChange, String> {
+fn mesh_in_box(path: &Path, mut file: MeshFile) -> Result<SceneChange, String> {
+    let notes = object_note(path, file.object_note.take());
     let cage = loose_box_cage(&file.mesh).ok_or_else(|| {
         format!(
             "{}: the mesh has no extent to put a cage around",
@@ -216,6 +231,7 @@ fn mesh_in_box(path: &Path, file: MeshFile) -> Result<SceneChange, String> {
             shown_path(path)
         ));
     change.offer_cage = true;
+    change.notes = notes;
     Ok(change)
 }
 
@@ -471,6 +487,7 @@ pub fn export_gltf(
                 mesh: (**current.mesh()).clone(),
                 obj_text: None,
                 node_transform: None,
+                object_note: None,
             };
             &made
         }

@@ -110,11 +110,51 @@ fn count_lines(text: &[u8]) -> (u64, u64, u64, u64) {
 /// the memory available, and no further than a NUL byte. A `.npy` is read by
 /// [`super::points_npy`]'s rules: an (n, 3) array of finite float32 or float64.
 pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
+    load_mesh_object(path, None)
+}
+
+/// The one check of an object name asked for (`--mesh-object`, `object=`):
+/// some text, as every name the readers list is.
+pub fn check_object_name(name: &str) -> Result<&str, String> {
+    if name.trim().is_empty() {
+        return Err("an object name cannot be empty".to_owned());
+    }
+    Ok(name)
+}
+
+/// [`load_mesh`], reading object `object` of a file with several: a glTF's
+/// node or mesh of that name ([`super::gltf::MeshPick::Object`]), an OBJ's
+/// `o` object (its faces and the vertices they use, re-indexed in file
+/// order; see [`super::obj`]). Without a name an OBJ's objects are read
+/// together and a glTF's first mesh alone, and [`MeshFile::object_note`]
+/// says so where the file has several. OFF and `.npy` files have no named
+/// objects, so a name is an error there.
+pub fn load_mesh_object(path: &Path, object: Option<&str>) -> Result<MeshFile, LoadError> {
     let format = format_of(path)?;
+    let unnamed = |format: &'static str| match object {
+        Some(name) => Err(LoadError::Object {
+            path: path.to_owned(),
+            source: super::ObjectError::Unnamed {
+                name: name.to_owned(),
+                format,
+            },
+        }),
+        None => Ok(()),
+    };
     match format {
-        MeshFormat::Npy => return read_points_npy(path, MAX_VERTICES),
-        MeshFormat::Gltf => return super::gltf::load_gltf(path, &super::gltf::MeshPick::First),
-        MeshFormat::Obj | MeshFormat::Off => {}
+        MeshFormat::Npy => {
+            unnamed(".npy")?;
+            return read_points_npy(path, MAX_VERTICES);
+        }
+        MeshFormat::Gltf => {
+            let pick = match object {
+                Some(name) => super::gltf::MeshPick::Object(name.to_owned()),
+                None => super::gltf::MeshPick::First,
+            };
+            return super::gltf::load_gltf(path, &pick);
+        }
+        MeshFormat::Off => unnamed("OFF")?,
+        MeshFormat::Obj => {}
     }
     let io_error = |source| LoadError::Io {
         path: path.to_owned(),
@@ -179,7 +219,11 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
             })
         }
     };
-    parse_mesh(path, text)
+    let file = parse_mesh(path, text)?;
+    match format {
+        MeshFormat::Obj => obj::pick_object(path, file, object),
+        _ => Ok(file),
+    }
 }
 
 /// Parse the text of an OBJ, OFF or `.gltf` file named `path` (the format chosen
@@ -213,6 +257,18 @@ pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
 /// Read a cage file and validate it (see [`Cage::new`]).
 pub fn load_cage(path: &Path) -> Result<(Cage, CageReport), CageLoadError> {
     cage_from_file(path, load_mesh(path)?)
+}
+
+/// [`load_cage`] of object `object` ([`load_mesh_object`]), and the note of
+/// which object was read where none was asked for and the file has several.
+pub fn load_cage_object(
+    path: &Path,
+    object: Option<&str>,
+) -> Result<(Cage, CageReport, Option<String>), CageLoadError> {
+    let mut file = load_mesh_object(path, object)?;
+    let note = file.object_note.take();
+    let (cage, report) = cage_from_file(path, file)?;
+    Ok((cage, report, note))
 }
 
 /// Validate a mesh read from `path` as a cage; errors name the file.

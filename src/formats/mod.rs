@@ -20,10 +20,11 @@ mod output;
 mod ply;
 
 pub use crate::budget::human_bytes;
-pub use error::{shown_path, CageLoadError, LoadError, WriteError};
+pub use error::{object_list, shown_path, CageLoadError, LoadError, ObjectError, WriteError};
 pub use io::{
-    cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, write_obj_to, write_polygons_obj_to,
+    cage_from_file, check_object_name, load_cage, load_cage_object, load_mesh, load_mesh_object,
+    parse_mesh, write_cage_and_pose, write_deformed_mesh, write_mesh_with_normals, write_obj,
+    write_obj_to, write_polygons_obj_to,
 };
 pub use mtllib::MovedLibrary;
 pub use npy::points::write_points_npy;
@@ -62,6 +63,9 @@ pub struct MeshFile {
     /// already applied to `mesh.positions`: a glTF export puts it back on its
     /// node. `None` for other formats and for the identity.
     pub node_transform: Option<glam::DMat4>,
+    /// Where the file has several objects and none was asked for, which was
+    /// read ("the file has 3 objects: …; …"), for the caller to say.
+    pub object_note: Option<String>,
 }
 
 /// What `path` is when it is not a regular file ("a named pipe", "a device",

@@ -139,5 +139,6 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
         mesh,
         obj_text: None,
         node_transform: None,
+        object_note: None,
     })
 }

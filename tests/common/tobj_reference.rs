@@ -225,6 +225,7 @@ pub fn parse_obj_with_tobj(path: &Path, text: String) -> Result<MeshFile, LoadEr
         mesh,
         obj_text: Some(text),
         node_transform: None,
+        object_note: None,
     })
 }
 

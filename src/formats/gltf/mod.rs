@@ -83,6 +83,7 @@ mod frame;
 mod hierarchy;
 mod json_size;
 mod layout;
+mod objects;
 mod read;
 mod write;
 
@@ -160,6 +161,10 @@ pub enum MeshPick {
     Index(usize),
     /// The first mesh of this name.
     Name(String),
+    /// The object of this name ([`objects`]): the node's transform is the
+    /// one that moves it; an error lists the names where none or several
+    /// have it.
+    Object(String),
 }
 
 /// Whether `path` names a glTF file: `.glb` or `.gltf`, in any case.
