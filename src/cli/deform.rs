@@ -8,7 +8,7 @@ use super::commands::{
 };
 use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
 use super::{CageInput, DeformArgs};
-use crate::coords::{BindOptions, Method};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method};
 use crate::formats::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
 use crate::formats::metadata::{metadata_path, read_metadata, WeightsMetadata};
 use crate::formats::{shown_path, LoadError, ObjectError};
@@ -136,9 +136,14 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     if let Some((json, metadata)) = stored.as_ref().and_then(|s| s.metadata.as_ref()) {
         metadata.check_inputs(json, &input.mesh.mesh.positions, &input.cage)?;
     }
+    // Stored weights are float64 where their metadata says so.
+    let dtype = stored
+        .as_ref()
+        .and_then(|stored| stored.metadata.as_ref())
+        .map_or(Dtype::Float32, |(_, metadata)| metadata.dtype());
     let weights = match &args.weights {
-        Some(path) => read_weights_for(path, &input, method)?,
-        None => compute_weights(&input, &args.method)?,
+        Some(path) => read_weights_for(path, &input, method, dtype)?,
+        None => AnyWeights::F32(compute_weights(&input, &args.method)?),
     };
     // Displacement form, p + Σλ(c̃ − c): the same as Σλc̃ for weights that
     // reproduce their points at rest (every family pmvc binds), and better in f32:

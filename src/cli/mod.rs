@@ -189,6 +189,18 @@ pub struct BindArgs {
     /// the whole cage at once and hold every row.
     #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
     pub block_rows: Option<u64>,
+    /// How the weights are stored: f32 (little-endian float32, the default) or
+    /// f64 (float64, every row as computed, without its rounding to float32, for
+    /// studies that check weights past 7 digits; W.json's "dtype" says which).
+    /// f64 binds on the CPU, whole (not in blocks), and not harmonic coordinates,
+    /// which are solved in float32 on their grid.
+    #[arg(long, default_value = "f32", value_name = "f32|f64", value_parser = parse_dtype)]
+    pub dtype: crate::coords::Dtype,
+}
+
+/// `--dtype`, read by the one parser of a dtype ([`crate::coords::Dtype::parse`]).
+fn parse_dtype(text: &str) -> Result<crate::coords::Dtype, String> {
+    crate::coords::Dtype::parse(text).map_err(|error| error.to_string())
 }
 
 #[derive(Debug, clap::Args)]
@@ -200,7 +212,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32 (float64 where W.json says "dtype": "float64"), one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format. A name ending in .glb gets binary glTF 2.0, and .gltf glTF's JSON with its buffer inside: positions, recomputed normals, texture coordinates (v flipped, as glTF has it) and the OBJ's groups as primitives.

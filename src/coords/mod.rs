@@ -20,6 +20,7 @@
 //! their extra triangle columns, so their rows ignore the point's class.
 
 pub mod cubemap;
+pub mod dtype;
 pub mod exact_pmvc;
 pub mod family;
 pub mod green;
@@ -32,6 +33,7 @@ pub mod split_effect;
 
 pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass, PointClasses};
+pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
     FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
     DEFAULT_RESOLUTION,
@@ -246,23 +248,50 @@ impl Weights {
             "one displacement per weights column"
         );
         assert_eq!(rest.len(), self.rows, "one rest position per weights row");
-        self.values
-            .par_chunks(self.cols.max(1))
-            .take(self.rows)
-            .zip(rest.par_iter())
-            .map(|(row, &p)| {
-                p + row
-                    .iter()
-                    .zip(moves)
-                    .map(|(&w, &d)| f64::from(w) * d)
-                    .sum::<DVec3>()
-            })
-            .collect()
+        dtype::displaced(&self.values, rest, moves)
     }
 
     /// Smallest weight in the matrix; infinity for an empty one.
     pub fn min(&self) -> f32 {
         self.values.iter().copied().fold(f32::INFINITY, f32::min)
+    }
+}
+
+/// Weights of either dtype: what a bind gives and a weights file holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyWeights {
+    F32(Weights),
+    F64(WeightsF64),
+}
+
+impl AnyWeights {
+    pub fn rows(&self) -> usize {
+        match self {
+            AnyWeights::F32(weights) => weights.rows,
+            AnyWeights::F64(weights) => weights.rows,
+        }
+    }
+
+    pub fn cols(&self) -> usize {
+        match self {
+            AnyWeights::F32(weights) => weights.cols,
+            AnyWeights::F64(weights) => weights.cols,
+        }
+    }
+
+    pub fn dtype(&self) -> Dtype {
+        match self {
+            AnyWeights::F32(_) => Dtype::Float32,
+            AnyWeights::F64(_) => Dtype::Float64,
+        }
+    }
+
+    /// [`Weights::apply_displacements`], whatever the dtype.
+    pub fn apply_displacements(&self, rest: &[DVec3], moves: &[DVec3]) -> Vec<DVec3> {
+        match self {
+            AnyWeights::F32(weights) => weights.apply_displacements(rest, moves),
+            AnyWeights::F64(weights) => weights.apply_displacements(rest, moves),
+        }
     }
 }
 
@@ -391,16 +420,61 @@ pub fn bind_cpu(
     Ok(weights)
 }
 
+/// [`bind_cpu`] into float64 weights: every row as computed, without the
+/// rounding to float32. Harmonic coordinates, solved in float32 on their grid,
+/// come widened (front ends refuse `Dtype::Float64` for them:
+/// [`Dtype::check_family`]).
+pub fn bind_cpu_f64(
+    points: &[DVec3],
+    classes: &[PointClass],
+    cage: &Cage,
+    options: BindOptions,
+    progress: &BindProgress,
+) -> Result<WeightsF64, BindFailure> {
+    options.validate()?;
+    let columns = options.method.columns(&options.cage_to_bind(cage));
+    crate::budget::check_memory(
+        || {
+            format!(
+                "the weights ({} rows × {columns} columns × 8 bytes)",
+                points.len()
+            )
+        },
+        crate::budget::bytes_for(points.len() as u64, 8 * columns as u64),
+    )?;
+    if options.method == Method::Harmonic {
+        let weights = bind_cpu(points, classes, cage, options, progress)?;
+        return Ok(WeightsF64 {
+            rows: weights.rows,
+            cols: weights.cols,
+            values: weights.values.iter().map(|&w| f64::from(w)).collect(),
+        });
+    }
+    let mut weights = WeightsF64::zeros(points.len(), columns);
+    let rows: Vec<usize> = (0..points.len()).collect();
+    bind_rows(
+        points,
+        classes,
+        cage,
+        options,
+        &rows,
+        &mut weights.values,
+        progress,
+    )?;
+    Ok(weights)
+}
+
 /// The one row loop of every CPU bind: fill `out` (`rows.len()` × the method's
-/// columns, row-major) with the weights of `points[rows[k]]`, in parallel, advancing
-/// `progress` and stopping early when it is cancelled.
-pub fn bind_rows(
+/// columns, row-major, float32 or float64) with the weights of `points[rows[k]]`,
+/// computed in f64, in parallel, advancing `progress` and stopping early when it
+/// is cancelled.
+pub fn bind_rows<T: WeightValue>(
     points: &[DVec3],
     classes: &[PointClass],
     cage: &Cage,
     options: BindOptions,
     rows: &[usize],
-    out: &mut [f32],
+    out: &mut [T],
     progress: &BindProgress,
 ) -> Result<(), Cancelled> {
     assert_eq!(points.len(), classes.len(), "one class per point");
@@ -446,7 +520,7 @@ pub fn bind_rows(
                         );
                     }
                     for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
-                        *out = value as f32;
+                        *out = T::from_f64(value);
                     }
                 }
                 progress.advance(block_rows.len());

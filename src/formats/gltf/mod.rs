@@ -88,6 +88,8 @@ mod read;
 mod write;
 
 #[cfg(test)]
+mod fuzz_mutations;
+#[cfg(test)]
 mod fuzz_tests;
 #[cfg(test)]
 mod json_size_tests;

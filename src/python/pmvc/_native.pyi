@@ -85,8 +85,10 @@ class Weights:
     loaded)."""
 
     @property
-    def matrix(self) -> npt.NDArray[np.float32]:
-        """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes."""
+    def matrix(self) -> Union[npt.NDArray[np.float32], npt.NDArray[np.float64]]:
+        """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes;
+        float64 where ``dtype=numpy.float64`` was asked for (as ``pmvc bind
+        --dtype f64``; ``metadata["dtype"]`` says which)."""
         ...
     @property
     def classes(self) -> npt.NDArray[np.int8]:
@@ -156,6 +158,7 @@ def bind(
     triangulate: Optional[str] = None,
     pmvc_kernel: str = "auto",
     strict: bool = False,
+    dtype: npt.DTypeLike = "float32",
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
@@ -167,7 +170,9 @@ def bind(
     predicted faster for this bind), "cpu" or "gpu". ``pmvc_kernel``: PMVC's GPU
     kernel, "auto", "tiles" or "bands" (as ``pmvc bind --pmvc-kernel``; "bands"
     reproduces GPU weights bound before the tile kernel). ``strict=True``
-    raises InputError before binding when points lie outside the cage. ``cage``
+    raises InputError before binding when points lie outside the cage.
+    ``dtype=numpy.float64`` keeps every row as computed, without rounding it to
+    float32 (bound on the CPU; not for harmonic coordinates). ``cage``
     is a Cage or a ``(V, F)`` pair. The GIL is released; Ctrl-C cancels within
     about a second."""
     ...
@@ -183,7 +188,7 @@ def deform(
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
     bound first with ``parameters`` (resolution, grid, backend, progress,
-    triangulate, pmvc_kernel, strict); with ``weights``, ``strict=True``
+    triangulate, pmvc_kernel, strict, dtype); with ``weights``, ``strict=True``
     refuses weights with rows outside the cage."""
     ...
 
