@@ -350,10 +350,7 @@ fn mesh_source(
     inputs.extend(document.cage_path());
     refuse_same_file(&sidecar, &inputs)?;
     match document.mesh_file() {
-        // Its material libraries are named from the session's folder.
-        Some(file) => {
-            write_deformed_mesh(file, positions, &sidecar)?;
-        }
+        Some(file) => write_deformed_mesh(file, positions, &sidecar).map(drop)?,
         None => write_obj(&sidecar, document.mesh())?,
     }
     Ok(MeshSource::File(relative_to(&sidecar, folder)))
