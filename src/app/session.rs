@@ -350,7 +350,7 @@ fn mesh_source(
     inputs.extend(document.cage_path());
     refuse_same_file(&sidecar, &inputs)?;
     match document.mesh_file() {
-        Some(file) => write_deformed_mesh(file, positions, &sidecar)?,
+        Some(file) => write_deformed_mesh(file, positions, &sidecar).map(drop)?,
         None => write_obj(&sidecar, document.mesh())?,
     }
     Ok(MeshSource::File(relative_to(&sidecar, folder)))

@@ -40,7 +40,8 @@ pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use parse::{
-    parse_grid, parse_percent, parse_resolution, parse_seconds, parse_view, TriangulateArg,
+    parse_grid, parse_object_name, parse_percent, parse_resolution, parse_seconds, parse_view,
+    TriangulateArg,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -100,7 +101,8 @@ pub enum BackendArg {
 
 #[derive(Debug, clap::Args)]
 pub struct CageInput {
-    /// The mesh to deform (.obj, .off, or the first mesh of a .glb or .gltf). A file
+    /// The mesh to deform (.obj, .off, or the first mesh of a .glb or .gltf, unless
+    /// --mesh-object names another). A file
     /// with vertices and no faces is a point set, and so is a .npy array of shape
     /// (n, 3), float32 or float64, in C order.
     #[arg(long, value_name = "MESH")]
@@ -109,6 +111,14 @@ pub struct CageInput {
     /// or a .glb or .gltf, whose vertices at one position are welded).
     #[arg(long, value_name = "CAGE")]
     pub cage: PathBuf,
+    /// Read the mesh from this object of a file with several (an OBJ's `o` name,
+    /// a glTF node's or mesh's name). Without it an OBJ's objects are read as one
+    /// mesh and a glTF's first mesh alone, and a note names the others.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name)]
+    pub mesh_object: Option<String>,
+    /// Read the cage from this object of a file with several, as --mesh-object.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name)]
+    pub cage_object: Option<String>,
 }
 
 #[derive(Debug, clap::Args)]

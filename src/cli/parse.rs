@@ -28,6 +28,11 @@ pub(super) fn parse_percent(text: &str) -> Result<f32, String> {
     crate::app::compare::check_difference_limit(percent / 100.0).map(|_| percent)
 }
 
+/// `--mesh-object`, `--cage-object`: checked as Python's `object=` is.
+pub(super) fn parse_object_name(text: &str) -> Result<String, String> {
+    crate::formats::check_object_name(text).map(str::to_owned)
+}
+
 /// `--animate`: a duration in seconds, finite and above 0.
 pub(super) fn parse_seconds(text: &str) -> Result<f32, String> {
     match text.trim().parse::<f32>() {

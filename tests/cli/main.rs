@@ -22,3 +22,4 @@ mod gltf;
 #[cfg(unix)]
 mod outputs;
 mod pipeline_cache;
+mod round_trip;

@@ -260,6 +260,8 @@ fn picked_mesh<'a>(json: &'a Value, pick: &MeshPick) -> Option<&'a Value> {
         MeshPick::Name(name) => meshes
             .iter()
             .find(|m| m.get("name").and_then(Value::as_str) == Some(name)),
+        // Not generated here.
+        MeshPick::Object(_) => None,
     }
 }
 

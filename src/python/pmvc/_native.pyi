@@ -33,8 +33,9 @@ class Cage:
 
     def __init__(self, vertices: ArrayLike, faces: Faces) -> None: ...
     @staticmethod
-    def load(path: Path) -> "Cage":
-        """Read and validate an OBJ or OFF file. Raises FileError (naming the
+    def load(path: Path, object: Optional[str] = None) -> "Cage":
+        """Read and validate an OBJ, OFF or glTF file (object ``object`` of a
+        file with several, as :func:`load_mesh`). Raises FileError (naming the
         file and line) or CageError."""
         ...
     @property
@@ -136,11 +137,14 @@ class Weights:
 
 def load_mesh(
     path: Path,
+    object: Optional[str] = None,
 ) -> Tuple[npt.NDArray[np.float64], Union[npt.NDArray[np.int64], List[List[int]]]]:
     """Read an OBJ, OFF or glTF file, or a .npy point set: ``(vertices,
     faces)``, vertices float64 (n, 3) in file order; faces an int64 array (m, 3)
     of 0-based indices when every face is a triangle ((0, 3) for a point set),
-    else a list of polygons (lists of indices)."""
+    else a list of polygons (lists of indices). ``object`` names one object of
+    a file with several (an OBJ's ``o`` name, a glTF node's or mesh's name);
+    without it a PmvcWarning names them where there are several."""
     ...
 
 def bind(
