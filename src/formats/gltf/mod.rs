@@ -96,6 +96,8 @@ mod json_size_tests;
 #[cfg(test)]
 mod node_tests;
 #[cfg(test)]
+mod refusal_tests;
+#[cfg(test)]
 mod tests;
 
 pub use read::{load_gltf, parse_gltf};
