@@ -55,7 +55,24 @@ where
         .into_iter()
         .map(|(id, value)| {
             let number = match value {
-                Written::Number(number) => number,
+                // A named value's code written as a number (resolution 0) is
+                // refused as a user's number is: the file says "exact".
+                Written::Number(number) => match parameter_of(&id) {
+                    Some(parameter) => {
+                        let spec = parameter.spec();
+                        let named = u32::try_from(number)
+                            .ok()
+                            .and_then(|value| spec.name_of(value))
+                            .is_some();
+                        if named {
+                            if let Err(error) = spec.validate_number(number) {
+                                return Err(serde::de::Error::custom(error.to_string()));
+                            }
+                        }
+                        number
+                    }
+                    None => number,
+                },
                 Written::Name(name) => {
                     let parameter = parameter_of(&id).ok_or_else(|| {
                         serde::de::Error::custom(format!("\"{id}\" is not a parameter"))
@@ -110,6 +127,17 @@ mod tests {
         assert_eq!(numbers.parameters["resolution"], 32);
         // A grid has no names: a string is not one of its values.
         assert!(serde_json::from_str::<File>(r#"{"parameters":{"grid":"64"}}"#).is_err());
+    }
+
+    #[test]
+    fn exact_s_code_as_a_number_is_refused() {
+        let error = serde_json::from_str::<File>(r#"{"parameters":{"resolution":0}}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("resolution 0") && error.contains("\"exact\""),
+            "{error}"
+        );
     }
 
     #[test]
