@@ -1,7 +1,7 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
-//! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), and the dense
-//! weights matrix they fill. Nothing here touches the GPU or the UI.
+//! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
+//! coordinates ([`mec`]), and the dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
@@ -24,6 +24,7 @@ pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;
+pub mod mec;
 pub mod mvc;
 pub mod pmvc;
 pub mod qmvc;
@@ -419,14 +420,8 @@ pub fn bind_rows(
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
-            || {
-                (
-                    vec![0.0f64; cols],
-                    mvc::MvcScratch::default(),
-                    pmvc::PmvcScratch::default(),
-                )
-            },
-            |(row_f64, mvc_scratch, pmvc_scratch), (block, block_rows)| {
+            || (vec![0.0f64; cols], RowScratch::default()),
+            |(row_f64, scratch), (block, block_rows)| {
                 if progress.is_cancelled() {
                     return Err(Cancelled);
                 }
@@ -441,8 +436,7 @@ pub fn bind_rows(
                             options.method,
                             &table,
                             row_f64,
-                            mvc_scratch,
-                            pmvc_scratch,
+                            scratch,
                         );
                     }
                     for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
@@ -464,9 +458,16 @@ fn green_row(green_cage: &green::GreenCage, x: DVec3, out: &mut [f64]) {
     }
 }
 
+/// Per-thread buffers of the families computed row by row, reused across rows.
+#[derive(Debug, Default)]
+pub struct RowScratch {
+    pub mvc: mvc::MvcScratch,
+    pub pmvc: pmvc::PmvcScratch,
+    pub mec: mec::MecScratch,
+}
+
 /// Coordinates of one point, following the policy of the module doc. `out` holds
 /// the method's columns ([`Method::columns`]).
-#[allow(clippy::too_many_arguments)]
 pub fn weights_at(
     x: DVec3,
     class: PointClass,
@@ -474,9 +475,13 @@ pub fn weights_at(
     method: Method,
     table: &cubemap::TexelTable,
     out: &mut [f64],
-    mvc_scratch: &mut mvc::MvcScratch,
-    pmvc_scratch: &mut pmvc::PmvcScratch,
+    scratch: &mut RowScratch,
 ) {
+    let RowScratch {
+        mvc: mvc_scratch,
+        pmvc: pmvc_scratch,
+        mec: mec_scratch,
+    } = scratch;
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
         // in `bind_rows`.
@@ -520,6 +525,13 @@ pub fn weights_at(
                 if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the
                     // surface or in a cage defect). Follow the outside policy.
+                    mvc::mvc_weights(x, cage, out, mvc_scratch);
+                }
+            }
+            Method::Mec => {
+                if mec::mec_weights_inside(x, cage, out, mec_scratch).is_err() {
+                    // Only a point not strictly inside the hull has no solution
+                    // (numerically on the surface): the outside policy, as PMVC.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);
                 }
             }
