@@ -19,9 +19,10 @@
 //!
 //! Units: `ρ_f` is an area, and the prior of a vertex has as many factors as the
 //! faces it misses, which differs between vertices. The prior is taken with
-//! areas in squared cage diagonals, which makes the coordinates invariant under
-//! scaling the scene (the definition as written is not), and equals it for a
-//! cage of unit diagonal.
+//! areas in units of the cage's area (the sum of its faces'), which makes the
+//! coordinates invariant under rotating and scaling the scene (the definition
+//! as written depends on the unit of length), and equals it for a cage of unit
+//! area.
 
 mod prior;
 
@@ -40,6 +41,11 @@ const MAX_ITERATIONS: u32 = 200;
 const MAX_HALVINGS: u32 = 60;
 /// Armijo's sufficient-decrease constant.
 const ARMIJO: f64 = 1e-4;
+/// The longest step in `λ` (inverse cage diagonals): it changes a weight's
+/// exponent by at most this much. Where the prior puts nearly all weight on one
+/// or two vertices, the Hessian is nearly singular and the full Newton step
+/// would be far beyond what halving can bring back.
+const MAX_STEP: f64 = 20.0;
 
 /// Why a point has no maximum entropy coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -69,6 +75,8 @@ pub struct MecSolve {
 #[derive(Debug, Default)]
 pub struct MecScratch {
     offsets: Vec<DVec3>,
+    /// Per face, its `ρ`.
+    rho: Vec<f64>,
     log_prior: Vec<f64>,
     weights: Vec<f64>,
 }
@@ -94,12 +102,13 @@ pub fn mec_weights_inside(
     }
     let MecScratch {
         offsets,
+        rho,
         log_prior,
         weights,
     } = scratch;
     offsets.clear();
     offsets.extend(cage.positions().iter().map(|&v| (v - x) / diagonal));
-    prior::log_prior(cage, offsets, log_prior);
+    prior::log_prior(cage, offsets, rho, log_prior);
     weights.resize(offsets.len(), 0.0);
     let solve = newton(offsets, log_prior, weights)?;
     for (out, &w) in out.iter_mut().zip(weights.iter()) {
@@ -128,7 +137,11 @@ fn newton(d: &[DVec3], log_prior: &[f64], w: &mut [f64]) -> Result<MecSolve, Mec
             return stalled(iterations, residual, lambda);
         }
         iterations += 1;
-        let step = newton_step(covariance(d, w, current.mean), gradient);
+        let mut step = newton_step(covariance(d, w, current.mean), gradient);
+        let length = step.length();
+        if length > MAX_STEP {
+            step *= MAX_STEP / length;
+        }
         let slope = gradient.dot(step);
         let mut t = 1.0;
         let mut accepted = None;

@@ -11,17 +11,40 @@
 use crate::geometry::Cage;
 use glam::DVec3;
 
-/// Below this a face's `ρ` (in squared cage diagonals) is taken as this: a point
-/// that close is on the face for every purpose, and the logarithm stays finite.
+/// Below this a face's `ρ` (in units of the cage's area) is taken as this: a
+/// point that close is on the face for every purpose, and the logarithm stays
+/// finite.
 const RHO_FLOOR: f64 = 1e-300;
 
 /// `log` of each vertex's prior at the point the offsets are taken from, up to
 /// a constant shared by all vertices; `−∞` for a vertex no face uses (its weight
-/// is zero). `offsets[i]` is cage vertex `i` less the point, in cage diagonals.
-pub(super) fn log_prior(cage: &Cage, offsets: &[DVec3], out: &mut Vec<f64>) {
+/// is zero). `offsets[i]` is cage vertex `i` less the point.
+///
+/// Areas are measured in units of the cage's area `Σ_f |vector area of f|`:
+/// a vertex's prior has as many factors as faces it misses, which differs
+/// between vertices, so the unit matters; this one moves with the cage, which
+/// makes the coordinates invariant under rotations and scalings.
+pub(super) fn log_prior(cage: &Cage, offsets: &[DVec3], rho: &mut Vec<f64>, out: &mut Vec<f64>) {
+    rho.clear();
+    let mut area = 0.0;
+    let mut measure = |corners: &[DVec3]| {
+        let (excess, face_area) = excess(corners);
+        rho.push(excess);
+        area += face_area;
+    };
+    for t in cage.lone_triangles() {
+        measure(&cage.triangles()[t].map(|i| offsets[i as usize]));
+    }
+    for quad in cage.quads() {
+        measure(&quad.corners.map(|i| offsets[i as usize]));
+    }
+    let log_area = area.ln();
     out.clear();
     out.resize(offsets.len(), f64::NEG_INFINITY);
-    let mut add = |corners: &[u32], log_rho: f64| {
+    let lone = cage.lone_triangles().map(|t| &cage.triangles()[t][..]);
+    let quads = cage.quads().iter().map(|quad| &quad.corners[..]);
+    for (corners, &rho) in lone.chain(quads).zip(rho.iter()) {
+        let log_rho = (rho.ln() - log_area).max(RHO_FLOOR.ln());
         for &corner in corners {
             let value = &mut out[corner as usize];
             if *value == f64::NEG_INFINITY {
@@ -29,26 +52,18 @@ pub(super) fn log_prior(cage: &Cage, offsets: &[DVec3], out: &mut Vec<f64>) {
             }
             *value -= log_rho;
         }
-    };
-    for t in cage.lone_triangles() {
-        let corners = cage.triangles()[t];
-        let rho = excess(&corners.map(|i| offsets[i as usize]));
-        add(&corners, rho.max(RHO_FLOOR).ln());
-    }
-    for quad in cage.quads() {
-        let rho = excess(&quad.corners.map(|i| offsets[i as usize]));
-        add(&quad.corners, rho.max(RHO_FLOOR).ln());
     }
 }
 
 /// `ρ_f` of a face whose corners, relative to the point, are `p` (3 or 4 of
 /// them): the sum of the areas of the triangles from the point to each edge less
-/// the length of their sum (the face's vector area, whatever the point).
+/// the length of their sum (the face's vector area, whatever the point); and
+/// that length.
 ///
 /// `Σ|aₑ| − |Σaₑ|` cancels to nothing near the face, so it is computed as
 /// `2 Σ_{e<e'} (|aₑ||aₑ'| − aₑ·aₑ') / (Σ|aₑ| + |Σaₑ|)`, whose terms are each
 /// non-negative and, where `aₑ·aₑ' > 0`, are taken as `|aₑ×aₑ'|² / (|aₑ||aₑ'| + aₑ·aₑ')`.
-pub(super) fn excess(p: &[DVec3]) -> f64 {
+pub(super) fn excess(p: &[DVec3]) -> (f64, f64) {
     let n = p.len().min(4);
     let mut a = [DVec3::ZERO; 4];
     let mut length = [0.0; 4];
@@ -71,11 +86,12 @@ pub(super) fn excess(p: &[DVec3]) -> f64 {
         }
     }
     let denominator = total + area;
-    if denominator > 0.0 {
+    let rho = if denominator > 0.0 {
         2.0 * pairs / denominator
     } else {
         0.0
-    }
+    };
+    (rho, area)
 }
 
 #[cfg(test)]
@@ -117,7 +133,7 @@ mod tests {
         ] {
             for corners in [&TRIANGLE[..], &quad[..]] {
                 let p = relative_to(x, corners);
-                let (stable, direct) = (excess(&p), direct(&p));
+                let (stable, direct) = (excess(&p).0, direct(&p));
                 assert!(
                     (stable - direct).abs() <= 1e-14 * direct.abs().max(1.0),
                     "{stable} {direct}"
@@ -129,9 +145,9 @@ mod tests {
     #[test]
     fn rho_vanishes_on_a_triangle_and_is_positive_elsewhere_in_its_plane() {
         let inside = DVec3::new(0.4, 0.3, 0.0);
-        assert!(excess(&relative_to(inside, &TRIANGLE)) <= 1e-16);
+        assert!(excess(&relative_to(inside, &TRIANGLE)).0 <= 1e-16);
         let beside = DVec3::new(0.8, 0.8, 0.0);
-        assert!(excess(&relative_to(beside, &TRIANGLE)) > 1e-3);
+        assert!(excess(&relative_to(beside, &TRIANGLE)).0 > 1e-3);
     }
 
     /// Near a face `ρ` shrinks as the squared height (its tetrahedra's slant
@@ -141,7 +157,7 @@ mod tests {
     #[test]
     fn rho_shrinks_as_the_squared_height_without_cancelling() {
         let foot = DVec3::new(0.4, 0.3, 0.0);
-        let at = |h: f64| excess(&relative_to(foot + DVec3::new(0.0, 0.0, h), &TRIANGLE));
+        let at = |h: f64| excess(&relative_to(foot + DVec3::new(0.0, 0.0, h), &TRIANGLE)).0;
         for h in [1e-4, 1e-6, 1e-9] {
             let ratio = at(h) / at(h / 10.0);
             assert!((ratio - 100.0).abs() < 1e-3, "h {h}: ratio {ratio}");
