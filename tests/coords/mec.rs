@@ -394,3 +394,51 @@ fn nearing_a_quad_mec_tends_to_an_interpolation_of_its_corners() {
         }
     }
 }
+
+/// The figures docs/coordinates.md quotes: time and Newton iterations per point,
+/// the weights at the centre of a cube of twelve triangles, and the weights
+/// near a sliver of the comb's cap. `cargo test --release
+/// --no-default-features --test coords mec_figures -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement: prints the figures of the docs"]
+fn mec_figures() {
+    let mut scenes = cages();
+    scenes.push(("sphere of 402 vertices", procedural::uv_sphere(1.0, 21, 20)));
+    for (name, cage) in scenes {
+        let points = procedural::points_inside(&cage, 2000, 21, 1e-3);
+        let mut scratch = mec::MecScratch::default();
+        let mut out = vec![0.0; cage.vertex_count()];
+        let (mut most, mut total) = (0, 0);
+        let start = std::time::Instant::now();
+        for &x in &points {
+            let solve = mec::mec_weights_inside(x, &cage, &mut out, &mut scratch)
+                .unwrap_or_else(|e| panic!("{name} {x}: {e}, distance {}", procedural::distance_to_surface(&cage, x)));
+            most = most.max(solve.iterations);
+            total += solve.iterations;
+        }
+        let micros = start.elapsed().as_secs_f64() * 1e6 / points.len() as f64;
+        println!(
+            "{name} ({} vertices, {} faces): {micros:.1} µs a point on one thread, Newton iterations mean {:.1}, most {most}",
+            cage.vertex_count(),
+            cage.polygons().len(),
+            total as f64 / points.len() as f64
+        );
+    }
+    let cube = procedural::cube_cage(1.0);
+    let w = row(&cube, DVec3::ZERO);
+    let faces = faces(&cube);
+    let degree = |i: usize| faces.iter().filter(|f| f.contains(&(i as u32))).count();
+    for (i, &w) in w.iter().enumerate() {
+        println!("cube of 12 triangles, centre: corner {i} on {} faces, weight {w:.4}", degree(i));
+    }
+    let comb = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
+    let [a, b, c] = comb.triangle(7);
+    let normal = (b - a).cross(c - a).normalize();
+    for h in [1e-2, 1e-5, 1e-8] {
+        let w = row(&comb, (a + 2.0 * b + 3.0 * c) / 6.0 - h * normal);
+        let corners = comb.triangles()[7];
+        let got: Vec<f64> = corners.iter().map(|&i| w[i as usize]).collect();
+        println!("comb cap sliver {a} {b} {c}, h {h}: corner weights {got:.4?} (barycentric 1/6, 1/3, 1/2)");
+    }
+}
+

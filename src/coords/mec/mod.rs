@@ -41,11 +41,13 @@ const MAX_ITERATIONS: u32 = 200;
 const MAX_HALVINGS: u32 = 60;
 /// Armijo's sufficient-decrease constant.
 const ARMIJO: f64 = 1e-4;
-/// The longest step in `λ` (inverse cage diagonals): it changes a weight's
-/// exponent by at most this much. Where the prior puts nearly all weight on one
-/// or two vertices, the Hessian is nearly singular and the full Newton step
-/// would be far beyond what halving can bring back.
-const MAX_STEP: f64 = 20.0;
+/// The first longest step in `λ` (inverse cage diagonals): it changes a
+/// weight's exponent by at most this much. Where the prior puts nearly all
+/// weight on one or two vertices, the Hessian is nearly singular and the full
+/// Newton step would be far beyond what halving can bring back. Each capped
+/// step taken whole quadruples the cap, since a prior that spans hundreds of
+/// orders of magnitude needs a `λ` of thousands.
+const FIRST_MAX_STEP: f64 = 20.0;
 
 /// Why a point has no maximum entropy coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -122,6 +124,7 @@ fn newton(d: &[DVec3], log_prior: &[f64], w: &mut [f64]) -> Result<MecSolve, Mec
     let mut lambda = DVec3::ZERO;
     let mut current = evaluate(lambda, d, log_prior, w);
     let mut iterations = 0;
+    let mut max_step = FIRST_MAX_STEP;
     loop {
         let residual = current.mean.length();
         if residual <= TOLERANCE {
@@ -139,8 +142,9 @@ fn newton(d: &[DVec3], log_prior: &[f64], w: &mut [f64]) -> Result<MecSolve, Mec
         iterations += 1;
         let mut step = newton_step(covariance(d, w, current.mean), gradient);
         let length = step.length();
-        if length > MAX_STEP {
-            step *= MAX_STEP / length;
+        let capped = length > max_step;
+        if capped {
+            step *= max_step / length;
         }
         let slope = gradient.dot(step);
         let mut t = 1.0;
@@ -160,7 +164,12 @@ fn newton(d: &[DVec3], log_prior: &[f64], w: &mut [f64]) -> Result<MecSolve, Mec
             t *= 0.5;
         }
         match accepted {
-            Some((trial, next)) => (lambda, current) = (trial, next),
+            Some((trial, next)) => {
+                if capped && t == 1.0 {
+                    max_step *= 4.0;
+                }
+                (lambda, current) = (trial, next);
+            }
             None => {
                 // Leave the weights of the last accepted λ in `w`.
                 evaluate(lambda, d, log_prior, w);
