@@ -97,7 +97,10 @@ fn families_without_a_kernel_always_bind_on_the_cpu() {
             "{}",
             prediction.explain()
         );
-        assert_eq!(scene.no_kernel_reason(), Some("this family has no GPU kernel"));
+        assert_eq!(
+            scene.no_kernel_reason(),
+            Some("this family has no GPU kernel")
+        );
         assert!(!decide(BackendRequest::Auto, None, &scene).on_gpu(method));
     }
 }

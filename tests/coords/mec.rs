@@ -50,7 +50,10 @@ fn faces(cage: &Cage) -> Vec<Vec<u32>> {
 
 /// A face's corners less `x`, and the halves of their edges' cross products.
 fn edge_areas(cage: &Cage, face: &[u32], x: DVec3) -> Vec<DVec3> {
-    let p: Vec<DVec3> = face.iter().map(|&i| cage.positions()[i as usize] - x).collect();
+    let p: Vec<DVec3> = face
+        .iter()
+        .map(|&i| cage.positions()[i as usize] - x)
+        .collect();
     let n = p.len();
     (0..n).map(|e| 0.5 * p[e].cross(p[(e + 1) % n])).collect()
 }
@@ -59,7 +62,12 @@ fn edge_areas(cage: &Cage, face: &[u32], x: DVec3) -> Vec<DVec3> {
 fn cage_area(cage: &Cage) -> f64 {
     faces(cage)
         .iter()
-        .map(|face| edge_areas(cage, face, DVec3::ZERO).iter().sum::<DVec3>().length())
+        .map(|face| {
+            edge_areas(cage, face, DVec3::ZERO)
+                .iter()
+                .sum::<DVec3>()
+                .length()
+        })
         .sum()
 }
 
@@ -138,7 +146,10 @@ fn reference_mec(cage: &Cage, x: DVec3) -> Vec<f64> {
         }
         (mu, f, g, w) = (next_mu, next_f, next_g, next_w);
     }
-    panic!("reference BFGS did not converge at {x}: gradient {}", g.length());
+    panic!(
+        "reference BFGS did not converge at {x}: gradient {}",
+        g.length()
+    );
 }
 
 fn outer(a: DVec3, b: DVec3) -> DMat3 {
@@ -146,7 +157,10 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
 }
 
 fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -177,7 +191,10 @@ fn mec_agrees_with_an_independent_quasi_newton_solver() {
             worst = worst.max(worst_difference(&row(&cage, x), &reference_mec(&cage, x)));
         }
         println!("{name}: max |MEC − BFGS reference| {worst:e}");
-        assert!(worst <= 1e-8, "{name}: MEC differs from the reference by {worst}");
+        assert!(
+            worst <= 1e-8,
+            "{name}: MEC differs from the reference by {worst}"
+        );
     }
 }
 
@@ -197,19 +214,30 @@ fn mec_is_positive_sums_to_one_and_reproduces_the_point() {
             position_error = position_error.max(moved.length() / cage.diagonal());
             min = min.min(w.iter().copied().fold(f64::INFINITY, f64::min));
         }
-        println!("{name}: |Σw − 1| {sum_error:e}, linear precision {position_error:e}, min {min:e}");
-        assert!(sum_error <= 1e-12, "{name}: partition of unity off by {sum_error}");
-        assert!(position_error <= 1e-10, "{name}: linear precision {position_error}");
+        println!(
+            "{name}: |Σw − 1| {sum_error:e}, linear precision {position_error:e}, min {min:e}"
+        );
+        assert!(
+            sum_error <= 1e-12,
+            "{name}: partition of unity off by {sum_error}"
+        );
+        assert!(
+            position_error <= 1e-10,
+            "{name}: linear precision {position_error}"
+        );
         assert!(min > 0.0, "{name}: weight {min}");
     }
 }
 
-/// The same answers after a rotation, a scaling (lengths enter the prior in
-/// cage diagonals) and a translation to 1e7 from the origin.
+/// A map of the scene, its name, and how far the weights may move under it.
+type SceneMap = (&'static str, Box<dyn Fn(DVec3) -> DVec3>, f64);
+
+/// The same answers after a rotation, a scaling (areas enter the prior in
+/// units of the cage's area) and a translation to 1e7 from the origin.
 #[test]
 fn mec_is_invariant_under_rotation_scaling_and_a_far_translation() {
     let turn = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 0.9);
-    let maps: [(&str, Box<dyn Fn(DVec3) -> DVec3>, f64); 3] = [
+    let maps: [SceneMap; 3] = [
         ("rotated", Box::new(move |p| turn * p), 1e-9),
         ("scaled by 1000", Box::new(|p| 1000.0 * p), 1e-9),
         // Positions at 1e7 are rounded to 2e-9: the geometry itself moves that much.
@@ -225,12 +253,21 @@ fn mec_is_invariant_under_rotation_scaling_and_a_far_translation() {
                 let (w, y) = (row(&cage, x), map(x));
                 let v = row(&moved, y);
                 worst = worst.max(worst_difference(&w, &v));
-                let offset: DVec3 = v.iter().zip(moved.positions()).map(|(w, &p)| *w * (p - y)).sum();
+                let offset: DVec3 = v
+                    .iter()
+                    .zip(moved.positions())
+                    .map(|(w, &p)| *w * (p - y))
+                    .sum();
                 precision = precision.max(offset.length() / moved.diagonal());
             }
-            println!("{name} {map_name}: weights differ by {worst:e}, linear precision {precision:e}");
+            println!(
+                "{name} {map_name}: weights differ by {worst:e}, linear precision {precision:e}"
+            );
             assert!(worst <= *tolerance, "{name} {map_name}: {worst}");
-            assert!(precision <= 1e-10, "{name} {map_name}: linear precision {precision}");
+            assert!(
+                precision <= 1e-10,
+                "{name} {map_name}: linear precision {precision}"
+            );
         }
     }
 }
@@ -239,7 +276,8 @@ fn mec_is_invariant_under_rotation_scaling_and_a_far_translation() {
 /// diagonal is chosen from its positions).
 fn cage_mapped(cage: &Cage, map: &dyn Fn(DVec3) -> DVec3) -> Cage {
     let positions: Vec<DVec3> = cage.positions().iter().map(|&p| map(p)).collect();
-    let (mapped, _) = cage_from_polygons(&positions, &cage.polygons()).expect("a moved cage is valid");
+    let (mapped, _) =
+        cage_from_polygons(&positions, &cage.polygons()).expect("a moved cage is valid");
     assert_eq!(mapped.quads().len(), cage.quads().len());
     mapped
 }
@@ -251,7 +289,11 @@ fn mec_interpolates_on_the_cage() {
     for (name, cage) in cages() {
         let mut points: Vec<DVec3> = cage.positions().to_vec();
         let mut expected: Vec<Vec<f64>> = (0..cage.vertex_count())
-            .map(|i| (0..cage.vertex_count()).map(|j| f64::from(u8::from(i == j))).collect())
+            .map(|i| {
+                (0..cage.vertex_count())
+                    .map(|j| f64::from(u8::from(i == j)))
+                    .collect()
+            })
             .collect();
         for t in (0..cage.triangle_count()).step_by(3) {
             let [a, b, c] = cage.triangle(t);
@@ -343,8 +385,6 @@ fn outside_the_cage_mec_rows_are_mvc_rows() {
     assert_eq!(bind(Method::Mec), bind(Method::Mvc));
 }
 
-
-
 /// Nearing a quad, the weight off its corners goes to zero with the distance
 /// when the quad is planar; among its corners the limit is the bilinear basis
 /// only where their priors agree (a box of squares). Elsewhere it is another
@@ -411,8 +451,13 @@ fn mec_figures() {
         let (mut most, mut total) = (0, 0);
         let start = std::time::Instant::now();
         for &x in &points {
-            let solve = mec::mec_weights_inside(x, &cage, &mut out, &mut scratch)
-                .unwrap_or_else(|e| panic!("{name} {x}: {e}, distance {}", procedural::distance_to_surface(&cage, x)));
+            let solve =
+                mec::mec_weights_inside(x, &cage, &mut out, &mut scratch).unwrap_or_else(|e| {
+                    panic!(
+                        "{name} {x}: {e}, distance {}",
+                        procedural::distance_to_surface(&cage, x)
+                    )
+                });
             most = most.max(solve.iterations);
             total += solve.iterations;
         }
@@ -429,7 +474,10 @@ fn mec_figures() {
     let faces = faces(&cube);
     let degree = |i: usize| faces.iter().filter(|f| f.contains(&(i as u32))).count();
     for (i, &w) in w.iter().enumerate() {
-        println!("cube of 12 triangles, centre: corner {i} on {} faces, weight {w:.4}", degree(i));
+        println!(
+            "cube of 12 triangles, centre: corner {i} on {} faces, weight {w:.4}",
+            degree(i)
+        );
     }
     let comb = procedural::extrude(&procedural::comb_outline(4, 1.0, 0.25, 3.0), -0.5, 0.5);
     let [a, b, c] = comb.triangle(7);
@@ -441,4 +489,3 @@ fn mec_figures() {
         println!("comb cap sliver {a} {b} {c}, h {h}: corner weights {got:.4?} (barycentric 1/6, 1/3, 1/2)");
     }
 }
-

@@ -245,7 +245,11 @@ fn newton_step(h: DMat3, gradient: DVec3) -> DVec3 {
         {
             return step;
         }
-        shift = if shift == 0.0 { 1e-14 * scale } else { shift * 10.0 };
+        shift = if shift == 0.0 {
+            1e-14 * scale
+        } else {
+            shift * 10.0
+        };
     }
     -gradient / scale
 }
@@ -254,23 +258,14 @@ fn newton_step(h: DMat3, gradient: DVec3) -> DVec3 {
 /// positive.
 fn cholesky_solve(a: DMat3, b: DVec3) -> Option<DVec3> {
     let at = |r: usize, c: usize| a.col(c)[r];
-    let l00 = at(0, 0).sqrt();
-    if !(l00 > 0.0) {
-        return None;
-    }
+    // A pivot that is not positive (NaN included) ends the factorisation.
+    let root = |pivot: f64| (pivot > 0.0).then(|| pivot.sqrt());
+    let l00 = root(at(0, 0))?;
     let l10 = at(1, 0) / l00;
     let l20 = at(2, 0) / l00;
-    let d1 = at(1, 1) - l10 * l10;
-    if !(d1 > 0.0) {
-        return None;
-    }
-    let l11 = d1.sqrt();
+    let l11 = root(at(1, 1) - l10 * l10)?;
     let l21 = (at(2, 1) - l20 * l10) / l11;
-    let d2 = at(2, 2) - l20 * l20 - l21 * l21;
-    if !(d2 > 0.0) {
-        return None;
-    }
-    let l22 = d2.sqrt();
+    let l22 = root(at(2, 2) - l20 * l20 - l21 * l21)?;
     // L y = b, then Lᵀ x = y.
     let y0 = b.x / l00;
     let y1 = (b.y - l10 * y0) / l11;
