@@ -122,3 +122,26 @@ fn the_cholesky_solve_matches_the_inverse_and_refuses_an_indefinite_matrix() {
     let indefinite = DMat3::from_diagonal(DVec3::new(1.0, -1.0, 1.0));
     assert_eq!(cholesky_solve(indefinite, b), None);
 }
+
+/// A vertex no face uses has no prior (`−∞` in the log domain): weight zero,
+/// and the others are those of the cage without it.
+#[test]
+fn a_vertex_no_face_uses_gets_no_weight() {
+    let cage = procedural::cube_cage(1.0);
+    let mut positions = cage.positions().to_vec();
+    positions.push(DVec3::new(0.1, 0.2, 0.3));
+    let (with_spare, report) = Cage::new(crate::geometry::TriMesh {
+        positions,
+        triangles: cage.triangles().to_vec(),
+        triangle_faces: cage.triangle_faces().to_vec(),
+    })
+    .unwrap();
+    assert_eq!(report.unreferenced, [8]);
+    let x = DVec3::new(0.3, -0.2, 0.1);
+    let (weights, _) = solve(&with_spare, x);
+    let (without, _) = solve(&cage, x);
+    assert_eq!(weights[8], 0.0);
+    for (a, b) in weights.iter().zip(&without) {
+        assert!((a - b).abs() < 1e-14, "{weights:?} {without:?}");
+    }
+}
