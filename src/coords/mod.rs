@@ -6,7 +6,9 @@
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
 //!   cage diagonal), every family gives the barycentric coordinates of the
-//!   touching triangle, which is the limit of each of them there;
+//!   touching triangle, which is the limit of each of them there (MEC's only on
+//!   well-shaped triangles: near slivers and quads it tends elsewhere, see
+//!   docs/coordinates.md);
 //! - outside, every family uses MVC. MVC is finite off the surface (its total weight
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
 //!   reproduces the rest pose by linear precision, and meets every family
