@@ -172,8 +172,10 @@ pub enum FileAction {
     SaveImage,
     ExportColouredMesh,
     /// The deformed mesh as glTF, named poses as morph targets, the timeline
-    /// as its animation.
+    /// as its animation; the rest mesh as its base shape.
     ExportGltf,
+    /// [`FileAction::ExportGltf`] with the current pose as its base shape.
+    ExportGltfPosedBase,
 }
 
 /// A side to look at the scene from, as Blender's numpad views: the scene's y

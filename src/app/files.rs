@@ -14,10 +14,10 @@ use super::session::{self, SessionSettings};
 use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
 use crate::formats::{
-    load_cage, load_mesh, refuse_same_file, write_cage_and_pose, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, MeshFile,
+    load_cage_object, load_mesh, refuse_same_file, write_atomically, write_cage_and_pose,
+    write_deformed_mesh, write_mesh_with_normals, write_polygons_obj_to, MeshFile,
 };
-use crate::geometry::{subdivide_midpoint, TriMesh};
+use crate::geometry::{polygons_of, subdivide_midpoint, TriMesh};
 use crate::render::OrbitCamera;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -135,8 +135,11 @@ pub fn open_session(path: &Path) -> Result<SceneChange, String> {
 
 /// A mesh and its cage together.
 pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, String> {
-    let mesh = load_mesh(mesh_path).map_err(|error| error.to_string())?;
-    let (cage, report) = load_cage(cage_path).map_err(|error| error.to_string())?;
+    let mut mesh = load_mesh(mesh_path).map_err(|error| error.to_string())?;
+    let (cage, report, cage_note) =
+        load_cage_object(cage_path, None).map_err(|error| error.to_string())?;
+    let mut notes = object_note(mesh_path, mesh.object_note.take());
+    notes.extend(object_note(cage_path, cage_note));
     let document = Document::new(file_title(mesh_path), mesh.mesh.clone(), cage)
         .with_files(Some(mesh), Some(cage_path.to_owned()));
     let action = format!(
@@ -149,8 +152,16 @@ pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, Stri
             mesh: mesh_path.to_owned(),
             cage: cage_path.to_owned(),
         });
-    change.notes = report.messages();
+    notes.extend(report.messages());
+    change.notes = notes;
     Ok(change)
+}
+
+/// A file's note of which of its objects was read, as a notice naming it.
+fn object_note(path: &Path, note: Option<String>) -> Vec<String> {
+    note.map(|note| format!("{}: {note}", shown_path(path)))
+        .into_iter()
+        .collect()
 }
 
 /// The mesh replaced (the cage kept) or the cage replaced (the mesh kept). A
@@ -158,21 +169,24 @@ pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, Stri
 pub fn open_file(role: FileRole, path: &Path, current: &Document) -> Result<SceneChange, String> {
     let (document, notes) = match role {
         FileRole::Mesh => {
-            let file = load_mesh(path).map_err(|error| error.to_string())?;
+            let mut file = load_mesh(path).map_err(|error| error.to_string())?;
             if !cage_reaches(current.cage(), &file.mesh) {
                 return mesh_in_box(path, file);
             }
+            let notes = object_note(path, file.object_note.take());
             let document = Document::new(
                 file_title(path),
                 file.mesh.clone(),
                 (**current.cage()).clone(),
             )
             .with_files(Some(file), current.cage_path().map(Into::into));
-            (document, Vec::new())
+            (document, notes)
         }
         FileRole::Cage => {
-            let (cage, report) = load_cage(path).map_err(|error| error.to_string())?;
-            let notes = report.messages();
+            let (cage, report, note) =
+                load_cage_object(path, None).map_err(|error| error.to_string())?;
+            let mut notes = object_note(path, note);
+            notes.extend(report.messages());
             let rest = cage.positions().to_vec();
             (current.with_cage(cage, Some(path.to_owned()), rest), notes)
         }
@@ -199,7 +213,8 @@ pub fn open_mesh_alone(path: &Path) -> Result<SceneChange, String> {
 
 /// `file`, read from `path`, in a loose box cage, with the Generate cage
 /// window offering a real one.
-fn mesh_in_box(path: &Path, file: MeshFile) -> Result<SceneChange, String> {
+fn mesh_in_box(path: &Path, mut file: MeshFile) -> Result<SceneChange, String> {
+    let notes = object_note(path, file.object_note.take());
     let cage = loose_box_cage(&file.mesh).ok_or_else(|| {
         format!(
             "{}: the mesh has no extent to put a cage around",
@@ -216,6 +231,7 @@ fn mesh_in_box(path: &Path, file: MeshFile) -> Result<SceneChange, String> {
             shown_path(path)
         ));
     change.offer_cage = true;
+    change.notes = notes;
     Ok(change)
 }
 
@@ -345,7 +361,8 @@ pub fn refuse_overwriting_inputs(
     refuse_same_file(path, &open_inputs(current, session)).map_err(|error| error.to_string())
 }
 
-/// Write the pose as a cage-shaped OBJ.
+/// Write the pose as an OBJ with the cage's faces as read (quads stay quads),
+/// as `pmvc deform` reads poses and Save cage writes them.
 pub fn save_pose(path: &Path, current: &Document) -> Result<String, String> {
     refuse_overwriting_open_files(path, current)?;
     let cage = current.cage();
@@ -354,7 +371,11 @@ pub fn save_pose(path: &Path, current: &Document) -> Result<String, String> {
         triangles: cage.triangles().to_vec(),
         triangle_faces: cage.triangle_faces().to_vec(),
     };
-    write_obj(path, &posed).map_err(|error| error.to_string())?;
+    let faces = polygons_of(&posed);
+    write_atomically(path, |out| {
+        write_polygons_obj_to(out, &posed.positions, &faces)
+    })
+    .map_err(|error| error.to_string())?;
     Ok(format!("saved pose {}", shown_path(path)))
 }
 
@@ -398,10 +419,25 @@ pub fn save_session(
     Ok(format!("saved session {}", shown_path(path)))
 }
 
-/// Write the mesh deformed with `method` as glTF: the current pose as the base
-/// shape, each named pose as a morph target named after it, and the timeline's
-/// keys, when it has two or more, as the animation.
-pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<String, String> {
+/// The base shape of a glTF export (Blender's Basis shape key).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GltfBase {
+    /// The mesh as read: an import lands where the original was.
+    Rest,
+    /// The mesh deformed with the current pose (File > Export glTF, pose as base).
+    Pose,
+}
+
+/// Write the mesh deformed with `method` as glTF: `base` as the base shape,
+/// each named pose as a morph target named after it, and the timeline's keys,
+/// when it has two or more, as the animation, which starts at the base (a key
+/// at 0 s with every weight 0) unless a pose is keyed at 0 s.
+pub fn export_gltf(
+    path: &Path,
+    current: &Document,
+    method: Method,
+    base_shape: GltfBase,
+) -> Result<String, String> {
     use crate::formats::gltf::{write_gltf, AnimationKey, GltfPose, GltfScene};
     refuse_overwriting_open_files(path, current)?;
     if current.weights(method).is_none() {
@@ -411,7 +447,10 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
             method.name()
         ));
     }
-    let base = current.deformed_positions(method);
+    let base = match base_shape {
+        GltfBase::Rest => current.mesh().positions.clone(),
+        GltfBase::Pose => current.deformed_positions(method),
+    };
     let named = current.named_poses();
     let deformed: Vec<Vec<DVec3>> = named
         .iter()
@@ -425,13 +464,19 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
             positions,
         })
         .collect();
-    let keys: Vec<AnimationKey> = crate::app::timeline::keys(named)
-        .into_iter()
-        .map(|(seconds, index)| AnimationKey {
-            seconds: seconds as f32,
-            pose: Some(index),
-        })
-        .collect();
+    let timeline = crate::app::timeline::keys(named);
+    let mut keys: Vec<AnimationKey> = Vec::with_capacity(timeline.len() + 1);
+    if timeline.first().is_some_and(|&(seconds, _)| seconds > 0.0) {
+        keys.push(AnimationKey {
+            seconds: 0.0,
+            pose: None,
+        });
+    }
+    keys.extend(timeline.iter().map(|&(seconds, index)| AnimationKey {
+        seconds: seconds as f32,
+        pose: Some(index),
+    }));
+    let animated = timeline.len() >= 2;
     let made;
     let mesh = match current.mesh_file() {
         Some(file) => file,
@@ -441,6 +486,8 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
                 format: crate::formats::MeshFormat::Obj,
                 mesh: (**current.mesh()).clone(),
                 obj_text: None,
+                node_transform: None,
+                object_note: None,
             };
             &made
         }
@@ -449,16 +496,20 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
         mesh,
         base: &base,
         poses: &poses,
-        animation: (keys.len() >= 2).then_some(keys.as_slice()),
+        animation: animated.then_some(keys.as_slice()),
     };
     write_gltf(path, &scene).map_err(|error| error.to_string())?;
-    let animated = if keys.len() >= 2 {
+    let animated = if animated {
         format!(", an animation of {} keys", keys.len())
     } else {
         String::new()
     };
+    let base_shape = match base_shape {
+        GltfBase::Rest => "the rest mesh",
+        GltfBase::Pose => "the current pose",
+    };
     Ok(format!(
-        "exported {} ({}, {} morph target(s){animated})",
+        "exported {} ({}, {base_shape} as its base, {} morph target(s){animated})",
         shown_path(path),
         method.name(),
         poses.len()
@@ -469,12 +520,17 @@ pub fn export_gltf(path: &Path, current: &Document, method: Method) -> Result<St
 pub fn export_deformed(path: &Path, current: &Document, method: Method) -> Result<String, String> {
     refuse_overwriting_open_files(path, current)?;
     let positions = current.deformed_positions(method);
-    match current.mesh_file() {
+    let moved = match current.mesh_file() {
         Some(file) => write_deformed_mesh(file, &positions, path),
-        None => write_mesh_with_normals(path, &positions, &current.mesh().triangles),
+        None => write_mesh_with_normals(path, &positions, &current.mesh().triangles)
+            .map(|()| Vec::new()),
     }
     .map_err(|error| error.to_string())?;
-    Ok(format!("exported {}", shown_path(path)))
+    let mut done = format!("exported {}", shown_path(path));
+    for library in moved {
+        done.push_str(&format!("; {library}"));
+    }
+    Ok(done)
 }
 
 /// The name a new session file is offered: the mesh's, as

@@ -96,7 +96,7 @@ pub struct SessionFile {
     /// The method a single view shows.
     pub method: Method,
     /// Each family's parameter by name ("resolution": 32).
-    #[serde(default)]
+    #[serde(default, with = "crate::coords::parameter_values")]
     pub parameters: BTreeMap<String, u64>,
     /// How the cage's quads are bound: "none" (bilinear patches, the default and
     /// what sessions from before this setting get), "shorter" or "longer".
@@ -350,7 +350,7 @@ fn mesh_source(
     inputs.extend(document.cage_path());
     refuse_same_file(&sidecar, &inputs)?;
     match document.mesh_file() {
-        Some(file) => write_deformed_mesh(file, positions, &sidecar)?,
+        Some(file) => write_deformed_mesh(file, positions, &sidecar).map(drop)?,
         None => write_obj(&sidecar, document.mesh())?,
     }
     Ok(MeshSource::File(relative_to(&sidecar, folder)))

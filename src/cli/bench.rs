@@ -2,7 +2,7 @@
 //! and on the shared evaluation data, on the CPU and on a GPU adapter. Reports medians over repeated runs, as markdown on
 //! stdout and optionally as JSON.
 
-use crate::coords::{BindOptions, BindProgress, Method, QuadSplit};
+use crate::coords::{BindOptions, BindProgress, Method, QuadSplit, EXACT_RESOLUTION};
 use crate::formats::shown_path;
 use crate::geometry::{procedural, Cage, PointClass};
 use crate::gpu::{Backend, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
@@ -41,6 +41,11 @@ pub struct BenchArgs {
     /// Only these families (e.g. `pmvc,mvc`); all by default.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub methods: Vec<Method>,
+    /// Instead of timings, PMVC's cube-map error against exact PMVC at
+    /// resolutions 8 to 128, on the bundled comb ("comb" in --scenes) and the
+    /// shared models: weights and deformation, beside MVC's difference.
+    #[arg(long)]
+    pub exact_error: bool,
 }
 
 /// The `--scenes` name of the paper's Table 2 rows.
@@ -113,6 +118,9 @@ struct Timed {
 pub fn run(args: &BenchArgs) -> Result<()> {
     let shared = shared_models(args);
     check_scenes(&args.scenes, &shared, args)?;
+    if args.exact_error {
+        return run_exact_error(args, &shared);
+    }
     // Opened before the work, so that an output that cannot be written is
     // reported now, not after the whole benchmark.
     let json_output = match &args.json {
@@ -172,6 +180,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         (Method::Mvc, 0),
         (Method::Pmvc, 32),
         (Method::Pmvc, 64),
+        (Method::Pmvc, EXACT_RESOLUTION),
         (Method::Harmonic, 64),
         (Method::Harmonic, 128),
     ];
@@ -217,6 +226,34 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--exact-error`: the table of [`super::bench_exact`], as markdown.
+fn run_exact_error(args: &BenchArgs, shared: &[String]) -> Result<()> {
+    let wanted = |name: &str| args.scenes.is_empty() || args.scenes.iter().any(|s| s == name);
+    let mut scenes = Vec::new();
+    if wanted(BUNDLED_COMB) {
+        scenes.push(super::bench_exact::comb_scene());
+    }
+    for name in shared.iter().filter(|name| wanted(name)) {
+        scenes.push(super::bench_exact::shared_scene(&args.data, name)?);
+    }
+    let mut rows = Vec::new();
+    for scene in &scenes {
+        let start = Instant::now();
+        rows.extend(super::bench_exact::measure(scene)?);
+        warn_line!("  {}: {:.1} s", scene.name, start.elapsed().as_secs_f64());
+    }
+    say!("{}", super::bench_exact::markdown(&rows));
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&rows)?;
+        crate::formats::PendingOutput::create(path)?
+            .finish(|out| out.write_all(json.as_bytes()))?;
+    }
+    Ok(())
+}
+
+/// The `--scenes` name of the bundled comb (`--exact-error` only).
+const BUNDLED_COMB: &str = "comb";
+
 /// The shared-data models in `--data` (X.obj beside X_Cage.obj), sorted; none
 /// with `--no-data` or when the folder cannot be read.
 fn shared_models(args: &BenchArgs) -> Vec<String> {
@@ -242,7 +279,11 @@ fn shared_models(args: &BenchArgs) -> Vec<String> {
 /// timed for it.
 fn check_scenes(scenes: &[String], shared: &[String], args: &BenchArgs) -> Result<()> {
     let mut known: Vec<&str> = procedural::table1_scene_names().to_vec();
-    known.push(TABLE2);
+    known.push(if args.exact_error {
+        BUNDLED_COMB
+    } else {
+        TABLE2
+    });
     let unknown: Vec<&str> = scenes
         .iter()
         .map(String::as_str)
@@ -308,14 +349,17 @@ fn bench_scene_split(
                 quads,
                 ..BindOptions::for_method(method)
             };
-            // MVC on quads is QMVC, which has no GPU kernel either.
-            let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
-            let kernel = crate::gpu::kernels::Kernel::for_cage(method, &options.cage_to_bind(cage));
-            if gpu_backend && kernel.is_none() {
-                continue;
-            }
             if let Some(parameter) = method.spec().parameter {
                 options.set(parameter.key, resolution);
+            }
+            // MVC on quads is QMVC, which has no GPU kernel either, nor has
+            // exact PMVC.
+            let gpu_backend = matches!(timed.backend, Backend::Gpu(_));
+            let has_kernel = crate::gpu::backend_choice::Work::of(options, points.len(), cage)
+                .kernel()
+                .is_some();
+            if gpu_backend && !has_kernel {
+                continue;
             }
             let pmvc_kernel = timed.pmvc_kernel.unwrap_or_default();
             let work = crate::gpu::backend_choice::Work::of(options, points.len(), cage);
@@ -408,10 +452,13 @@ fn bench_shared_data(
         } else {
             &[QuadSplit::None]
         };
-        let configurations: Vec<_> = [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)]
-            .into_iter()
-            .flat_map(|(method, value)| splits.iter().map(move |&split| (method, value, split)))
-            .collect();
+        let mut configurations: Vec<_> =
+            [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)]
+                .into_iter()
+                .flat_map(|(method, value)| splits.iter().map(move |&split| (method, value, split)))
+                .collect();
+        // Exact PMVC split a cage's quads themselves: one row.
+        configurations.push((Method::Pmvc, EXACT_RESOLUTION, QuadSplit::None));
         rows.extend(bench_scene_split(
             name,
             &cage,

@@ -10,12 +10,16 @@ use super::commands::{
     outside_policy, progress_bar, summary, BoundInput, InputRules,
 };
 use super::weights_format::{check_weights_format, writes_npz};
+use super::BackendArg;
 use super::BindArgs;
+use crate::coords::{bind_cpu_f64, BindProgress, Dtype, DtypeError};
 use crate::formats::metadata::{
     class_codes, classes_path, metadata_path, write_classes_npy_to, BindRecord, WeightsMetadata,
 };
-use crate::formats::npy::{npy_file_bytes, npy_preamble, write_f32_values};
-use crate::formats::npz::{npz_payload_bytes, write_npz};
+use crate::formats::npy::{
+    npy_file_bytes_of, npy_preamble, npy_preamble_of, write_f32_values, write_values,
+};
+use crate::formats::npz::{npz_payload_bytes_of, write_npz, write_npz_values};
 use crate::formats::{
     refuse_same_file, refuse_unwritable, resolve_output, shown_path, OutputSet, OutputTarget,
 };
@@ -87,16 +91,29 @@ struct BindDone {
 pub(super) fn bind(args: &BindArgs) -> Result<()> {
     let inputs = [args.input.mesh.as_path(), args.input.cage.as_path()];
     check_weights_format(args)?;
+    let dtype = args.dtype;
+    dtype.check_family(args.method.method)?;
     let (extensions, what): (&[&str], _) = if writes_npz(args.method.method) {
-        (&["npz"], "phi and psi float32 arrays in .npz format")
+        (
+            &["npz"],
+            format!("phi and psi {} arrays in .npz format", dtype.id()),
+        )
     } else {
-        (&["npy"], "float32 weights in .npy format")
+        (&["npy"], format!("{} weights in .npy format", dtype.id()))
     };
-    check_output(&args.out, &inputs, extensions, what)?;
+    check_output(&args.out, &inputs, extensions, &what)?;
     let companions = companion_paths(&args.out, &inputs)?;
     // Opening a device takes a tenth of a second or more, mostly waiting on the
     // driver: for `gpu`, and `auto` on a large mesh, it opens while the inputs load.
-    let choice = args.method.backend;
+    // Float64 weights are computed on the CPU.
+    let choice = if dtype == Dtype::Float64 {
+        if args.method.backend == BackendArg::Gpu {
+            warn_line!("pmvc: notice: {}", DtypeError::NotOnGpu);
+        }
+        BackendArg::Cpu
+    } else {
+        args.method.backend
+    };
     let mesh_bytes = std::fs::metadata(&args.input.mesh).map_or(0, |meta| meta.len());
     let probe = std::thread::spawn(move || choose_backend(choice, mesh_bytes));
     let method = args.method.method;
@@ -106,7 +123,11 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
             options: args.method.options(),
             strict: args.method.strict,
             outside_policy: outside_policy(Some(method)),
-            resident_rows: &|rows, columns| bind_resident_rows(args, rows, columns),
+            // Rows of float64 hold twice the bytes the budget counts per row.
+            resident_rows: &|rows, columns| match dtype {
+                Dtype::Float32 => bind_resident_rows(args, rows, columns),
+                Dtype::Float64 => rows.saturating_mul(2),
+            },
         },
     )?;
     let backend = probe
@@ -122,20 +143,24 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
     outputs.check_space(
         0,
         if writes_npz(method) {
-            npz_payload_bytes(rows, columns)
+            npz_payload_bytes_of(rows, columns, dtype)
         } else {
-            npy_file_bytes(rows, columns)
+            npy_file_bytes_of(rows, columns, dtype)
         },
     )?;
-    let done = bind_to(args, &input, backend, outputs, rows, columns)?;
+    let done = match dtype {
+        Dtype::Float32 => bind_to(args, &input, backend, outputs, rows, columns)?,
+        Dtype::Float64 => bind_to_f64(args, &input, outputs, rows)?,
+    };
     let shape = if writes_npz(method) {
         let vertices = input.cage.vertex_count();
         format!(
-            "phi {rows} × {vertices} and psi {rows} × {} float32",
-            columns - vertices
+            "phi {rows} × {vertices} and psi {rows} × {} {}",
+            columns - vertices,
+            dtype.id()
         )
     } else {
-        format!("{rows} × {columns} float32 weights")
+        format!("{rows} × {columns} {} weights", dtype.id())
     };
     let beside = match companions.as_slice() {
         [classes, json] => format!(
@@ -158,7 +183,7 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
 
 /// `W.json` for weights bound from `input` as `done` says.
 fn metadata_json(args: &BindArgs, input: &BoundInput, done: &BindDone) -> String {
-    WeightsMetadata::new(&BindRecord {
+    let mut metadata = WeightsMetadata::new(&BindRecord {
         options: args.method.options(),
         cage: &input.cage,
         points: &input.mesh.mesh.positions,
@@ -169,8 +194,63 @@ fn metadata_json(args: &BindArgs, input: &BoundInput, done: &BindDone) -> String
         mesh_file: &args.input.mesh.to_string_lossy(),
         cage_file: &args.input.cage.to_string_lossy(),
         weights_file: &args.out,
-    })
-    .to_json_pretty()
+    });
+    metadata.dtype = args.dtype.id().to_owned();
+    metadata.to_json_pretty()
+}
+
+/// `--dtype f64`: bind every row on the CPU in float64 (a family whose rows
+/// are independent, so Green's `.npz` too), then write the weights, the class
+/// mask and the metadata (`outputs` holds the weights first).
+fn bind_to_f64(
+    args: &BindArgs,
+    input: &BoundInput,
+    outputs: OutputSet,
+    rows: usize,
+) -> Result<BindDone> {
+    let bar = progress_bar(rows as u64, args.method.method);
+    let options = args.method.options();
+    let progress = BindProgress::new(rows);
+    let started = std::time::Instant::now();
+    let weights = std::thread::scope(|scope| {
+        let binding = scope.spawn(|| {
+            bind_cpu_f64(
+                &input.mesh.mesh.positions,
+                &input.classes.classes,
+                &input.cage,
+                options,
+                &progress,
+            )
+        });
+        while !binding.is_finished() && !bar.is_hidden() {
+            bar.set_position(progress.done() as u64);
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        binding
+            .join()
+            .map_err(|_| anyhow::anyhow!("internal error: the bind thread panicked"))
+    })??;
+    bar.finish_and_clear();
+    let done = BindDone {
+        device: "CPU".to_owned(),
+        on_gpu: false,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let json = metadata_json(args, input, &done);
+    let codes = class_codes(&input.classes.classes);
+    let preamble = npy_preamble_of(&args.out, rows, weights.cols, Dtype::Float64)?;
+    let vertices = args.method.method.vertex_columns(&input.cage);
+    let npz = writes_npz(args.method.method);
+    outputs.finish_seekable(|index, out| match index {
+        0 if npz => write_npz_values(out, &args.out, (&weights.values, weights.cols), vertices),
+        0 => {
+            out.write_all(&preamble)?;
+            write_values(out, &weights.values)
+        }
+        1 => write_classes_npy_to(out, &codes),
+        _ => out.write_all(json.as_bytes()),
+    })?;
+    Ok(done)
 }
 
 /// Bind and write the weights, whole or in blocks of rows, then the class mask

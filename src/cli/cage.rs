@@ -13,6 +13,9 @@ pub struct CageArgs {
     /// The mesh to enclose (.obj, .off, .glb or .gltf): a triangle mesh, closed or not.
     #[arg(long, value_name = "MESH")]
     pub mesh: PathBuf,
+    /// Read the mesh from this object of a file with several (as `deform --mesh-object`).
+    #[arg(long, value_name = "NAME", value_parser = super::parse::parse_object_name)]
+    pub mesh_object: Option<String>,
     /// About how many vertices the cage should have (8 to 20000); the result is
     /// within ±15% of it unless the mesh's shape needs more or allows fewer.
     #[arg(long, value_name = "N")]
@@ -39,7 +42,7 @@ pub struct CageArgs {
 
 pub(super) fn cage(args: &CageArgs) -> Result<()> {
     super::commands::check_output(&args.out, &[&args.mesh], &["obj"], "an OBJ cage")?;
-    let mesh = crate::formats::load_mesh(&args.mesh)?;
+    let mesh = super::commands::read_mesh(&args.mesh, args.mesh_object.as_deref())?;
     let options = CageOptions {
         clearance: args.clearance,
         cell_size: args.cell_size,

@@ -54,8 +54,8 @@ pub(super) struct InputRules<'a> {
 /// Weights rows that cannot fit in memory (`rules.resident_rows`) are an error
 /// before any work on the points.
 pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundInput> {
-    let mesh = crate::formats::load_mesh(&input.mesh)?;
-    let (cage, report) = crate::formats::load_cage(&input.cage)?;
+    let mesh = read_mesh(&input.mesh, input.mesh_object.as_deref())?;
+    let (cage, report) = read_cage(&input.cage, input.cage_object.as_deref())?;
     let columns = rules.options.method.columns(&cage);
     let rows = (rules.resident_rows)(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
@@ -299,8 +299,36 @@ fn check_weights_fit(rows: usize, cols: usize, mesh: &std::path::Path) -> Result
     })
 }
 
+/// Read object `object` of the mesh file `path`; where none was named and
+/// the file has several, a note says which was read.
+pub(super) fn read_mesh(path: &std::path::Path, object: Option<&str>) -> Result<MeshFile> {
+    let mut file = crate::formats::load_mesh_object(path, object)?;
+    if let Some(note) = file.object_note.take() {
+        warn_line!(
+            "pmvc: {}: note: {note}; --mesh-object NAME reads one alone",
+            shown_path(path)
+        );
+    }
+    Ok(file)
+}
+
+/// [`read_mesh`] for the cage, validated.
+pub(super) fn read_cage(
+    path: &std::path::Path,
+    object: Option<&str>,
+) -> Result<(Cage, geometry::CageReport)> {
+    let (cage, report, note) = crate::formats::load_cage_object(path, object)?;
+    if let Some(note) = note {
+        warn_line!(
+            "pmvc: {}: note: {note}; --cage-object NAME reads one alone",
+            shown_path(path)
+        );
+    }
+    Ok((cage, report))
+}
+
 pub(super) fn check(args: &CheckArgs) -> Result<()> {
-    let mesh = crate::formats::load_mesh(&args.input.mesh)?;
+    let mesh = read_mesh(&args.input.mesh, args.input.mesh_object.as_deref())?;
     say!(
         "mesh  {}: {} vertices, {} triangles{}",
         shown_path(&args.input.mesh),
@@ -312,7 +340,7 @@ pub(super) fn check(args: &CheckArgs) -> Result<()> {
             ""
         }
     );
-    let (cage, report) = crate::formats::load_cage(&args.input.cage)?;
+    let (cage, report) = read_cage(&args.input.cage, args.input.cage_object.as_deref())?;
     let faces = if cage.has_quads() {
         format!(
             "{} quads (bilinear patches) and {} triangles",

@@ -7,11 +7,11 @@ use super::commands::{
     InputRules,
 };
 use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
-use super::DeformArgs;
-use crate::coords::{BindOptions, Method};
+use super::{CageInput, DeformArgs};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method};
 use crate::formats::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
 use crate::formats::metadata::{metadata_path, read_metadata, WeightsMetadata};
-use crate::formats::shown_path;
+use crate::formats::{shown_path, LoadError, ObjectError};
 use crate::geometry::{bounds_of, find_crossing, Cage};
 use anyhow::{bail, Result};
 use glam::DVec3;
@@ -127,18 +127,23 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             resident_rows: &|rows, _| if holds_weights { rows } else { 0 },
         },
     )?;
-    let pose = load_pose(&args.deformed_cage, &input.cage, &args.input.cage)?;
+    let pose = load_pose(&args.deformed_cage, &input.cage, &args.input)?;
     let poses = args
         .poses
         .iter()
-        .map(|path| load_pose(path, &input.cage, &args.input.cage))
+        .map(|path| load_pose(path, &input.cage, &args.input))
         .collect::<Result<Vec<_>>>()?;
     if let Some((json, metadata)) = stored.as_ref().and_then(|s| s.metadata.as_ref()) {
         metadata.check_inputs(json, &input.mesh.mesh.positions, &input.cage)?;
     }
+    // Stored weights are float64 where their metadata says so.
+    let dtype = stored
+        .as_ref()
+        .and_then(|stored| stored.metadata.as_ref())
+        .map_or(Dtype::Float32, |(_, metadata)| metadata.dtype());
     let weights = match &args.weights {
-        Some(path) => read_weights_for(path, &input, method)?,
-        None => compute_weights(&input, &args.method)?,
+        Some(path) => read_weights_for(path, &input, method, dtype)?,
+        None => AnyWeights::F32(compute_weights(&input, &args.method)?),
     };
     // Displacement form, p + Σλ(c̃ − c): the same as Σλc̃ for weights that
     // reproduce their points at rest (every family pmvc binds), and better in f32:
@@ -178,7 +183,9 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             },
         )?;
     } else {
-        crate::formats::write_deformed_mesh(&input.mesh, &deformed, &args.out)?;
+        for library in crate::formats::write_deformed_mesh(&input.mesh, &deformed, &args.out)? {
+            warn_line!("pmvc: {}: note: {library}", shown_path(&args.out));
+        }
     }
     let source = match (&args.weights, &stored) {
         (Some(path), Some(stored)) if stored.metadata.is_some() => format!(
@@ -207,9 +214,24 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
 }
 
 /// A pose of the cage read from `path`: its vertices, which must be as many as
-/// the cage's, in order. A pose that crosses itself gets a warning.
-pub(super) fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Vec<DVec3>> {
-    let pose = crate::formats::load_mesh(path)?;
+/// the cage's, in order. A pose that crosses itself gets a warning. With
+/// `--cage-object`, a pose file with named objects gives that object (one
+/// exported from the same scene); one without (as pmvc saves poses) is read whole.
+pub(super) fn load_pose(path: &Path, cage: &Cage, input: &CageInput) -> Result<Vec<DVec3>> {
+    let cage_path = input.cage.as_path();
+    let object = input.cage_object.as_deref();
+    let pose = match crate::formats::load_mesh_object(path, object) {
+        Err(LoadError::Object { source, .. }) if names_no_object(&source) => {
+            crate::formats::load_mesh(path)?
+        }
+        read => read?,
+    };
+    if let Some(note) = &pose.object_note {
+        warn_line!(
+            "pmvc: {}: note: {note}; --cage-object NAME reads one alone",
+            shown_path(path)
+        );
+    }
     let (expected, found) = (cage.vertex_count(), pose.mesh.positions.len());
     if found != expected {
         bail!(
@@ -220,6 +242,15 @@ pub(super) fn load_pose(path: &Path, cage: &Cage, cage_path: &Path) -> Result<Ve
     }
     warn_if_crossed(cage, &pose.mesh.positions, path);
     Ok(pose.mesh.positions)
+}
+
+/// Whether a file had no named objects to pick from.
+fn names_no_object(error: &ObjectError) -> bool {
+    match error {
+        ObjectError::NotFound { names, .. } => names.is_empty(),
+        ObjectError::Unnamed { .. } => true,
+        ObjectError::Ambiguous { .. } => false,
+    }
 }
 
 /// A morph target's name: its pose file's stem (`wave` for `poses/wave.obj`).

@@ -23,6 +23,7 @@ macro_rules! warn_line {
 }
 
 mod bench;
+mod bench_exact;
 mod bind;
 mod cage;
 mod commands;
@@ -39,7 +40,8 @@ pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use parse::{
-    parse_grid, parse_percent, parse_resolution, parse_seconds, parse_view, TriangulateArg,
+    parse_grid, parse_object_name, parse_percent, parse_resolution, parse_seconds, parse_view,
+    TriangulateArg,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -99,7 +101,8 @@ pub enum BackendArg {
 
 #[derive(Debug, clap::Args)]
 pub struct CageInput {
-    /// The mesh to deform (.obj, .off, or the first mesh of a .glb or .gltf). A file
+    /// The mesh to deform (.obj, .off, or the first mesh of a .glb or .gltf, unless
+    /// --mesh-object names another). A file
     /// with vertices and no faces is a point set, and so is a .npy array of shape
     /// (n, 3), float32 or float64, in C order.
     #[arg(long, value_name = "MESH")]
@@ -108,6 +111,14 @@ pub struct CageInput {
     /// or a .glb or .gltf, whose vertices at one position are welded).
     #[arg(long, value_name = "CAGE")]
     pub cage: PathBuf,
+    /// Read the mesh from this object of a file with several (an OBJ's `o` name,
+    /// a glTF node's or mesh's name). Without it an OBJ's objects are read as one
+    /// mesh and a glTF's first mesh alone, and a note names the others.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name)]
+    pub mesh_object: Option<String>,
+    /// Read the cage from this object of a file with several, as --mesh-object.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name)]
+    pub cage_object: Option<String>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -115,7 +126,7 @@ pub struct MethodChoice {
     /// Coordinates to compute.
     #[arg(long, value_enum, default_value_t = crate::coords::Method::Pmvc)]
     pub method: crate::coords::Method,
-    /// PMVC cube-map resolution: texels along one face edge (1–1024).
+    /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated in closed form, on the CPU, on triangles (quads are split along their shorter diagonal unless --triangulate says otherwise).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
     /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
@@ -179,6 +190,18 @@ pub struct BindArgs {
     /// the whole cage at once and hold every row.
     #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
     pub block_rows: Option<u64>,
+    /// How the weights are stored: f32 (little-endian float32, the default) or
+    /// f64 (float64, every row as computed, without its rounding to float32, for
+    /// studies that check weights past 7 digits; W.json's "dtype" says which).
+    /// f64 binds on the CPU, whole (not in blocks), and not harmonic coordinates,
+    /// which are solved in float32 on their grid.
+    #[arg(long, default_value = "f32", value_name = "f32|f64", value_parser = parse_dtype)]
+    pub dtype: crate::coords::Dtype,
+}
+
+/// `--dtype`, read by the one parser of a dtype ([`crate::coords::Dtype::parse`]).
+fn parse_dtype(text: &str) -> Result<crate::coords::Dtype, String> {
+    crate::coords::Dtype::parse(text).map_err(|error| error.to_string())
 }
 
 #[derive(Debug, clap::Args)]
@@ -190,7 +213,7 @@ pub struct DeformArgs {
     pub deformed_cage: PathBuf,
     #[command(flatten)]
     pub method: MethodChoice,
-    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32, one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
+    /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32 (float64 where W.json says "dtype": "float64"), one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format. A name ending in .glb gets binary glTF 2.0, and .gltf glTF's JSON with its buffer inside: positions, recomputed normals, texture coordinates (v flipped, as glTF has it) and the OBJ's groups as primitives.
@@ -219,7 +242,7 @@ pub struct CheckArgs {
     /// longest axis).
     #[arg(long, value_name = "POSE.obj")]
     pub deformed_cage: Option<PathBuf>,
-    /// PMVC cube-map resolution for that measurement (1–1024).
+    /// PMVC cube-map resolution for that measurement (1–1024), or `exact`.
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
 }
@@ -238,7 +261,7 @@ pub struct EditArgs {
     /// A deformed cage with the same vertex count, applied after binding.
     #[arg(long, value_name = "POSE.obj")]
     pub pose: Option<PathBuf>,
-    /// PMVC cube-map resolution (1–1024).
+    /// PMVC cube-map resolution (1–1024), or `exact` (no cube map).
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<u32>,
     /// Harmonic grid: cells along the cage's longest side (4–2048).

@@ -14,11 +14,7 @@ pub(super) fn parse_grid(text: &str) -> Result<u32, String> {
 }
 
 fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
-    let value: u64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a whole number"))?;
-    parameter.validate(value).map_err(|error| error.to_string())
+    parameter.spec().parse(text)
 }
 
 /// `--difference-limit`: a percentage of the cage diagonal, with or without the
@@ -30,6 +26,11 @@ pub(super) fn parse_percent(text: &str) -> Result<f32, String> {
         .parse()
         .map_err(|_| format!("'{text}' is not a percentage (e.g. 0.5 or 0.5%)"))?;
     crate::app::compare::check_difference_limit(percent / 100.0).map(|_| percent)
+}
+
+/// `--mesh-object`, `--cage-object`: checked as Python's `object=` is.
+pub(super) fn parse_object_name(text: &str) -> Result<String, String> {
+    crate::formats::check_object_name(text).map(str::to_owned)
 }
 
 /// `--animate`: a duration in seconds, finite and above 0.

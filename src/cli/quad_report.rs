@@ -18,7 +18,7 @@ pub(super) fn report_split_effect(args: &CheckArgs, cage: &Cage, points: &[DVec3
     }
     let (pose, pose_name) = match &args.deformed_cage {
         Some(path) => {
-            let posed = super::deform::load_pose(path, cage, &args.input.cage)?;
+            let posed = super::deform::load_pose(path, cage, &args.input)?;
             (posed, shown_path(path))
         }
         None => (

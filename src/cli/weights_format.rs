@@ -5,9 +5,9 @@
 use super::commands::BoundInput;
 use super::BindArgs;
 use crate::coords::family::ColumnLayout;
-use crate::coords::{Method, Weights};
-use crate::formats::npy::{read_npy, ExpectedArray};
-use crate::formats::npz::read_npz;
+use crate::coords::{AnyWeights, Dtype, Method};
+use crate::formats::npy::{read_npy, read_npy_f64, ExpectedArray};
+use crate::formats::npz::{read_npz, read_npz_f64};
 use crate::formats::shown_path;
 use anyhow::{bail, Result};
 
@@ -69,18 +69,20 @@ pub(super) fn stored_family(path: &std::path::Path, asked: Method) -> Result<Met
 /// Weights of `method` ([`stored_family`]) from a file. The file's arrays must
 /// have this mesh's and cage's shape, finite values, and rows of cage-vertex
 /// weights that sum to 1 (checked as they are read).
+/// The file's values are float32, or float64 where its metadata says so (`dtype`).
 pub(super) fn read_weights_for(
     path: &std::path::Path,
     input: &BoundInput,
     method: Method,
-) -> Result<Weights> {
+    dtype: Dtype,
+) -> Result<AnyWeights> {
     let rows = input.mesh.mesh.positions.len();
     let (vertices, triangles) = (input.cage.vertex_count(), input.cage.triangle_count());
-    if writes_npz(method) {
-        return Ok(read_npz(path, rows, vertices, triangles)?);
-    }
-    Ok(read_npy(
-        path,
-        ExpectedArray::cage_vertices(rows, vertices),
-    )?)
+    let expected = ExpectedArray::cage_vertices(rows, vertices);
+    Ok(match (dtype, writes_npz(method)) {
+        (Dtype::Float32, true) => AnyWeights::F32(read_npz(path, rows, vertices, triangles)?),
+        (Dtype::Float32, false) => AnyWeights::F32(read_npy(path, expected)?),
+        (Dtype::Float64, true) => AnyWeights::F64(read_npz_f64(path, rows, vertices, triangles)?),
+        (Dtype::Float64, false) => AnyWeights::F64(read_npy_f64(path, expected)?),
+    })
 }

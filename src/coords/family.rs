@@ -87,13 +87,26 @@ pub struct ParameterSpec {
     /// The smallest and largest values accepted from any source ([`Self::validate`]).
     pub min: u32,
     pub max: u32,
-    /// How a value reads in titles, e.g. "32²".
+    /// Values outside `min..=max` that mean something else, by name
+    /// (PMVC's "exact": no cube map).
+    pub named: &'static [NamedValue],
+    /// How a value reads in titles, e.g. "32²" or "exact".
     pub format: fn(u32) -> String,
+}
+
+/// A parameter value with a name, written and read as that name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NamedValue {
+    pub value: u32,
+    pub name: &'static str,
 }
 
 /// A parameter value outside its family's range.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{id} {value} is out of range: the {label} must be {min} to {max}")]
+#[error(
+    "{id} {value} is out of range: the {label} must be {min} to {max}{}",
+    or_named(named)
+)]
 pub struct ParameterError {
     /// The name saved files give it ("resolution").
     pub id: &'static str,
@@ -101,22 +114,76 @@ pub struct ParameterError {
     pub value: u64,
     pub min: u32,
     pub max: u32,
+    pub named: &'static [NamedValue],
+}
+
+/// `, or "exact"` after a range, for a parameter with named values.
+fn or_named(named: &[NamedValue]) -> String {
+    named
+        .iter()
+        .map(|named| format!(", or \"{}\"", named.name))
+        .collect()
 }
 
 impl ParameterSpec {
     /// The one check of a value, wherever it comes from (the command line, a
-    /// session, the editor's controls): `value` when it is in `min..=max`.
+    /// session, the editor's controls): `value` when it is in `min..=max` or
+    /// one of the named values.
     pub fn validate(&self, value: u64) -> Result<u32, ParameterError> {
         match u32::try_from(value) {
             Ok(value) if (self.min..=self.max).contains(&value) => Ok(value),
-            _ => Err(ParameterError {
-                id: self.key.id(),
-                label: self.label,
-                value,
-                min: self.min,
-                max: self.max,
-            }),
+            Ok(value) if self.named.iter().any(|named| named.value == value) => Ok(value),
+            _ => Err(self.out_of_range(value)),
         }
+    }
+
+    fn out_of_range(&self, value: u64) -> ParameterError {
+        ParameterError {
+            id: self.key.id(),
+            label: self.label,
+            value,
+            min: self.min,
+            max: self.max,
+            named: self.named,
+        }
+    }
+
+    /// The one reading of a value from text (the command line, Python, saved
+    /// files): a whole number checked by [`Self::validate`], or a value's name.
+    pub fn parse(&self, text: &str) -> Result<u32, String> {
+        let text = text.trim();
+        if let Some(named) = self
+            .named
+            .iter()
+            .find(|n| n.name.eq_ignore_ascii_case(text))
+        {
+            return Ok(named.value);
+        }
+        let value: u64 = text.parse().map_err(|_| {
+            format!(
+                "'{text}' is not a whole number{}",
+                or_named(self.named).replacen(',', "", 1)
+            )
+        })?;
+        self.validate_number(value)
+            .map_err(|error| error.to_string())
+    }
+
+    /// [`Self::validate`] of a value given as a number by a user: a named
+    /// value is given by its name, so its code (PMVC's exact is 0) is refused.
+    pub fn validate_number(&self, value: u64) -> Result<u32, ParameterError> {
+        match u32::try_from(value) {
+            Ok(value) if (self.min..=self.max).contains(&value) => Ok(value),
+            _ => Err(self.out_of_range(value)),
+        }
+    }
+
+    /// The name of `value`, if it is a named one.
+    pub fn name_of(&self, value: u32) -> Option<&'static str> {
+        self.named
+            .iter()
+            .find(|named| named.value == value)
+            .map(|named| named.name)
     }
 }
 
@@ -201,6 +268,10 @@ pub struct FamilySpec {
 /// PMVC's default cube-map resolution (texels along one face edge).
 pub const DEFAULT_RESOLUTION: u32 = 32;
 
+/// PMVC's resolution "exact": the visible cage integrated in closed form, with
+/// no cube map ([`super::exact_pmvc`]).
+pub const EXACT_RESOLUTION: u32 = 0;
+
 // The distance is mvc::FAR_FIELD_DIAGONALS; a test keeps the two in step.
 const OUTSIDE_BY_MVC: &str = "vertices outside the cage get MVC weights (their affine \
      extension beyond 4 cage diagonals), which sum to one and reproduce their points";
@@ -224,11 +295,18 @@ const RESOLUTION: ParameterSpec = ParameterSpec {
     key: Parameter::Resolution,
     label: "PMVC resolution",
     flag: "--resolution",
-    choices: &[16, 32, 64, 128],
+    choices: &[16, 32, 64, 128, EXACT_RESOLUTION],
     default: DEFAULT_RESOLUTION,
     min: 1,
     max: 1024,
-    format: |value| format!("{value}²"),
+    named: &[NamedValue {
+        value: EXACT_RESOLUTION,
+        name: "exact",
+    }],
+    format: |value| match value {
+        EXACT_RESOLUTION => "exact".to_owned(),
+        side => format!("{side}²"),
+    },
 };
 
 /// Harmonic coordinates' grid: fewer than `MIN_GRID` cells cannot resolve a
@@ -241,13 +319,14 @@ const GRID: ParameterSpec = ParameterSpec {
     default: super::harmonic::DEFAULT_GRID,
     min: super::harmonic::MIN_GRID,
     max: 2048,
+    named: &[],
     format: |value| format!("grid {value}"),
 };
 
 const PMVC: FamilySpec = FamilySpec {
     id: "pmvc",
     name: "PMVC",
-    summary: "positive mean value coordinates: only the visible cage counts (cube map)",
+    summary: "positive mean value coordinates: only the visible cage counts (cube map, or exact)",
     parameter: Some(RESOLUTION),
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
@@ -459,7 +538,18 @@ mod tests {
         );
         let error = Parameter::Resolution.validate(1 << 40).unwrap_err();
         assert!(error.to_string().contains("1099511627776"), "{error}");
-        assert!(Parameter::Resolution.validate(0).is_err());
+        // 0 is exact PMVC's code: stored options hold it, a user names it.
+        assert_eq!(Parameter::Resolution.validate(0), Ok(EXACT_RESOLUTION));
+        let spec = Parameter::Resolution.spec();
+        assert!(spec.validate_number(0).is_err());
+        assert_eq!(spec.parse(" Exact "), Ok(EXACT_RESOLUTION));
+        assert_eq!(spec.parse("64"), Ok(64));
+        let refused = spec.parse("0").unwrap_err();
+        assert!(
+            refused.ends_with("must be 1 to 1024, or \"exact\""),
+            "{refused}"
+        );
+        assert!(Parameter::Grid.spec().parse("exact").is_err());
         assert!(Parameter::Grid.validate(3).is_err());
         assert_eq!(Parameter::Resolution.validate(1024), Ok(1024));
         assert_eq!(Parameter::Grid.validate(4), Ok(4));

@@ -22,27 +22,32 @@
 //! their extra triangle columns, so their rows ignore the point's class.
 
 pub mod cubemap;
+pub mod dtype;
 pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;
 pub mod mec;
 pub mod mvc;
+pub mod parameter_values;
 pub mod pmvc;
+mod progress;
 pub mod qmvc;
 pub mod quality;
 pub mod split_effect;
 
 pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass, PointClasses};
+pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
-    FamilySpec, Method, Parameter, ParameterError, ParameterSpec, QuadSupport, WeightsId,
-    DEFAULT_RESOLUTION,
+    FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
+    WeightsId, DEFAULT_RESOLUTION, EXACT_RESOLUTION,
 };
 use glam::DVec3;
+pub use pmvc::PmvcIntegration;
+pub use progress::{BindProgress, Cancelled};
 pub use quality::WeightQuality;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// How many of `total` points lie outside the cage, and the first few (0-based,
 /// ascending `outside`): the warning of a bind with outside points, and the
@@ -140,12 +145,21 @@ impl BindOptions {
         crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
-    /// How the cage's quads are split for this bind, if they are.
+    /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
+    pub fn pmvc_exact(&self) -> bool {
+        self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
+    }
+
+    /// How the cage's quads are split for this bind, if they are. Exact PMVC
+    /// integrates triangles only, so quads are split as for Green coordinates.
     pub fn split_applied(&self, cage: &Cage) -> Option<QuadSplit> {
         if !cage.has_quads() {
             return None;
         }
         match (self.quads, self.method.spec().quads) {
+            (QuadSplit::None, QuadSupport::Patches { .. }) if self.pmvc_exact() => {
+                Some(QuadSplit::Shorter)
+            }
             (QuadSplit::None, QuadSupport::Patches { .. }) => None,
             (QuadSplit::None, QuadSupport::Triangles) => Some(QuadSplit::Shorter),
             (split, _) => Some(split),
@@ -171,6 +185,11 @@ impl BindOptions {
         let split = self.split_applied(cage)?;
         let count = cage.quads().len();
         let spec = self.method.spec();
+        if self.pmvc_exact() && self.quads == QuadSplit::None {
+            return Some(format!(
+                "notice: exact PMVC integrate triangles: the cage's {count} quads were split along the shorter diagonal (--triangulate longer for the other one)"
+            ));
+        }
         Some(match spec.quads {
             QuadSupport::Triangles => format!(
                 "notice: {} are bound on triangles: the cage's {count} quads were split along the {} diagonal ({})",
@@ -249,18 +268,7 @@ impl Weights {
             "one displacement per weights column"
         );
         assert_eq!(rest.len(), self.rows, "one rest position per weights row");
-        self.values
-            .par_chunks(self.cols.max(1))
-            .take(self.rows)
-            .zip(rest.par_iter())
-            .map(|(row, &p)| {
-                p + row
-                    .iter()
-                    .zip(moves)
-                    .map(|(&w, &d)| f64::from(w) * d)
-                    .sum::<DVec3>()
-            })
-            .collect()
+        dtype::displaced(&self.values, rest, moves)
     }
 
     /// Smallest weight in the matrix; infinity for an empty one.
@@ -269,65 +277,43 @@ impl Weights {
     }
 }
 
-/// Progress and cancellation shared between a running bind and its observers:
-/// the one progress type of every bind, CPU or GPU, command line or editor.
-#[derive(Debug, Default)]
-pub struct BindProgress {
-    total: usize,
-    done: AtomicUsize,
-    cancel: AtomicBool,
+/// Weights of either dtype: what a bind gives and a weights file holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyWeights {
+    F32(Weights),
+    F64(WeightsF64),
 }
 
-impl BindProgress {
-    /// Progress of a bind of `total` rows.
-    pub fn new(total: usize) -> Self {
-        Self {
-            total,
-            ..Self::default()
+impl AnyWeights {
+    pub fn rows(&self) -> usize {
+        match self {
+            AnyWeights::F32(weights) => weights.rows,
+            AnyWeights::F64(weights) => weights.rows,
         }
     }
 
-    /// Rows finished so far; never decreases, never exceeds [`Self::total`] once
-    /// a total is set.
-    pub fn done(&self) -> usize {
-        let done = self.done.load(Ordering::Relaxed);
-        if self.total > 0 {
-            done.min(self.total)
-        } else {
-            done
+    pub fn cols(&self) -> usize {
+        match self {
+            AnyWeights::F32(weights) => weights.cols,
+            AnyWeights::F64(weights) => weights.cols,
         }
     }
 
-    pub fn total(&self) -> usize {
-        self.total
-    }
-
-    /// Share done, in [0, 1]; 1 for an empty bind.
-    pub fn fraction(&self) -> f32 {
-        if self.total == 0 {
-            1.0
-        } else {
-            self.done() as f32 / self.total as f32
+    pub fn dtype(&self) -> Dtype {
+        match self {
+            AnyWeights::F32(_) => Dtype::Float32,
+            AnyWeights::F64(_) => Dtype::Float64,
         }
     }
 
-    pub fn cancel(&self) {
-        self.cancel.store(true, Ordering::Relaxed);
-    }
-
-    pub fn is_cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
-    }
-
-    pub fn advance(&self, rows: usize) {
-        self.done.fetch_add(rows, Ordering::Relaxed);
+    /// [`Weights::apply_displacements`], whatever the dtype.
+    pub fn apply_displacements(&self, rest: &[DVec3], moves: &[DVec3]) -> Vec<DVec3> {
+        match self {
+            AnyWeights::F32(weights) => weights.apply_displacements(rest, moves),
+            AnyWeights::F64(weights) => weights.apply_displacements(rest, moves),
+        }
     }
 }
-
-/// The bind was cancelled; no weights were produced.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("binding was cancelled")]
-pub struct Cancelled;
 
 /// Why a CPU bind produced no weights.
 #[derive(Debug, thiserror::Error)]
@@ -394,16 +380,61 @@ pub fn bind_cpu(
     Ok(weights)
 }
 
+/// [`bind_cpu`] into float64 weights: every row as computed, without the
+/// rounding to float32. Harmonic coordinates, solved in float32 on their grid,
+/// come widened (front ends refuse `Dtype::Float64` for them:
+/// [`Dtype::check_family`]).
+pub fn bind_cpu_f64(
+    points: &[DVec3],
+    classes: &[PointClass],
+    cage: &Cage,
+    options: BindOptions,
+    progress: &BindProgress,
+) -> Result<WeightsF64, BindFailure> {
+    options.validate()?;
+    let columns = options.method.columns(&options.cage_to_bind(cage));
+    crate::budget::check_memory(
+        || {
+            format!(
+                "the weights ({} rows × {columns} columns × 8 bytes)",
+                points.len()
+            )
+        },
+        crate::budget::bytes_for(points.len() as u64, 8 * columns as u64),
+    )?;
+    if options.method == Method::Harmonic {
+        let weights = bind_cpu(points, classes, cage, options, progress)?;
+        return Ok(WeightsF64 {
+            rows: weights.rows,
+            cols: weights.cols,
+            values: weights.values.iter().map(|&w| f64::from(w)).collect(),
+        });
+    }
+    let mut weights = WeightsF64::zeros(points.len(), columns);
+    let rows: Vec<usize> = (0..points.len()).collect();
+    bind_rows(
+        points,
+        classes,
+        cage,
+        options,
+        &rows,
+        &mut weights.values,
+        progress,
+    )?;
+    Ok(weights)
+}
+
 /// The one row loop of every CPU bind: fill `out` (`rows.len()` × the method's
-/// columns, row-major) with the weights of `points[rows[k]]`, in parallel, advancing
-/// `progress` and stopping early when it is cancelled.
-pub fn bind_rows(
+/// columns, row-major, float32 or float64) with the weights of `points[rows[k]]`,
+/// computed in f64, in parallel, advancing `progress` and stopping early when it
+/// is cancelled.
+pub fn bind_rows<T: WeightValue>(
     points: &[DVec3],
     classes: &[PointClass],
     cage: &Cage,
     options: BindOptions,
     rows: &[usize],
-    out: &mut [f32],
+    out: &mut [T],
     progress: &BindProgress,
 ) -> Result<(), Cancelled> {
     assert_eq!(points.len(), classes.len(), "one class per point");
@@ -417,7 +448,7 @@ pub fn bind_rows(
     if cols == 0 || rows.is_empty() {
         return Ok(());
     }
-    let table = cubemap::TexelTable::new(options.resolution.max(1));
+    let integration = PmvcIntegration::of(options);
     let green_cage = (options.method == Method::Green).then(|| green::GreenCage::new(cage));
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
@@ -436,13 +467,13 @@ pub fn bind_rows(
                             classes[i],
                             cage,
                             options.method,
-                            &table,
+                            &integration,
                             row_f64,
                             scratch,
                         );
                     }
                     for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
-                        *out = value as f32;
+                        *out = T::from_f64(value);
                     }
                 }
                 progress.advance(block_rows.len());
@@ -475,7 +506,7 @@ pub fn weights_at(
     class: PointClass,
     cage: &Cage,
     method: Method,
-    table: &cubemap::TexelTable,
+    integration: &PmvcIntegration,
     out: &mut [f64],
     scratch: &mut RowScratch,
 ) {
@@ -524,7 +555,7 @@ pub fn weights_at(
                 mvc::mvc_weights(x, cage, out, mvc_scratch)
             }
             Method::Pmvc => {
-                if !pmvc::pmvc_weights_inside(x, cage, table, out, pmvc_scratch) {
+                if !integration.weights_inside(x, cage, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the
                     // surface or in a cage defect). Follow the outside policy.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);

@@ -60,6 +60,45 @@ pub enum LoadError {
         count: usize,
         limit: usize,
     },
+    /// The object asked for by name is not one of the file's.
+    #[error("{path}: {source}", path = shown_path(path))]
+    Object { path: PathBuf, source: ObjectError },
+}
+
+/// An object asked for by name (`--mesh-object`, `object=`) that the file
+/// cannot give.
+#[derive(Debug, thiserror::Error)]
+pub enum ObjectError {
+    #[error("no object is named '{name}'; the file has {}", object_list(names))]
+    NotFound { name: String, names: Vec<String> },
+    #[error(
+        "{count} objects are named '{name}', so which one is meant is unclear; the file has {}",
+        object_list(names)
+    )]
+    Ambiguous {
+        name: String,
+        count: usize,
+        names: Vec<String>,
+    },
+    #[error("{format} files hold one unnamed object, so there is no object '{name}' to read")]
+    Unnamed { name: String, format: &'static str },
+}
+
+/// Object names as messages list them: quoted, the first twenty, then how
+/// many more.
+pub fn object_list(names: &[String]) -> String {
+    const SHOWN: usize = 20;
+    if names.is_empty() {
+        return "no named objects".to_owned();
+    }
+    let quoted: Vec<String> = names.iter().take(SHOWN).map(|n| format!("'{n}'")).collect();
+    let more = names.len().saturating_sub(SHOWN);
+    let list = quoted.join(", ");
+    match (names.len(), more) {
+        (1, _) => format!("one object, {list}"),
+        (count, 0) => format!("{count} objects: {list}"),
+        (count, more) => format!("{count} objects: {list} and {more} more"),
+    }
 }
 
 /// A cage file could not be read, or was read but is not a valid cage.

@@ -2,6 +2,7 @@
 //! [`super::write_atomically`].
 
 use super::error::{CageLoadError, WriteError};
+use super::mtllib::{LibraryPaths, MovedLibrary};
 use super::npy::points::read_points_npy;
 use super::obj::MAX_VERTICES;
 use super::output::write_atomically;
@@ -109,11 +110,51 @@ fn count_lines(text: &[u8]) -> (u64, u64, u64, u64) {
 /// the memory available, and no further than a NUL byte. A `.npy` is read by
 /// [`super::points_npy`]'s rules: an (n, 3) array of finite float32 or float64.
 pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
+    load_mesh_object(path, None)
+}
+
+/// The one check of an object name asked for (`--mesh-object`, `object=`):
+/// some text, as every name the readers list is.
+pub fn check_object_name(name: &str) -> Result<&str, String> {
+    if name.trim().is_empty() {
+        return Err("an object name cannot be empty".to_owned());
+    }
+    Ok(name)
+}
+
+/// [`load_mesh`], reading object `object` of a file with several: a glTF's
+/// node or mesh of that name ([`super::gltf::MeshPick::Object`]), an OBJ's
+/// `o` object (its faces and the vertices they use, re-indexed in file
+/// order; see [`super::obj`]). Without a name an OBJ's objects are read
+/// together and a glTF's first mesh alone, and [`MeshFile::object_note`]
+/// says so where the file has several. OFF and `.npy` files have no named
+/// objects, so a name is an error there.
+pub fn load_mesh_object(path: &Path, object: Option<&str>) -> Result<MeshFile, LoadError> {
     let format = format_of(path)?;
+    let unnamed = |format: &'static str| match object {
+        Some(name) => Err(LoadError::Object {
+            path: path.to_owned(),
+            source: super::ObjectError::Unnamed {
+                name: name.to_owned(),
+                format,
+            },
+        }),
+        None => Ok(()),
+    };
     match format {
-        MeshFormat::Npy => return read_points_npy(path, MAX_VERTICES),
-        MeshFormat::Gltf => return super::gltf::load_gltf(path, &super::gltf::MeshPick::First),
-        MeshFormat::Obj | MeshFormat::Off => {}
+        MeshFormat::Npy => {
+            unnamed(".npy")?;
+            return read_points_npy(path, MAX_VERTICES);
+        }
+        MeshFormat::Gltf => {
+            let pick = match object {
+                Some(name) => super::gltf::MeshPick::Object(name.to_owned()),
+                None => super::gltf::MeshPick::First,
+            };
+            return super::gltf::load_gltf(path, &pick);
+        }
+        MeshFormat::Off => unnamed("OFF")?,
+        MeshFormat::Obj => {}
     }
     let io_error = |source| LoadError::Io {
         path: path.to_owned(),
@@ -178,7 +219,11 @@ pub fn load_mesh(path: &Path) -> Result<MeshFile, LoadError> {
             })
         }
     };
-    parse_mesh(path, text)
+    let file = parse_mesh(path, text)?;
+    match format {
+        MeshFormat::Obj => obj::pick_object(path, file, object),
+        _ => Ok(file),
+    }
 }
 
 /// Parse the text of an OBJ, OFF or `.gltf` file named `path` (the format chosen
@@ -212,6 +257,18 @@ pub fn parse_mesh(path: &Path, text: String) -> Result<MeshFile, LoadError> {
 /// Read a cage file and validate it (see [`Cage::new`]).
 pub fn load_cage(path: &Path) -> Result<(Cage, CageReport), CageLoadError> {
     cage_from_file(path, load_mesh(path)?)
+}
+
+/// [`load_cage`] of object `object` ([`load_mesh_object`]), and the note of
+/// which object was read where none was asked for and the file has several.
+pub fn load_cage_object(
+    path: &Path,
+    object: Option<&str>,
+) -> Result<(Cage, CageReport, Option<String>), CageLoadError> {
+    let mut file = load_mesh_object(path, object)?;
+    let note = file.object_note.take();
+    let (cage, report) = cage_from_file(path, file)?;
+    Ok((cage, report, note))
 }
 
 /// Validate a mesh read from `path` as a cage; errors name the file.
@@ -305,17 +362,21 @@ pub fn write_cage_and_pose(
 /// vertex, written before the first face under a comment that says so), and
 /// every face corner refers to its vertex's normal. Comments that speak of
 /// normals (MeshLab's "# 39028 vertices, 0 vertices normals") would then be
-/// wrong, so they are left out.
+/// wrong, so they are left out. Written to another folder than the source's,
+/// `mtllib` lines name their libraries by paths that resolve from there
+/// ([`super::mtllib`]): what comes back says which, for the caller to tell.
 pub fn write_deformed_mesh(
     file: &MeshFile,
     positions: &[DVec3],
     path: &Path,
-) -> Result<(), WriteError> {
+) -> Result<Vec<MovedLibrary>, WriteError> {
     assert_eq!(
         positions.len(),
         file.mesh.positions.len(),
         "one position per mesh vertex"
     );
+    let libraries = LibraryPaths::new(&file.path, path);
+    let mut moved = Vec::new();
     match (&file.format, &file.obj_text) {
         // A glTF's text is OBJ written from it.
         (MeshFormat::Obj | MeshFormat::Gltf, Some(text)) => write_atomically(path, |out| {
@@ -336,6 +397,13 @@ pub fn write_deformed_mesh(
                     }
                     // Stale after the deformation: recomputed below.
                     Some("vn") => {}
+                    Some("mtllib") if libraries.is_some() => {
+                        let names = line.trim_start()["mtllib".len()..].trim();
+                        let paths = libraries.as_ref().expect("checked by the guard");
+                        let (line, libraries) = paths.rewrite(names);
+                        moved.extend(libraries);
+                        writeln!(out, "{line}")?
+                    }
                     Some(first) if first.starts_with('#') && speaks_of_normals(line) => {}
                     Some("f") => {
                         if !normals_written {
@@ -363,9 +431,10 @@ pub fn write_deformed_mesh(
                 }
             }
             Ok(())
-        }),
-        _ => write_mesh_with_normals(path, positions, &file.mesh.triangles),
+        })?,
+        _ => write_mesh_with_normals(path, positions, &file.mesh.triangles)?,
     }
+    Ok(moved)
 }
 
 /// Write an OBJ of `positions` and `triangles` with recomputed vertex normals

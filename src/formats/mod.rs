@@ -11,6 +11,7 @@ mod error;
 pub mod gltf;
 mod io;
 pub mod metadata;
+mod mtllib;
 pub mod npy;
 pub mod npz;
 mod obj;
@@ -19,11 +20,13 @@ mod output;
 mod ply;
 
 pub use crate::budget::human_bytes;
-pub use error::{shown_path, CageLoadError, LoadError, WriteError};
+pub use error::{object_list, shown_path, CageLoadError, LoadError, ObjectError, WriteError};
 pub use io::{
-    cage_from_file, load_cage, load_mesh, parse_mesh, write_cage_and_pose, write_deformed_mesh,
-    write_mesh_with_normals, write_obj, write_obj_to, write_polygons_obj_to,
+    cage_from_file, check_object_name, load_cage, load_cage_object, load_mesh, load_mesh_object,
+    parse_mesh, write_cage_and_pose, write_deformed_mesh, write_mesh_with_normals, write_obj,
+    write_obj_to, write_polygons_obj_to,
 };
+pub use mtllib::MovedLibrary;
 pub use npy::points::write_points_npy;
 pub use output::{
     extension_warning, refuse_same_file, refuse_unwritable, remove_unfinished_outputs,
@@ -56,6 +59,13 @@ pub struct MeshFile {
     /// glTF file, OBJ text written from its mesh (positions, texture coordinates,
     /// primitives as groups), which is what was parsed.
     pub obj_text: Option<String>,
+    /// For a glTF mesh, the world transform of the node it was read through,
+    /// already applied to `mesh.positions`: a glTF export puts it back on its
+    /// node. `None` for other formats and for the identity.
+    pub node_transform: Option<glam::DMat4>,
+    /// Where the file has several objects and none was asked for, which was
+    /// read ("the file has 3 objects: …; …"), for the caller to say.
+    pub object_note: Option<String>,
 }
 
 /// What `path` is when it is not a regular file ("a named pipe", "a device",

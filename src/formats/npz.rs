@@ -1,15 +1,16 @@
 //! Green coordinates as a NumPy `.npz` archive, what `pmvc bind --method green`
-//! writes and `pmvc deform --weights` reads: two float32 arrays in C order,
+//! writes and `pmvc deform --weights` reads: two float32 arrays in C order
+//! (float64 with `--dtype f64`),
 //! `phi` (points × cage vertices) and `psi` (points × cage triangles, in the order
 //! the cage's faces are triangulated, [`crate::geometry::Cage::triangles`]).
 //! Entries are stored uncompressed, as `numpy.savez` writes them; `np.load` reads
 //! the file. In memory the two are one [`Weights`] matrix, φ columns then ψ.
 
 use super::npy::{
-    allocate, npy_preamble, open, read_array_header, read_values, write_f32_values, ArrayAt,
-    ExpectedArray, NpyError,
+    allocate, npy_preamble_of, open, read_array_header, read_values, write_values, ArrayAt,
+    ExpectedArray, LeBytes, NpyError,
 };
-use crate::coords::Weights;
+use crate::coords::{Dtype, Weights, WeightsF64};
 use crate::formats::{PendingOutput, WriteSeek};
 use std::io::{Read, Seek, Write as _};
 use std::path::Path;
@@ -21,7 +22,12 @@ pub const PSI: &str = "psi";
 /// The size of the archive [`write_npz_to`] writes, less the zip headers (a few
 /// hundred bytes): for the free-space check.
 pub fn npz_payload_bytes(rows: usize, cols: usize) -> u64 {
-    super::npy::npy_file_bytes(rows, cols)
+    npz_payload_bytes_of(rows, cols, Dtype::Float32)
+}
+
+/// [`npz_payload_bytes`] for values of `dtype`.
+pub fn npz_payload_bytes_of(rows: usize, cols: usize, dtype: Dtype) -> u64 {
+    super::npy::npy_file_bytes_of(rows, cols, dtype)
 }
 
 /// Write `weights` (φ in the first `vertex_columns` columns, ψ after them) as the
@@ -33,7 +39,13 @@ pub fn write_npz_to(
     vertex_columns: usize,
 ) -> Result<(), NpyError> {
     // The preambles are checked before anything is written.
-    npz_preambles(path, weights, vertex_columns)?;
+    npz_preambles(
+        path,
+        weights.rows,
+        weights.cols,
+        vertex_columns,
+        Dtype::Float32,
+    )?;
     output.finish_seekable(|out| write_npz(out, path, weights, vertex_columns))?;
     Ok(())
 }
@@ -43,22 +55,24 @@ type NpzParts = [(&'static str, std::ops::Range<usize>, Vec<u8>); 2];
 
 fn npz_preambles(
     path: &Path,
-    weights: &Weights,
+    rows: usize,
+    cols: usize,
     vertex_columns: usize,
+    dtype: Dtype,
 ) -> Result<NpzParts, NpyError> {
-    let vertex_columns = vertex_columns.min(weights.cols);
+    let vertex_columns = vertex_columns.min(cols);
     let phi = 0..vertex_columns;
-    let psi = vertex_columns..weights.cols;
+    let psi = vertex_columns..cols;
     Ok([
         (
             PHI,
             phi.clone(),
-            npy_preamble(path, weights.rows, phi.len())?,
+            npy_preamble_of(path, rows, phi.len(), dtype)?,
         ),
         (
             PSI,
             psi.clone(),
-            npy_preamble(path, weights.rows, psi.len())?,
+            npy_preamble_of(path, rows, psi.len(), dtype)?,
         ),
     ])
 }
@@ -70,10 +84,23 @@ pub fn write_npz(
     weights: &Weights,
     vertex_columns: usize,
 ) -> std::io::Result<()> {
-    let parts = npz_preambles(path, weights, vertex_columns).map_err(std::io::Error::other)?;
+    write_npz_values(out, path, (&weights.values, weights.cols), vertex_columns)
+}
+
+/// [`write_npz`] of a row-major matrix of either dtype, given as its values and
+/// its number of columns.
+pub fn write_npz_values<T: LeBytes>(
+    out: &mut dyn WriteSeek,
+    path: &Path,
+    (values, cols): (&[T], usize),
+    vertex_columns: usize,
+) -> std::io::Result<()> {
+    let rows = values.len() / cols.max(1);
+    let parts =
+        npz_preambles(path, rows, cols, vertex_columns, T::DTYPE).map_err(std::io::Error::other)?;
     let mut zip = zip::ZipWriter::new(out);
     for (name, columns, preamble) in &parts {
-        let bytes = preamble.len() as u64 + 4 * (weights.rows * columns.len()) as u64;
+        let bytes = preamble.len() as u64 + (T::DTYPE.size() * rows * columns.len()) as u64;
         let options = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Stored)
             .large_file(bytes >= u64::from(u32::MAX));
@@ -81,12 +108,8 @@ pub fn write_npz(
             .map_err(std::io::Error::other)?;
         zip.write_all(preamble)?;
         // Row by row: each array is a column range of the joint matrix.
-        for row in weights
-            .values
-            .chunks(weights.cols.max(1))
-            .take(weights.rows)
-        {
-            write_f32_values(&mut zip, &row[columns.clone()])?;
+        for row in values.chunks(cols.max(1)).take(rows) {
+            write_values(&mut zip, &row[columns.clone()])?;
         }
     }
     zip.finish().map_err(std::io::Error::other)?;
@@ -98,13 +121,42 @@ pub fn write_npz(
 /// by [`write_npz_to`] (or `numpy.savez(path, phi=…, psi=…)`), as one matrix, φ
 /// columns then ψ. Both arrays' headers are checked against those sizes and the
 /// bytes the archive holds before the matrix is allocated; values must be finite
-/// and each row of φ must sum to 1 (as for [`read_npy`]).
+/// and each row of φ must sum to 1 (as for [`super::npy::read_npy`]).
 pub fn read_npz(
     path: &Path,
     rows: usize,
     cage_vertices: usize,
     cage_triangles: usize,
 ) -> Result<Weights, NpyError> {
+    let values = read_npz_values::<f32>(path, rows, cage_vertices, cage_triangles)?;
+    Ok(Weights {
+        rows,
+        cols: cage_vertices + cage_triangles,
+        values,
+    })
+}
+
+/// [`read_npz`] of float64 arrays, as `pmvc bind --dtype f64` writes them.
+pub fn read_npz_f64(
+    path: &Path,
+    rows: usize,
+    cage_vertices: usize,
+    cage_triangles: usize,
+) -> Result<WeightsF64, NpyError> {
+    let values = read_npz_values::<f64>(path, rows, cage_vertices, cage_triangles)?;
+    Ok(WeightsF64 {
+        rows,
+        cols: cage_vertices + cage_triangles,
+        values,
+    })
+}
+
+fn read_npz_values<T: LeBytes>(
+    path: &Path,
+    rows: usize,
+    cage_vertices: usize,
+    cage_triangles: usize,
+) -> Result<Vec<T>, NpyError> {
     let (file, file_bytes) = open(path)?;
     let mut archive =
         zip::ZipArchive::new(std::io::BufReader::new(file)).map_err(|source| NpyError::NotNpz {
@@ -131,27 +183,28 @@ pub fn read_npz(
     // Both headers before anything is allocated.
     for (name, expected, _) in arrays {
         let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
-        read_array_header(&mut entry, present, &at(name), expected)?;
+        read_array_header(&mut entry, present, &at(name), expected, T::DTYPE)?;
     }
     let whole = ArrayAt {
         path: path.to_owned(),
         array: None,
     };
-    let mut weights = allocate(&whole, rows, cage_vertices + cage_triangles)?;
+    let columns = cage_vertices + cage_triangles;
+    let mut values = allocate::<T>(&whole, rows, columns)?;
     for (name, expected, first_column) in arrays {
         let (mut entry, present) = open_entry(&mut archive, path, name, file_bytes)?;
         let mut entry = std::io::BufReader::new(&mut entry);
-        let data_present = read_array_header(&mut entry, present, &at(name), expected)?;
+        let data_present = read_array_header(&mut entry, present, &at(name), expected, T::DTYPE)?;
         read_values(
             &mut entry,
             &at(name),
             expected,
             data_present,
-            &mut weights,
+            (&mut values, columns),
             first_column,
         )?;
     }
-    Ok(weights)
+    Ok(values)
 }
 
 /// The entry `name`.npy, stored (not compressed), and the bytes it holds: the
@@ -245,7 +298,7 @@ mod tests {
         let mut zip = zip::ZipWriter::new(file);
         zip.start_file("phi.npy", zip::write::SimpleFileOptions::default())
             .expect("entry");
-        zip.write_all(&npy_preamble(&path, 1, 1).expect("preamble"))
+        zip.write_all(&npy_preamble_of(&path, 1, 1, Dtype::Float32).expect("preamble"))
             .expect("write");
         zip.write_all(&1f32.to_le_bytes()).expect("write");
         zip.start_file("weights.npy", zip::write::SimpleFileOptions::default())

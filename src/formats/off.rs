@@ -138,5 +138,7 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
         format: MeshFormat::Off,
         mesh,
         obj_text: None,
+        node_transform: None,
+        object_note: None,
     })
 }

@@ -90,12 +90,14 @@ pub struct Work {
     /// Quads the family binds as bilinear patches (0 when they are split).
     pub cage_quads: usize,
     pub cpu_threads: usize,
+    /// Exact PMVC ([`BindOptions::pmvc_exact`]), which has no GPU kernel.
+    pub pmvc_exact: bool,
 }
 
 impl Work {
     /// `points` bound to `cage` with `options`, on this process's CPU threads.
     pub fn of(options: BindOptions, points: usize, cage: &Cage) -> Self {
-        let texels = if options.method == Method::Pmvc {
+        let texels = if options.method == Method::Pmvc && !options.pmvc_exact() {
             let side = options.resolution as usize;
             6 * side * side
         } else {
@@ -112,11 +114,15 @@ impl Work {
                 Some(_) => 0,
             },
             cpu_threads: rayon::current_num_threads(),
+            pmvc_exact: options.pmvc_exact(),
         }
     }
 
     /// The GPU kernel for this work, if any ([`Kernel::for_cage`]).
     pub fn kernel(&self) -> Option<Kernel> {
+        if self.pmvc_exact {
+            return None;
+        }
         Kernel::of_work(self.method, self.cage_quads > 0)
     }
 
@@ -124,6 +130,9 @@ impl Work {
     pub fn no_kernel_reason(&self) -> Option<&'static str> {
         match (self.kernel(), Kernel::of(self.method)) {
             (Some(_), _) => None,
+            (None, _) if self.pmvc_exact => {
+                Some("exact PMVC integrate on the CPU: they have no GPU kernel")
+            }
             (None, Some(_)) => Some("MVC on a cage with quads is QMVC, which has no GPU kernel"),
             (None, None) => Some("this family has no GPU kernel"),
         }

@@ -15,6 +15,7 @@ fn work(method: Method, points: usize, cage_vertices: usize, cpu_threads: usize)
         cage_vertices,
         cage_quads: 0,
         cpu_threads,
+        pmvc_exact: false,
     }
 }
 

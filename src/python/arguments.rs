@@ -85,3 +85,13 @@ pub(super) fn path(value: &Bound<'_, PyAny>, what: &str) -> PyResult<PathBuf> {
         )
     })
 }
+
+/// `object=`: None, or an object's name, checked as `--mesh-object` is.
+pub(super) fn object_name(value: Option<Bound<'_, PyAny>>) -> PyResult<Option<String>> {
+    let Some(value) = value.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    let name = text(&value, "object")?;
+    crate::formats::check_object_name(&name).map_err(|message| error(Kind::Parameter, message))?;
+    Ok(Some(name))
+}

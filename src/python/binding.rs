@@ -5,11 +5,16 @@
 //! once the work has stopped (within one block of rows or one GPU batch).
 
 use super::arguments::{flag, shown, text};
-use super::arrays::{matrix, positions};
+use super::arrays::positions;
+use super::bind_arguments::{
+    bind_options, dtype_argument, method_argument, method_from, pmvc_kernel_from,
+};
 use super::errors::{backend_warning, error, Kind};
 use super::scene::{cage_argument, PyCage};
 use super::weights::PyWeights;
-use crate::coords::{BindOptions, BindProgress, Method, Parameter, QuadSplit};
+use crate::coords::{
+    bind_cpu_f64, AnyWeights, BindOptions, BindProgress, Dtype, DtypeError, Method,
+};
 use crate::formats::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
 use crate::gpu::{Backend, BindConfig, BindError, BindInput, Binder, PmvcKernel};
@@ -130,88 +135,15 @@ fn choose_backend(
         .map_err(|cause| error(Kind::Backend, format!("backend \"{choice}\": {cause}")))
 }
 
-/// `triangulate`: "shorter" or "longer" (None keeps quads as bilinear patches).
-fn quad_split_from(value: &Bound<'_, PyAny>) -> PyResult<QuadSplit> {
-    let bad = || {
-        error(
-            Kind::Parameter,
-            format!("triangulate must be None, \"shorter\" or \"longer\", not {value}"),
-        )
-    };
-    let id: String = value.extract().map_err(|_| bad())?;
-    match QuadSplit::from_id(&id) {
-        Some(split) if split != QuadSplit::None => Ok(split),
-        _ => Err(bad()),
-    }
-}
-
-/// The family named `id`, or an error listing the known ones.
-pub(super) fn method_from(id: &str) -> PyResult<Method> {
-    Method::from_id(id).ok_or_else(|| {
-        let known: Vec<&str> = Method::ALL.iter().map(|m| m.id()).collect();
-        error(
-            Kind::Parameter,
-            format!(
-                "method \"{id}\" is not a family; known: {}",
-                known.join(", ")
-            ),
-        )
-    })
-}
-
-/// A parameter's value from Python, checked by its spec's one `validate`.
-fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u32> {
-    let spec = parameter.spec();
-    let value: i128 = value.extract().map_err(|_| {
-        error(
-            Kind::Parameter,
-            format!("{} must be an integer, not {value}", parameter.id()),
-        )
-    })?;
-    // Below zero or past u64 it is out of range all the same; the spec's
-    // message gives the range.
-    let clamped = u64::try_from(value).unwrap_or(u64::MAX);
-    spec.validate(clamped).map_err(|cause| {
-        let message = cause
-            .to_string()
-            .replacen(&clamped.to_string(), &value.to_string(), 1);
-        error(Kind::Parameter, message)
-    })
-}
-
-/// The options of a bind of `method` with `resolution` and `grid`: the
-/// family's own parameter is checked, the others are not read.
-/// A parameter not given keeps its default.
-pub(super) fn bind_options(
-    method: Method,
-    resolution: Option<&Bound<'_, PyAny>>,
-    grid: Option<&Bound<'_, PyAny>>,
-    triangulate: Option<&Bound<'_, PyAny>>,
-) -> PyResult<BindOptions> {
-    let mut options = BindOptions::for_method(method);
-    if let Some(given) = triangulate.filter(|value| !value.is_none()) {
-        options.quads = quad_split_from(given)?;
-    }
-    if let Some(spec) = method.spec().parameter {
-        let given = match spec.key {
-            Parameter::Resolution => resolution,
-            Parameter::Grid => grid,
-        };
-        if let Some(given) = given.filter(|value| !value.is_none()) {
-            options.set(spec.key, parameter_value(spec.key, given)?);
-        }
-    }
-    options
-        .validate()
-        .map_err(|cause| error(Kind::Parameter, cause.to_string()))?;
-    Ok(options)
-}
-
 /// Bind ``points`` to ``cage`` with one family: a :class:`Weights` whose
-/// ``matrix`` is float32 (n, columns), bit-for-bit what ``pmvc bind`` writes.
+/// ``matrix`` is float32 (n, columns), bit-for-bit what ``pmvc bind`` writes;
+/// ``dtype=numpy.float64`` keeps every row as computed, in float64 (on the CPU;
+/// not for harmonic coordinates, solved in float32 on their grid), as ``pmvc
+/// bind --dtype f64``.
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
-/// cube-map resolution, ``grid`` harmonic coordinates' grid (each read only by
+/// cube-map resolution (or ``"exact"``: no cube map, the visible cage
+/// integrated in closed form on the CPU), ``grid`` harmonic coordinates' grid (each read only by
 /// its family). A cage's quads are bilinear patches (MVC on them is QMVC);
 /// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
 /// first, as before quads were patches (Green coordinates always bind on
@@ -226,8 +158,8 @@ pub(super) fn bind_options(
 /// GIL is released while binding; Ctrl-C cancels within about a second.
 #[pyfunction]
 #[pyo3(
-    signature = (points, cage, method=None, resolution=None, grid=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False)"
+    signature = (points, cage, method=None, resolution=None, grid=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None, dtype=None),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False, dtype='float32')"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(
@@ -242,6 +174,7 @@ pub(super) fn bind<'py>(
     triangulate: Option<Bound<'py, PyAny>>,
     pmvc_kernel: Option<Bound<'py, PyAny>>,
     strict: Option<Bound<'py, PyAny>>,
+    dtype: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyWeights> {
     let method = method_argument(method.as_ref())?;
     let options = bind_options(
@@ -255,6 +188,7 @@ pub(super) fn bind<'py>(
         backend.as_ref(),
         pmvc_kernel.as_ref(),
         strict.as_ref(),
+        dtype.as_ref(),
     )?;
     let cage = cage_argument(cage)?;
     let points = positions(points, "points")?;
@@ -267,15 +201,18 @@ pub(super) struct HowToBind {
     pub backend: String,
     pub pmvc_kernel: PmvcKernel,
     pub strict: bool,
+    pub dtype: Dtype,
 }
 
 impl HowToBind {
-    /// `backend=`, `pmvc_kernel=` and `strict=` of `function` (None: the defaults).
+    /// `backend=`, `pmvc_kernel=`, `strict=` and `dtype=` of `function` (None:
+    /// the defaults).
     fn from_arguments<'py>(
         function: &str,
         backend: Option<&Bound<'py, PyAny>>,
         pmvc_kernel: Option<&Bound<'py, PyAny>>,
         strict: Option<&Bound<'py, PyAny>>,
+        dtype: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         let given =
             |value: Option<&Bound<'py, PyAny>>| value.filter(|value| !value.is_none()).cloned();
@@ -294,24 +231,16 @@ impl HowToBind {
             Some(value) => flag(&value, &format!("{function}: strict"))?,
             None => false,
         };
+        let dtype = match given(dtype) {
+            Some(value) => dtype_argument(&value, function)?,
+            None => Dtype::Float32,
+        };
         Ok(Self {
             backend,
             pmvc_kernel,
             strict,
+            dtype,
         })
-    }
-}
-
-/// `pmvc_kernel=` checked by the command line's one parser.
-fn pmvc_kernel_from(function: &str, text: &str) -> PyResult<PmvcKernel> {
-    PmvcKernel::parse(text).map_err(|cause| error(Kind::Parameter, format!("{function}: {cause}")))
-}
-
-/// `method=`: a family id, "pmvc" when not given.
-pub(super) fn method_argument(value: Option<&Bound<'_, PyAny>>) -> PyResult<Method> {
-    match value.filter(|value| !value.is_none()) {
-        Some(value) => method_from(&text(value, "method")?),
-        None => Ok(Method::Pmvc),
     }
 }
 
@@ -324,10 +253,34 @@ pub(super) fn bind_points(
     how: &HowToBind,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyWeights> {
-    let decision = choose_backend(py, &how.backend, options, points.len(), cage)?;
+    let dtype = how.dtype;
+    dtype
+        .check_family(options.method)
+        .map_err(|cause| error(Kind::Parameter, format!("bind: {cause}")))?;
+    // Float64 weights are computed on the CPU: no GPU is opened for them.
+    let backend_asked = match dtype {
+        Dtype::Float32 => how.backend.as_str(),
+        Dtype::Float64 => {
+            if how.backend == "gpu" {
+                backend_warning(py, &format!("bind: {}", DtypeError::NotOnGpu))?;
+            }
+            // Still checked, so that a bad name is an error whatever the dtype.
+            BackendRequest::from_name(&how.backend).ok_or_else(|| {
+                error(
+                    Kind::Parameter,
+                    format!(
+                        "backend \"{}\" is not one of \"auto\", \"cpu\", \"gpu\"",
+                        how.backend
+                    ),
+                )
+            })?;
+            "cpu"
+        }
+    };
+    let decision = choose_backend(py, backend_asked, options, points.len(), cage)?;
     let pmvc_kernel = how.pmvc_kernel;
     let on_gpu = decision.on_gpu(options.method);
-    if how.backend == "gpu" && !on_gpu {
+    if backend_asked == "gpu" && !on_gpu {
         let label = match options.parameter() {
             Some((spec, value)) => format!(
                 "{} {}",
@@ -345,9 +298,10 @@ pub(super) fn bind_points(
     let device = backend.clone();
     let rows = points.len();
     let columns = options.method.columns(&cage.cage);
+    let size = dtype.size();
     crate::budget::check_memory(
-        || format!("the weights ({rows} rows × {columns} columns × 4 bytes)"),
-        crate::budget::bytes_for(rows as u64, 4 * columns as u64),
+        || format!("the weights ({rows} rows × {columns} columns × {size} bytes)"),
+        crate::budget::bytes_for(rows as u64, (size * columns) as u64),
     )
     .map_err(|cause| error(Kind::TooLarge, format!("bind: {cause}")))?;
     let points: Arc<[glam::DVec3]> = points.into();
@@ -366,18 +320,42 @@ pub(super) fn bind_points(
         if strict && !classified.outside.is_empty() {
             return (classes, classified.outside, None);
         }
-        let input = BindInput {
-            points: bound_points,
-            classes: Arc::clone(&classes),
-            cage: cage_arc,
-            options,
+        let result = match dtype {
+            Dtype::Float32 => {
+                let input = BindInput {
+                    points: Arc::clone(&bound_points),
+                    classes: Arc::clone(&classes),
+                    cage: cage_arc,
+                    options,
+                };
+                Binder::new(backend)
+                    .with_config(BindConfig {
+                        pmvc_kernel,
+                        ..BindConfig::default()
+                    })
+                    .bind_blocking(&input, &shared)
+                    .and_then(|output| {
+                        let weights = output.weights.ok_or(BindError::NothingKept)?;
+                        Ok((
+                            AnyWeights::F32(weights),
+                            output.stats.device,
+                            output.stats.elapsed,
+                        ))
+                    })
+            }
+            Dtype::Float64 => {
+                let started = Instant::now();
+                bind_cpu_f64(&bound_points, &classes, &cage_arc, options, &shared)
+                    .map(|weights| {
+                        (
+                            AnyWeights::F64(weights),
+                            "CPU".to_owned(),
+                            started.elapsed(),
+                        )
+                    })
+                    .map_err(BindError::from)
+            }
         };
-        let result = Binder::new(backend)
-            .with_config(BindConfig {
-                pmvc_kernel,
-                ..BindConfig::default()
-            })
-            .bind_blocking(&input, &shared);
         (classes, classified.outside, Some(result))
     })?;
     let Some(result) = result else {
@@ -388,30 +366,28 @@ pub(super) fn bind_points(
             backend_warning(py, &format!("bind: {notice}"))?;
         }
     }
-    let output = result.map_err(|cause| bind_error(&cause))?;
-    let weights = output
-        .weights
-        .ok_or_else(|| error(Kind::Bind, "internal error: the bind returned no weights"))?;
+    let (weights, device_name, elapsed) = result.map_err(|cause| bind_error(&cause))?;
     let cage_file = cage
         .path
         .as_deref()
         .map(|path| path.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let metadata = WeightsMetadata::new(&BindRecord {
+    let mut metadata = WeightsMetadata::new(&BindRecord {
         options,
         cage: &cage.cage,
         points: &points,
         classes: &classes,
         backend: if on_gpu { "gpu" } else { "cpu" },
-        device: &output.stats.device,
-        seconds: output.stats.elapsed.as_secs_f64(),
+        device: &device_name,
+        seconds: elapsed.as_secs_f64(),
         mesh_file: "",
         cage_file: &cage_file,
         weights_file: Path::new(""),
     });
+    metadata.dtype = dtype.id().to_owned();
     let codes = class_codes(&classes);
     Ok(PyWeights::new(
-        matrix(py, weights.values, weights.rows, weights.cols)?.unbind(),
+        super::weights::matrix_array(py, weights)?,
         numpy::PyArray1::from_vec(py, codes).unbind(),
         metadata,
         options,
@@ -470,7 +446,7 @@ pub(super) fn deform<'py>(
     method: Option<Bound<'py, PyAny>>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const BINDING: [&str; 7] = [
+    const BINDING: [&str; 8] = [
         "resolution",
         "grid",
         "backend",
@@ -478,6 +454,7 @@ pub(super) fn deform<'py>(
         "triangulate",
         "pmvc_kernel",
         "strict",
+        "dtype",
     ];
     let weights = match weights.filter(|value| !value.is_none()) {
         Some(value) => Some(value.cast_into::<PyWeights>().map_err(|refused| {
@@ -519,6 +496,7 @@ pub(super) fn deform<'py>(
         parameter("backend")?.as_ref(),
         parameter("pmvc_kernel")?.as_ref(),
         parameter("strict")?.as_ref(),
+        parameter("dtype")?.as_ref(),
     )?;
     let asked = match method.filter(|value| !value.is_none()) {
         Some(value) => Some(method_from(&text(&value, "deform: method")?)?),

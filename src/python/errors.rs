@@ -87,6 +87,14 @@ pub(super) fn backend_warning(py: Python<'_>, message: &str) -> PyResult<()> {
         .map(|_| ())
 }
 
+/// A `pmvc.PmvcWarning`: which object of a file with several was read.
+pub(super) fn object_warning(py: Python<'_>, message: &str) -> PyResult<()> {
+    let category = py.import("pmvc._errors")?.getattr("PmvcWarning")?;
+    py.import("warnings")?
+        .call_method1("warn", (message, category, 1))
+        .map(|_| ())
+}
+
 /// A mesh file that could not be read, naming the file and line.
 pub(super) fn load_error(error: &LoadError) -> PyErr {
     let message = error.to_string();
@@ -102,6 +110,7 @@ pub(super) fn load_error(error: &LoadError) -> PyErr {
         | LoadError::Obj { path, .. }
         | LoadError::Npy { path, .. }
         | LoadError::Gltf { path, .. }
+        | LoadError::Object { path, .. }
         | LoadError::TooLarge { path, .. } => (path, None),
     };
     let kind = match error {

@@ -20,6 +20,7 @@
 
 mod arguments;
 mod arrays;
+mod bind_arguments;
 mod binding;
 mod errors;
 mod scene;

@@ -204,14 +204,17 @@ impl PyCage {
         Self::from_arrays(py, vertices, faces)
     }
 
-    /// Read and validate a cage from an OBJ or OFF file.
+    /// Read and validate a cage from an OBJ, OFF or glTF file: object
+    /// ``object`` of a file with several, as ``load_mesh`` reads it.
     #[staticmethod]
-    fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let path = super::arguments::path(path, "Cage.load")?;
-        let file = py
-            .detach(|| crate::formats::load_mesh(&path))
-            .map_err(|cause| load_error(&cause))?;
-        Self::validated(file.mesh, Some(path), py)
+    #[pyo3(signature = (path, object=None))]
+    fn load(
+        py: Python<'_>,
+        path: &Bound<'_, PyAny>,
+        object: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let file = read_object(py, path, object, "Cage.load")?;
+        Self::validated(file.mesh, Some(file.path), py)
     }
 
     /// Vertex positions, float64, shape (m, 3), in file order (weights columns
@@ -335,15 +338,20 @@ impl PyCage {
 /// (m, 3) of 0-based indices when every face is a triangle ((0, 3) for a point
 /// set), and a list of polygons (lists of indices) when a face has more
 /// corners, so that quads stay quads.
+///
+/// ``object`` names one object of a file with several (an OBJ's ``o`` name,
+/// a glTF node's or mesh's name): its faces and the vertices they use,
+/// re-indexed in file order. Without it an OBJ's objects are read as one
+/// mesh and a glTF's first mesh alone, with a ``PmvcWarning`` naming the
+/// others; a name the file does not have raises ``FileError`` listing them.
 #[pyfunction]
+#[pyo3(signature = (path, object=None))]
 pub(super) fn load_mesh<'py>(
     py: Python<'py>,
     path: &Bound<'py, PyAny>,
+    object: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let path = super::arguments::path(path, "load_mesh")?;
-    let file = py
-        .detach(|| crate::formats::load_mesh(&path))
-        .map_err(|cause| load_error(&cause))?;
+    let file = read_object(py, path, object, "load_mesh")?;
     let vertices = positions_array(py, &file.mesh.positions)?;
     let polygons = polygons_of(&file.mesh);
     let faces = if polygons.iter().all(|face| face.len() == 3) {
@@ -353,6 +361,29 @@ pub(super) fn load_mesh<'py>(
         faces_list(py, &polygons)?.into_any()
     };
     PyTuple::new(py, [vertices.into_any(), faces])
+}
+
+/// The mesh file `path` (object `object`, when given) for `caller`, with a
+/// warning naming the file's objects where it has several and none was named.
+fn read_object(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    object: Option<Bound<'_, PyAny>>,
+    caller: &str,
+) -> PyResult<crate::formats::MeshFile> {
+    let path = super::arguments::path(path, caller)?;
+    let object = super::arguments::object_name(object)?;
+    let mut file = py
+        .detach(|| crate::formats::load_mesh_object(&path, object.as_deref()))
+        .map_err(|cause| load_error(&cause))?;
+    if let Some(note) = file.object_note.take() {
+        let message = format!(
+            "{}: {note}; object=NAME reads one alone",
+            crate::formats::shown_path(&path)
+        );
+        super::errors::object_warning(py, &message)?;
+    }
+    Ok(file)
 }
 
 /// Where each point lies, int8: 0 inside the cage, 1 on it, 2 outside (by the
@@ -370,8 +401,8 @@ pub(super) fn classify<'py>(
     method: Option<Bound<'py, PyAny>>,
     triangulate: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<i8>>> {
-    let method = super::binding::method_argument(method.as_ref())?;
-    let options = super::binding::bind_options(method, None, None, triangulate.as_ref())?;
+    let method = super::bind_arguments::method_argument(method.as_ref())?;
+    let options = super::bind_arguments::bind_options(method, None, None, triangulate.as_ref())?;
     let cage = cage_argument(cage)?;
     let points = positions(points, "points")?;
     let cage = Arc::clone(&cage.cage);
@@ -534,7 +565,16 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             entry.set_item("default", parameter.default)?;
             entry.set_item("min", parameter.min)?;
             entry.set_item("max", parameter.max)?;
-            entry.set_item("choices", parameter.choices.to_vec())?;
+            let choices = PyList::empty(py);
+            for &choice in parameter.choices {
+                match parameter.name_of(choice) {
+                    Some(name) => choices.append(name)?,
+                    None => choices.append(choice)?,
+                }
+            }
+            entry.set_item("choices", choices)?;
+            let named: Vec<&str> = parameter.named.iter().map(|n| n.name).collect();
+            entry.set_item("named", named)?;
             parameters.append(entry)?;
         }
         family.set_item("parameters", parameters)?;

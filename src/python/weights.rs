@@ -6,27 +6,28 @@ use super::errors::{error, file_error, Kind};
 use super::scene::PyCage;
 use crate::budget::{bytes_for, check_memory};
 use crate::coords::family::ColumnLayout;
-use crate::coords::{BindOptions, Method, Weights};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method, WeightValue, Weights, WeightsF64};
 use crate::formats::metadata::{
-    classes_path, load_weights_set, save_weights_set, MetadataError, WeightsMetadata,
+    classes_path, load_any_weights_set, save_any_weights_set, MetadataError, WeightsMetadata,
 };
 use crate::formats::npy::row_sum_off;
 use crate::formats::shown_path;
 use glam::DVec3;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use std::path::{Path, PathBuf};
 
-/// The weights of a bind: ``matrix`` (float32, one row per point, one column
-/// per entry of ``columns``), ``classes`` (int8 per row: 0 inside, 1 on the
+/// The weights of a bind: ``matrix`` (float32, or float64 where asked for; one
+/// row per point, one column per entry of ``columns``), ``classes`` (int8 per row: 0 inside, 1 on the
 /// cage, 2 outside, where the family's outside policy applies), the family
 /// (``method``, ``parameters``), where it ran (``backend``, ``device``,
 /// ``seconds``), and for Green coordinates the ``triangles`` that ψ refers to.
 /// ``metadata`` is all of it as ``pmvc bind`` writes it in ``W.json``.
 #[pyclass(name = "Weights", module = "pmvc", frozen)]
 pub(super) struct PyWeights {
-    matrix: Py<PyArray2<f32>>,
+    /// A 2-D numpy array of the metadata's dtype (float32 or float64).
+    matrix: Py<PyAny>,
     classes: Py<PyArray1<i8>>,
     metadata: WeightsMetadata,
     options: BindOptions,
@@ -36,7 +37,7 @@ pub(super) struct PyWeights {
 
 impl PyWeights {
     pub(super) fn new(
-        matrix: Py<PyArray2<f32>>,
+        matrix: Py<PyAny>,
         classes: Py<PyArray1<i8>>,
         metadata: WeightsMetadata,
         options: BindOptions,
@@ -61,14 +62,43 @@ impl PyWeights {
             .unwrap_or_else(|| PathBuf::from("weights"))
     }
 
-    /// The matrix as the library's `Weights`, after the checks `pmvc deform
-    /// --weights` makes on a file: the shape the metadata states, finite
-    /// values, and cage-vertex weights summing to 1 in every row (the array is
-    /// its owner's to change).
-    fn checked_matrix(&self, py: Python<'_>) -> PyResult<Weights> {
+    /// The matrix as the library's weights (of its dtype), after the checks
+    /// `pmvc deform --weights` makes on a file: the shape the metadata states,
+    /// finite values, and cage-vertex weights summing to 1 in every row (the
+    /// array is its owner's to change).
+    fn checked_matrix(&self, py: Python<'_>) -> PyResult<AnyWeights> {
+        let (rows, columns) = (self.metadata.rows, self.metadata.columns);
+        Ok(match self.metadata.dtype() {
+            Dtype::Float32 => AnyWeights::F32(Weights {
+                rows,
+                cols: columns,
+                values: self.checked_values::<f32>(py)?,
+            }),
+            Dtype::Float64 => AnyWeights::F64(WeightsF64 {
+                rows,
+                cols: columns,
+                values: self.checked_values::<f64>(py)?,
+            }),
+        })
+    }
+
+    fn checked_values<T: WeightValue + numpy::Element + std::fmt::Display>(
+        &self,
+        py: Python<'_>,
+    ) -> PyResult<Vec<T>> {
         let (rows, columns) = (self.metadata.rows, self.metadata.columns);
         let vertices = self.metadata.cage.vertices;
-        let matrix = self.matrix.bind(py).readonly();
+        let matrix = self.matrix.bind(py).cast::<PyArray2<T>>().map_err(|_| {
+            error(
+                Kind::Weights,
+                format!(
+                    "{}: the matrix is not a 2-dimensional {} array",
+                    shown_path(&self.shown()),
+                    T::DTYPE.id()
+                ),
+            )
+        })?;
+        let matrix = matrix.readonly();
         let shape = matrix.shape().to_vec();
         if shape != [rows, columns] {
             return Err(error(
@@ -82,9 +112,10 @@ impl PyWeights {
                 ),
             ));
         }
+        let size = T::DTYPE.size();
         check_memory(
-            || format!("a copy of the weights ({rows} rows × {columns} columns × 4 bytes)"),
-            bytes_for(rows as u64, 4 * columns as u64),
+            || format!("a copy of the weights ({rows} rows × {columns} columns × {size} bytes)"),
+            bytes_for(rows as u64, (size * columns) as u64),
         )
         .map_err(|cause| {
             error(
@@ -92,12 +123,12 @@ impl PyWeights {
                 format!("{}: {cause}", shown_path(&self.shown())),
             )
         })?;
-        let values: Vec<f32> = match matrix.as_slice() {
+        let values: Vec<T> = match matrix.as_slice() {
             Ok(values) => values.to_vec(),
             Err(_) => matrix.as_array().iter().copied().collect(),
         };
         for (row, values) in values.chunks(columns.max(1)).enumerate() {
-            if let Some(column) = values.iter().position(|w| !w.is_finite()) {
+            if let Some(column) = values.iter().position(|w| !w.to_f64().is_finite()) {
                 return Err(error(
                     Kind::Weights,
                     format!(
@@ -117,11 +148,7 @@ impl PyWeights {
                 ));
             }
         }
-        Ok(Weights {
-            rows,
-            cols: columns,
-            values,
-        })
+        Ok(values)
     }
 
     /// `strict=True` with these weights: an error when a row is outside the cage.
@@ -181,9 +208,10 @@ fn metadata_error(cause: &MetadataError) -> PyErr {
 
 #[pymethods]
 impl PyWeights {
-    /// The weights, float32, shape (rows, columns).
+    /// The weights, shape (rows, columns): float32, or float64 where
+    /// ``dtype=numpy.float64`` was asked for (``metadata["dtype"]`` says which).
     #[getter]
-    fn matrix<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
+    fn matrix<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         self.matrix.bind(py).clone()
     }
 
@@ -205,8 +233,16 @@ impl PyWeights {
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let parameters = PyDict::new(py);
-        for (name, value) in &self.metadata.parameters {
-            parameters.set_item(name, value)?;
+        for (name, &value) in &self.metadata.parameters {
+            // A named value ("exact") as its name, as W.json writes it.
+            let named = crate::coords::Parameter::ALL
+                .into_iter()
+                .find(|p| p.id() == name)
+                .and_then(|p| p.spec().name_of(value));
+            match named {
+                Some(named) => parameters.set_item(name, named)?,
+                None => parameters.set_item(name, value)?,
+            }
         }
         Ok(parameters)
     }
@@ -293,13 +329,31 @@ impl PyWeights {
 
     fn __repr__(&self) -> String {
         format!(
-            "Weights({}, {} × {} float32, {})",
+            "Weights({}, {} × {} {}, {})",
             self.metadata.method_name,
             self.metadata.rows,
             self.metadata.columns,
+            self.metadata.dtype,
             self.metadata.backend
         )
     }
+}
+
+/// Weights of either dtype as the numpy array `Weights.matrix` holds, without a
+/// copy.
+pub(super) fn matrix_array(py: Python<'_>, weights: AnyWeights) -> PyResult<Py<PyAny>> {
+    Ok(match weights {
+        AnyWeights::F32(weights) => {
+            super::arrays::matrix(py, weights.values, weights.rows, weights.cols)?
+                .into_any()
+                .unbind()
+        }
+        AnyWeights::F64(weights) => {
+            super::arrays::matrix(py, weights.values, weights.rows, weights.cols)?
+                .into_any()
+                .unbind()
+        }
+    })
 }
 
 /// Weights from their pickled state (``Weights.__reduce__``): the metadata
@@ -325,15 +379,25 @@ pub(super) fn restore_weights(
         .map_err(|cause| error(Kind::Weights, cause.to_string()))?;
     let (rows, columns) = (metadata.rows, metadata.columns);
     // Arrays rebuilt from a buffer may be misaligned: aligned here, once.
+    let dtype = metadata.dtype();
     let not_matrix = || {
         error(
             Kind::Weights,
-            "pickled weights: the matrix is not a 2-dimensional float32 array",
+            format!(
+                "pickled weights: the matrix is not a 2-dimensional {} array (the metadata's dtype)",
+                dtype.id()
+            ),
         )
     };
-    matrix.cast::<PyArray2<f32>>().map_err(|_| not_matrix())?;
-    let matrix = super::arrays::aligned(matrix, "float32")?
-        .cast_into::<PyArray2<f32>>()
+    let is_matrix = match dtype {
+        Dtype::Float32 => matrix.cast::<PyArray2<f32>>().is_ok(),
+        Dtype::Float64 => matrix.cast::<PyArray2<f64>>().is_ok(),
+    };
+    if !is_matrix {
+        return Err(not_matrix());
+    }
+    let matrix = super::arrays::aligned(matrix, dtype.id())?
+        .cast_into::<PyUntypedArray>()
         .map_err(|_| not_matrix())?;
     if matrix.shape() != [rows, columns] {
         return Err(error(
@@ -362,7 +426,12 @@ pub(super) fn restore_weights(
             format!("pickled weights: {} classes for {rows} rows", classes.len()),
         ));
     }
-    let mut weights = PyWeights::new(matrix.unbind(), classes.unbind(), metadata, options);
+    let mut weights = PyWeights::new(
+        matrix.into_any().unbind(),
+        classes.unbind(),
+        metadata,
+        options,
+    );
     weights.path = path;
     Ok(weights)
 }
@@ -413,7 +482,7 @@ pub(super) fn save_weights(
         .file_name()
         .map(|name| name.to_string_lossy().into_owned())
         .unwrap_or_default();
-    py.detach(|| save_weights_set(&path, &matrix, &metadata, &classes))
+    py.detach(|| save_any_weights_set(&path, &matrix, &metadata, &classes))
         .map_err(|cause| metadata_error(&cause))
 }
 
@@ -424,16 +493,10 @@ pub(super) fn save_weights(
 pub(super) fn load_weights(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyWeights> {
     let path = super::arguments::path(path, "load_weights")?;
     let loaded = py
-        .detach(|| load_weights_set(&path))
+        .detach(|| load_any_weights_set(&path))
         .map_err(|cause| metadata_error(&cause))?;
-    let matrix = super::arrays::matrix(
-        py,
-        loaded.weights.values,
-        loaded.weights.rows,
-        loaded.weights.cols,
-    )?;
     let mut weights = PyWeights::new(
-        matrix.unbind(),
+        matrix_array(py, loaded.weights)?,
         PyArray1::from_vec(py, loaded.classes).unbind(),
         loaded.metadata,
         loaded.options,

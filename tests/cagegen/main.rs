@@ -8,6 +8,7 @@ mod common;
 mod autocage;
 mod autocage_bad_input;
 mod autocage_bounds;
+mod autocage_bundled;
 mod autocage_quads;
 // Reads the generation summary the editor and `pmvc cage` print.
 #[cfg(feature = "editor")]

@@ -10,6 +10,7 @@ mod backend_choice;
 mod bad_input;
 mod cli;
 mod cli_cage;
+mod cli_exact_pmvc;
 mod cli_green;
 #[cfg(unix)]
 mod cli_messages;
@@ -21,3 +22,4 @@ mod gltf;
 #[cfg(unix)]
 mod outputs;
 mod pipeline_cache;
+mod round_trip;

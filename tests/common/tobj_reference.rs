@@ -224,6 +224,8 @@ pub fn parse_obj_with_tobj(path: &Path, text: String) -> Result<MeshFile, LoadEr
         format: MeshFormat::Obj,
         mesh,
         obj_text: Some(text),
+        node_transform: None,
+        object_note: None,
     })
 }
 

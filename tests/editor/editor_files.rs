@@ -322,3 +322,41 @@ fn save_cage_keeps_the_quads_and_writes_the_pose_beside_it_never_over_the_cage_r
         harness.state().document().pose()
     );
 }
+
+#[test]
+fn a_file_of_several_objects_opens_with_a_notice_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let cage = common::write(
+        dir.path(),
+        "cage.obj",
+        &common::cage_obj(&pmvc::geometry::procedural::cube_cage(1.0)),
+    );
+    let mesh = common::write(
+        dir.path(),
+        "scene.obj",
+        "o First\nv 0 0 0\nv 0.2 0 0\nv 0 0.2 0\nf 1 2 3\n\
+         o Second\nv 0 0 0.2\nv 0.2 0 0.2\nv 0 0.2 0.2\nf 4 5 6\n",
+    );
+    let Some(mut harness) = editor_with(pmvc::app::EditorOptions {
+        mesh: Some(mesh),
+        cage: Some(cage),
+        ..Default::default()
+    }) else {
+        return;
+    };
+    harness.run_steps(2);
+    assert_eq!(harness.state().document().mesh().positions.len(), 6);
+    let notices: Vec<String> = harness
+        .state()
+        .notices()
+        .all()
+        .iter()
+        .map(|n| n.text.clone())
+        .collect();
+    assert!(
+        notices.iter().any(|n| n.ends_with(
+            "scene.obj: the file has 2 objects: 'First', 'Second', read together as one mesh"
+        )),
+        "{notices:?}"
+    );
+}

@@ -199,3 +199,49 @@ fn the_difference_view_compares_a_family_with_its_triangulated_twin() {
     harness.run_steps(3);
     assert_eq!(harness.state().view().difference_split, None);
 }
+
+/// The `f` lines of an OBJ text, as written (corner lists only).
+fn face_lines(text: &str) -> Vec<Vec<u32>> {
+    text.lines()
+        .filter_map(|line| line.strip_prefix("f "))
+        .map(|corners| {
+            corners
+                .split_whitespace()
+                .map(|c| c.split('/').next().unwrap().parse().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn save_pose_keeps_the_cages_faces_quads_and_triangles_as_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, _) = quad_scene(dir.path());
+    // Five quads and the sixth side as two triangles.
+    let box_cage = twisted_box(2.0, 0.6);
+    let mut cage_text = common::points_obj(box_cage.positions());
+    for (k, quad) in box_cage.quads().iter().enumerate() {
+        let [a, b, c, d] = quad.corners.map(|i| i + 1);
+        if k == 0 {
+            cage_text.push_str(&format!("f {a} {b} {c}\nf {a} {c} {d}\n"));
+        } else {
+            cage_text.push_str(&format!("f {a} {b} {c} {d}\n"));
+        }
+    }
+    let cage = common::write(dir.path(), "mixed_cage.obj", &cage_text);
+    let Some(mut harness) = open(&mesh, &cage, EditorOptions::default()) else {
+        return;
+    };
+    twist_top(&mut harness);
+    let pose_path = dir.path().join("pose.obj");
+    assert!(harness.state_mut().save_pose(&pose_path));
+    let saved = std::fs::read_to_string(&pose_path).unwrap();
+    let faces = face_lines(&saved);
+    assert_eq!(faces, face_lines(&cage_text));
+    assert_eq!(faces.iter().filter(|f| f.len() == 4).count(), 5);
+    // The positions are the pose, and it loads back as one.
+    let read = pmvc::formats::load_mesh(&pose_path).unwrap();
+    assert_eq!(read.mesh.positions, harness.state().document().pose());
+    assert!(harness.state_mut().load_pose(&pose_path));
+    assert_eq!(harness.state().last_error(), None);
+}

@@ -198,3 +198,89 @@ fn export_gltf_writes_named_poses_as_shape_keys_and_the_timeline_as_the_animatio
     assert_eq!(harness.state().last_error(), None);
     assert_eq!(harness.state().document().mesh().triangles.len(), triangles);
 }
+
+/// The largest distance from a point of `points` to the nearest of `to`.
+fn farthest_from(points: &[DVec3], to: &[DVec3]) -> f64 {
+    points
+        .iter()
+        .map(|p| {
+            to.iter()
+                .map(|q| q.distance(*p))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The base shape of the glTF at `path`: mesh 0's POSITION, moved by the node.
+fn gltf_base(path: &std::path::Path) -> Vec<DVec3> {
+    use common::gltf_reader::{read_gltf, vec3};
+    let gltf = read_gltf(path);
+    let origin = gltf.translation();
+    let mut base = Vec::new();
+    for primitive in gltf.json["meshes"][0]["primitives"].as_array().unwrap() {
+        let positions = gltf.accessor(&primitive["attributes"]["POSITION"]);
+        base.extend(positions.iter().map(|p| origin + vec3(p)));
+    }
+    base
+}
+
+#[test]
+fn export_gltf_has_the_rest_mesh_as_its_base_and_its_animation_starts_at_rest() {
+    let Some(mut harness) = tall_editor() else {
+        return;
+    };
+    three_keys(&mut harness);
+    // The timeline starts at 0.5 s, and a pose is applied when exporting.
+    harness
+        .state_mut()
+        .queue_action(Action::Apply(pmvc::app::model::Command::SetPoseTime {
+            index: 0,
+            time: Some(0.5),
+        }));
+    harness.run_steps(2);
+    let rest_handle = harness.state().document().cage().positions()[3];
+    harness
+        .state_mut()
+        .set_handle_position(3, rest_handle + DVec3::new(0.0, 0.8, 0.0));
+    harness.run_steps(2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rest_base.glb");
+    assert!(harness.state_mut().export_gltf(&path));
+    let notices = harness.state().notices().all();
+    let notice = &notices.last().unwrap().text;
+    assert!(notice.contains("the rest mesh as its base"), "{notice}");
+
+    let document = harness.state().document();
+    let rest = document.mesh().positions.clone();
+    let posed = document.deformed_positions(harness.state().active_method());
+    let scale = document.mesh().diagonal();
+    let base = gltf_base(&path);
+    assert!(farthest_from(&base, &rest) < 1e-5 * scale);
+    assert!(farthest_from(&rest, &base) < 1e-5 * scale);
+    assert!(
+        farthest_from(&base, &posed) > 1e-2 * scale,
+        "the pose moved the mesh, and the base is not it"
+    );
+    // pmvc's own reader reads the same base back.
+    let read = pmvc::formats::load_mesh(&path).unwrap().mesh.positions;
+    assert!(farthest_from(&read, &rest) < 1e-5 * scale);
+
+    // A key at 0 s with every weight 0 (the base), then the timeline's keys.
+    let gltf = common::gltf_reader::read_gltf(&path);
+    let sampler = &gltf.json["animations"][0]["samplers"][0];
+    let times: Vec<f64> = gltf
+        .accessor(&sampler["input"])
+        .into_iter()
+        .map(|t| t[0])
+        .collect();
+    assert_eq!(times, [0.0, 0.5, 1.0, 2.0]);
+    let weights = gltf.accessor(&sampler["output"]);
+    assert!(weights[..3].iter().all(|w| w[0] == 0.0), "{weights:?}");
+    assert_eq!(weights[3][0], 1.0, "the first pose at 0.5 s");
+
+    // Asked for, the base is the current pose.
+    let posed_path = dir.path().join("posed_base.glb");
+    assert!(harness.state_mut().export_gltf_posed_base(&posed_path));
+    let base = gltf_base(&posed_path);
+    assert!(farthest_from(&base, &posed) < 1e-5 * scale);
+}

@@ -12,6 +12,8 @@ mod editor_assets;
 #[cfg(feature = "ui-tests")]
 mod editor_attributes;
 #[cfg(feature = "ui-tests")]
+mod editor_autosave_failures;
+#[cfg(feature = "ui-tests")]
 mod editor_cage;
 #[cfg(feature = "ui-tests")]
 mod editor_chunks;

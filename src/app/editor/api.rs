@@ -488,10 +488,16 @@ impl EditorApp {
         self.export_deformed_now(path)
     }
 
-    /// File > Export glTF…: the deformed mesh, named poses as morph targets and
-    /// the timeline as its animation; true when it was written.
+    /// File > Export glTF…: the rest mesh as the base shape, named poses as
+    /// morph targets and the timeline as its animation; true when it was written.
     pub fn export_gltf(&mut self, path: &Path) -> bool {
-        self.export_gltf_now(path)
+        self.export_gltf_now(path, crate::app::files::GltfBase::Rest)
+    }
+
+    /// File > Export glTF, the pose as its base…: [`Self::export_gltf`] with
+    /// the mesh deformed by the current pose as the base shape.
+    pub fn export_gltf_posed_base(&mut self, path: &Path) -> bool {
+        self.export_gltf_now(path, crate::app::files::GltfBase::Pose)
     }
 
     /// File > Export coloured mesh…: the deformed mesh as PLY in the view's colours.

@@ -489,12 +489,13 @@ impl EditorApp {
         self.report(files::export_deformed(path, self.model.document(), method))
     }
 
-    pub(super) fn export_gltf_now(&mut self, path: &Path) -> bool {
+    pub(super) fn export_gltf_now(&mut self, path: &Path, base: files::GltfBase) -> bool {
         if self.refuse_overwriting_session(path) {
             return false;
         }
-        let method = self.binding.active_method();
-        self.report(files::export_gltf(path, self.model.document(), method))
+        let (document, method) = (self.model.document(), self.binding.active_method());
+        let exported = files::export_gltf(path, document, method, base);
+        self.report(exported)
     }
 
     pub(super) fn export_coloured_mesh_now(&mut self, path: &Path) -> bool {
@@ -554,7 +555,8 @@ impl EditorApp {
             FileAction::SaveSession => self.save_session_now(path),
             FileAction::SaveImage => self.save_image_now(path),
             FileAction::ExportColouredMesh => self.export_coloured_mesh_now(path),
-            FileAction::ExportGltf => self.export_gltf_now(path),
+            FileAction::ExportGltf => self.export_gltf_now(path, files::GltfBase::Rest),
+            FileAction::ExportGltfPosedBase => self.export_gltf_now(path, files::GltfBase::Pose),
         };
         if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
             if done {

@@ -30,6 +30,7 @@ impl FileAction {
             FileAction::SaveImage => "Save image",
             FileAction::ExportColouredMesh => "Export coloured mesh",
             FileAction::ExportGltf => "Export glTF",
+            FileAction::ExportGltfPosedBase => "Export glTF, the pose as its base",
         }
     }
 
@@ -43,6 +44,7 @@ impl FileAction {
                 | FileAction::SaveImage
                 | FileAction::ExportColouredMesh
                 | FileAction::ExportGltf
+                | FileAction::ExportGltfPosedBase
         )
     }
 
@@ -53,7 +55,7 @@ impl FileAction {
             FileAction::OpenSession | FileAction::SaveSession => &["json"],
             FileAction::SaveImage => &["png"],
             FileAction::ExportColouredMesh => &["ply"],
-            FileAction::ExportGltf => &["glb", "gltf"],
+            FileAction::ExportGltf | FileAction::ExportGltfPosedBase => &["glb", "gltf"],
             // Point sets (n × 3 arrays) open wherever a mesh does, and glTF's
             // first mesh.
             FileAction::OpenMesh => &["obj", "off", "npy", "glb", "gltf"],
@@ -82,7 +84,7 @@ impl FileAction {
             FileAction::SaveSession => "scene.session.json",
             FileAction::SaveImage => "view.png",
             FileAction::ExportColouredMesh => "coloured.ply",
-            FileAction::ExportGltf => "deformed.glb",
+            FileAction::ExportGltf | FileAction::ExportGltfPosedBase => "deformed.glb",
             _ => "",
         }
     }
@@ -95,9 +97,10 @@ impl FileAction {
             | FileAction::SaveCage
             | FileAction::SaveSession
             | FileAction::SaveImage => "Save",
-            FileAction::ExportMesh | FileAction::ExportColouredMesh | FileAction::ExportGltf => {
-                "Export"
-            }
+            FileAction::ExportMesh
+            | FileAction::ExportColouredMesh
+            | FileAction::ExportGltf
+            | FileAction::ExportGltfPosedBase => "Export",
         }
     }
 }

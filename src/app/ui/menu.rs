@@ -91,12 +91,22 @@ fn file_menu(ui: &mut egui::Ui, cx: &mut PanelContext) {
     if ui
         .button("Export glTF (poses as shape keys)…")
         .on_hover_text(
-            "The deformed mesh as .glb or .gltf: every named pose a morph target (shape key) \
-             named after it, and the timeline's keys as its animation",
+            "The mesh as .glb or .gltf: the rest mesh as its base (Blender's Basis), every \
+             named pose a morph target (shape key) named after it, and the timeline's keys \
+             as its animation, starting at rest",
         )
         .clicked()
     {
         cx.send(Action::AskForFile(FileAction::ExportGltf));
+    }
+    if ui
+        .button("Export glTF, the pose as its base…")
+        .on_hover_text(
+            "As Export glTF, with the mesh deformed by the current pose as the base shape",
+        )
+        .clicked()
+    {
+        cx.send(Action::AskForFile(FileAction::ExportGltfPosedBase));
     }
     if ui
         .button("Export coloured mesh (PLY)…")

@@ -289,8 +289,8 @@ fn fill_boundary_and_outside(
     weights: &mut Weights,
 ) {
     let columns = weights.cols.max(1);
-    // MVC reads no cube map; the table is only there to satisfy the signature.
-    let table = super::cubemap::TexelTable::new(1);
+    // MVC reads no cube map; PMVC's integration is only there for the signature.
+    let integration = super::PmvcIntegration::Exact;
     weights
         .values
         .par_chunks_mut(columns)
@@ -299,7 +299,7 @@ fn fill_boundary_and_outside(
         .for_each_init(
             || (vec![0.0f64; columns], super::RowScratch::default()),
             |(row_f64, scratch), (row, (&x, &class))| {
-                super::weights_at(x, class, cage, super::Method::Mvc, &table, row_f64, scratch);
+                super::weights_at(x, class, cage, super::Method::Mvc, &integration, row_f64, scratch);
                 for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
                     *out = value as f32;
                 }

@@ -35,6 +35,7 @@
 //! A cage of triangles only takes the triangle code alone, unchanged.
 
 mod frustum;
+mod integration;
 mod lanes;
 mod missed;
 mod patch;
@@ -61,6 +62,8 @@ use raster::raster_triangle_avx2;
 use raster::{raster_triangle, FaceTriangle};
 use std::ops::Range;
 
+pub use integration::PmvcIntegration;
+
 /// Reusable buffers, so that binding allocates nothing per vertex.
 #[derive(Debug, Default)]
 pub struct PmvcScratch {
@@ -84,6 +87,8 @@ pub struct PmvcScratch {
     drawn_patches: Vec<(u32, FacePatch, Range<usize>)>,
     /// Per texel of the current face, the hit of the patch that holds it.
     patch_hits: PatchHits,
+    /// Exact PMVC's buffers ([`PmvcIntegration::Exact`]).
+    exact: crate::coords::exact_pmvc::ExactPmvcScratch,
 }
 
 /// What every triangle at a cage vertex needs, computed once per vertex.

@@ -34,10 +34,16 @@
 //!   distinct texture coordinate at its corners, as OBJ converters do. The
 //!   targets use the same split. Vertices in no triangle are left out; a mesh
 //!   with no triangles is written as points.
-//! - Positions are f32. A mesh far from the origin is written relative to a
-//!   point near its centre (the centre rounded to a multiple of the power of
-//!   two at or above the bounding box's diagonal, so 0 for a mesh around the
-//!   origin), which becomes the node's translation, so the f32 values keep
+//! - A mesh read from glTF keeps the transform of the node it was read through
+//!   ([`MeshFile::node_transform`]): the node written has it (as translation,
+//!   rotation and scale) and the positions are in its frame, so that an
+//!   import lands where the original was; where the source mirrors, the
+//!   triangles keep its winding. A transform that is no translation, rotation
+//!   and scale (a shear) is baked into the positions instead.
+//! - Positions are f32. A mesh far from its node's origin is written relative
+//!   to a point near its centre (the centre rounded to a multiple of the power
+//!   of two at or above the bounding box's diagonal, so 0 for a mesh around
+//!   the origin), added to the node's translation, so the f32 values keep
 //!   their precision; deltas are taken in f64 before rounding.
 //! - An animation, when asked for, is one `weights` channel with LINEAR
 //!   interpolation: at each [`AnimationKey`] its pose's weight is 1 and every
@@ -73,16 +79,24 @@
 //! element (`accessor 3: …`, `node 2 …`, `buffer 0 ("data.bin"): …`).
 
 mod buffers;
+mod frame;
 mod hierarchy;
 mod json_size;
 mod layout;
+mod objects;
 mod read;
 mod write;
 
 #[cfg(test)]
+mod fuzz_mutations;
+#[cfg(test)]
 mod fuzz_tests;
 #[cfg(test)]
 mod json_size_tests;
+#[cfg(test)]
+mod node_tests;
+#[cfg(test)]
+mod refusal_tests;
 #[cfg(test)]
 mod tests;
 
@@ -151,6 +165,10 @@ pub enum MeshPick {
     Index(usize),
     /// The first mesh of this name.
     Name(String),
+    /// The object of this name ([`objects`]): the node's transform is the
+    /// one that moves it; an error lists the names where none or several
+    /// have it.
+    Object(String),
 }
 
 /// Whether `path` names a glTF file: `.glb` or `.gltf`, in any case.

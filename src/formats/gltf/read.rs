@@ -6,6 +6,7 @@ use super::super::obj::{parse_obj, MAX_VERTICES};
 use super::buffers::{split_glb, Buffers};
 use super::hierarchy::check_hierarchy;
 use super::json_size::JsonSize;
+use super::objects::{default_note, pick_object};
 use super::MeshPick;
 use crate::budget::human_bytes;
 use crate::budget::{available_memory, bytes_for, check_memory, read_limited};
@@ -85,8 +86,18 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
         )));
     }
     let document = validated(root).map_err(fail)?;
-    let mesh = picked(&document, pick).map_err(fail)?;
-    let text = obj_text(path, &document, &mesh, bin).map_err(|e| match e {
+    let (mesh, node) = match pick {
+        MeshPick::Object(name) => {
+            let object = pick_object(&document, name).map_err(|source| LoadError::Object {
+                path: path.to_owned(),
+                source,
+            })?;
+            (object.mesh, object.node)
+        }
+        _ => (picked(&document, pick).map_err(fail)?, None),
+    };
+    let transform = world_transform(&document, mesh.index(), node);
+    let text = obj_text(path, &document, &mesh, transform, bin).map_err(|e| match e {
         Refused::Invalid(message) => fail(message),
         Refused::Memory(e) => out_of_memory(path, e),
         Refused::TooManyVertices(count) => LoadError::TooLarge {
@@ -97,6 +108,10 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
     })?;
     let mut file = parse_obj(path, text)?;
     file.format = MeshFormat::Gltf;
+    file.node_transform = (transform != DMat4::IDENTITY).then_some(transform);
+    if *pick == MeshPick::First {
+        file.object_note = default_note(&document, mesh.index());
+    }
     Ok(file)
 }
 
@@ -165,13 +180,13 @@ fn validated(root: gltf::json::Root) -> Result<gltf::Document, String> {
 fn picked<'a>(document: &'a gltf::Document, pick: &MeshPick) -> Result<gltf::Mesh<'a>, String> {
     let count = document.meshes().len();
     let found = match pick {
-        MeshPick::First => document.meshes().next(),
+        MeshPick::First | MeshPick::Object(_) => document.meshes().next(),
         MeshPick::Index(index) => document.meshes().nth(*index),
         MeshPick::Name(name) => document.meshes().find(|m| m.name() == Some(name.as_str())),
     };
     found.ok_or_else(|| match pick {
         _ if count == 0 => "the file has no meshes".to_owned(),
-        MeshPick::First => "the file has no meshes".to_owned(),
+        MeshPick::First | MeshPick::Object(_) => "the file has no meshes".to_owned(),
         MeshPick::Index(index) => {
             format!("the file has {count} meshes, so there is no mesh {index} (they count from 0)")
         }
@@ -228,9 +243,9 @@ fn local_transform(node: &gltf::Node) -> DMat4 {
     }
 }
 
-/// The world transform of the first node (lowest index) that draws `mesh`,
-/// its parents' included; the identity where no node does.
-fn world_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
+/// The world transform of `node`, or else of the first node (lowest index)
+/// that draws `mesh`, its parents' included; the identity where no node does.
+fn world_transform(document: &gltf::Document, mesh: usize, node: Option<usize>) -> DMat4 {
     let nodes: Vec<gltf::Node> = document.nodes().collect();
     let mut parents = vec![None; nodes.len()];
     for node in &nodes {
@@ -238,10 +253,11 @@ fn world_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
             parents[child.index()].get_or_insert(node.index());
         }
     }
-    let Some(first) = nodes
-        .iter()
-        .find(|n| n.mesh().is_some_and(|m| m.index() == mesh))
-    else {
+    let Some(first) = node.and_then(|n| nodes.get(n)).or_else(|| {
+        nodes
+            .iter()
+            .find(|n| n.mesh().is_some_and(|m| m.index() == mesh))
+    }) else {
         return DMat4::IDENTITY;
     };
     let mut transform = local_transform(first);
@@ -434,6 +450,7 @@ fn obj_text(
     path: &Path,
     document: &gltf::Document,
     mesh: &gltf::Mesh,
+    transform: DMat4,
     bin: Option<&[u8]>,
 ) -> Result<String, Refused> {
     let mesh_index = mesh.index();
@@ -453,7 +470,6 @@ fn obj_text(
         bytes_for(vertices, BYTES_PER_VERTEX).saturating_add(bytes_for(corners, BYTES_PER_INDEX)),
     )
     .map_err(Refused::Memory)?;
-    let transform = world_transform(document, mesh_index);
     let mirrored = transform.determinant() < 0.0;
     let mut buffers = Buffers::new(path, document, bin);
     let mut welded: HashMap<[u64; 3], u32> = HashMap::new();

@@ -1,14 +1,14 @@
 //! [`write_gltf`]: the buffers, the JSON (gltf-json's types) and the file.
 
+use super::frame::Frame;
 use super::layout::{layout_memory, Layout, Primitive};
 use super::{AnimationKey, GltfScene, GltfWriteError};
 use crate::budget::human_bytes;
 use crate::budget::{bytes_for, check_memory, TooLarge};
 use crate::formats::PendingOutput;
-use crate::geometry::bounds_of;
 use crate::geometry::vertex_normals;
 use base64::Engine as _;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use gltf::json;
 use json::validation::{Checked::Valid, USize64};
 use json::Index;
@@ -32,8 +32,8 @@ pub fn write_gltf(path: &Path, scene: &GltfScene) -> Result<(), GltfWriteError> 
     };
     check_scene(scene).map_err(invalid)?;
     let mesh = &scene.mesh.mesh;
-    // The normals of two shapes at a time, in f64.
-    let normals_bytes = bytes_for(mesh.positions.len() as u64, 2 * 24);
+    // The normals of two shapes at a time and a shape in the node's frame, in f64.
+    let normals_bytes = bytes_for(mesh.positions.len() as u64, 3 * 24);
     check_memory(
         || {
             format!(
@@ -194,17 +194,6 @@ fn buffer_bytes(layout: &Layout, scene: &GltfScene) -> u64 {
     .fold(0, u64::saturating_add)
 }
 
-/// The point the positions are written relative to: the base's bounding-box
-/// centre rounded to a multiple of the power of two at or above its diagonal,
-/// then to f32 (it is the node's translation), so 0 for a mesh around the origin.
-fn origin_of(base: &[DVec3]) -> DVec3 {
-    let (low, high) = bounds_of(base);
-    let diagonal = (high - low).length();
-    let step = diagonal.max(f64::MIN_POSITIVE).log2().ceil().exp2();
-    let rounded = ((low + high) * 0.5 / step).round() * step;
-    rounded.as_vec3().as_dvec3()
-}
-
 /// The JSON document and its binary buffer.
 struct Builder {
     root: json::Root,
@@ -284,6 +273,16 @@ fn f32s(value: DVec3) -> [f32; 3] {
     value.as_vec3().to_array()
 }
 
+/// The vertex normals of `positions`, flipped where the node mirrors: the
+/// triangles are then written in the source's winding ([`json_primitive`]).
+fn normals(positions: &[DVec3], triangles: &[[u32; 3]], mirrored: bool) -> Vec<DVec3> {
+    let mut normals = vertex_normals(positions, triangles);
+    if mirrored {
+        normals.iter_mut().for_each(|n| *n = -*n);
+    }
+    normals
+}
+
 fn build(layout: &Layout, scene: &GltfScene) -> (json::Root, Vec<u8>) {
     use json::accessor::Type;
     let array = Some(json::buffer::Target::ArrayBuffer);
@@ -292,17 +291,16 @@ fn build(layout: &Layout, scene: &GltfScene) -> (json::Root, Vec<u8>) {
         bin: Vec::new(),
     };
     let triangles = &scene.mesh.mesh.triangles;
-    let origin = origin_of(scene.base);
-    let base_normals = (!layout.points).then(|| vertex_normals(scene.base, triangles));
+    let frame = Frame::of(scene.mesh, scene.base);
+    let base: Vec<DVec3> = scene.base.iter().map(|&p| frame.point(p)).collect();
+    let base_normals = (!layout.points).then(|| normals(&base, triangles, frame.mirrored));
     let mut primitives: Vec<json::mesh::Primitive> = layout
         .primitives
         .iter()
         .map(|primitive| {
             let sources = &layout.source[primitive.vertices.clone()];
-            let positions: Vec<[f32; 3]> = sources
-                .iter()
-                .map(|&s| f32s(scene.base[s as usize] - origin))
-                .collect();
+            let positions: Vec<[f32; 3]> =
+                sources.iter().map(|&s| f32s(base[s as usize])).collect();
             let mut attributes = std::collections::BTreeMap::new();
             let position = builder.floats(&positions, Type::Vec3, array, true);
             attributes.insert(Valid(json::mesh::Semantic::Positions), position);
@@ -320,7 +318,7 @@ fn build(layout: &Layout, scene: &GltfScene) -> (json::Root, Vec<u8>) {
                 let uv = builder.floats(&uvs, Type::Vec2, array, false);
                 attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
             }
-            json_primitive(&mut builder, primitive, attributes)
+            json_primitive(&mut builder, primitive, attributes, frame.mirrored)
         })
         .collect();
     add_targets(
@@ -328,7 +326,7 @@ fn build(layout: &Layout, scene: &GltfScene) -> (json::Root, Vec<u8>) {
         &mut primitives,
         layout,
         scene,
-        base_normals.as_deref(),
+        (&frame, base_normals.as_deref()),
     );
     let names: Vec<&str> = scene.poses.iter().map(|p| p.name).collect();
     let stem = scene
@@ -347,7 +345,10 @@ fn build(layout: &Layout, scene: &GltfScene) -> (json::Root, Vec<u8>) {
     let node = builder.root.push(json::Node {
         mesh: Some(mesh),
         name: stem,
-        translation: (origin != DVec3::ZERO).then(|| f32s(origin)),
+        translation: (frame.translation != Vec3::ZERO).then(|| frame.translation.to_array()),
+        rotation: (frame.rotation != [0.0, 0.0, 0.0, 1.0])
+            .then_some(json::scene::UnitQuaternion(frame.rotation)),
+        scale: (frame.scale != Vec3::ONE).then(|| frame.scale.to_array()),
         ..Default::default()
     });
     let scene_index = builder.root.push(json::Scene {
@@ -387,9 +388,19 @@ fn json_primitive(
         json::validation::Checked<json::mesh::Semantic>,
         Index<json::Accessor>,
     >,
+    mirrored: bool,
 ) -> json::mesh::Primitive {
     let indices = (!primitive.indices.is_empty()).then(|| {
-        let words = primitive.indices.iter().map(|i| i.to_le_bytes());
+        // The reader reversed the winding where the node mirrors; a viewer
+        // reverses it again.
+        let words = primitive.indices.chunks_exact(3).flat_map(|t| {
+            let t = if mirrored {
+                [t[0], t[2], t[1]]
+            } else {
+                [t[0], t[1], t[2]]
+            };
+            t.map(u32::to_le_bytes)
+        });
         let kind = (
             json::accessor::ComponentType::U32,
             json::accessor::Type::Scalar,
@@ -435,18 +446,21 @@ fn add_targets(
     primitives: &mut [json::mesh::Primitive],
     layout: &Layout,
     scene: &GltfScene,
-    base_normals: Option<&[DVec3]>,
+    (frame, base_normals): (&Frame, Option<&[DVec3]>),
 ) {
     use json::accessor::Type;
     let array = Some(json::buffer::Target::ArrayBuffer);
     let triangles = &scene.mesh.mesh.triangles;
     for pose in scene.poses {
-        let normals = base_normals.map(|_| vertex_normals(pose.positions, triangles));
+        let normals = base_normals.map(|_| {
+            let local: Vec<DVec3> = pose.positions.iter().map(|&p| frame.point(p)).collect();
+            normals(&local, triangles, frame.mirrored)
+        });
         for (primitive, json_primitive) in layout.primitives.iter().zip(primitives.iter_mut()) {
             let sources = &layout.source[primitive.vertices.clone()];
             let deltas: Vec<[f32; 3]> = sources
                 .iter()
-                .map(|&s| f32s(pose.positions[s as usize] - scene.base[s as usize]))
+                .map(|&s| f32s(frame.vector(pose.positions[s as usize] - scene.base[s as usize])))
                 .collect();
             let positions = Some(builder.floats(&deltas, Type::Vec3, array, true));
             let normals = normals.as_ref().zip(base_normals).map(|(pose, base)| {

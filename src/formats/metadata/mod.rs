@@ -5,10 +5,12 @@
 //! that rows a family filled by its outside policy can be told from the rest.
 //! The command line and the Python package both read and write them here.
 
-use super::npy::{npy_preamble, read_npy, write_f32_values, ExpectedArray, NpyError};
-use super::npz::{read_npz, write_npz};
+use super::npy::{
+    npy_preamble_of, read_npy, read_npy_f64, write_values, ExpectedArray, LeBytes, NpyError,
+};
+use super::npz::{read_npz, read_npz_f64, write_npz_values};
 use crate::coords::family::ColumnLayout;
-use crate::coords::{BindOptions, Method, ParameterError, Weights};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method, ParameterError, Weights};
 use crate::formats::{shown_path, OutputSet, WriteError};
 use crate::geometry::{Cage, PointClass, QuadSplit};
 use glam::DVec3;
@@ -17,9 +19,14 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 mod classes;
+mod sets;
 pub use classes::{
     class_code, class_codes, classes_path, read_classes_npy, write_classes_npy_to, CLASS_INSIDE,
     CLASS_ON_CAGE, CLASS_OUTSIDE,
+};
+pub use sets::{
+    load_any_weights_set, load_weights_set, save_any_weights_set, save_weights_set,
+    LoadedAnyWeights, LoadedWeights,
 };
 
 /// The `format` field of every metadata file.
@@ -115,6 +122,7 @@ pub struct WeightsMetadata {
     pub method: String,
     pub method_name: String,
     /// The family's own parameters and their values (none for MVC and Green).
+    #[serde(with = "crate::coords::parameter_values")]
     pub parameters: BTreeMap<String, u32>,
     /// `--triangulate` as asked: "none" (quads stay bilinear patches), "shorter"
     /// or "longer". Files from before quads were patches have none and read as
@@ -125,6 +133,11 @@ pub struct WeightsMetadata {
     /// diagonal they were split along (Green coordinates always split them).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub quads_bound_as: String,
+    /// How the matrix is stored: "float32", or "float64" where it was asked for
+    /// (`--dtype f64`, Python's `dtype=numpy.float64`). Files from before the
+    /// field read as "float32", which they are.
+    #[serde(default = "float32")]
+    pub dtype: String,
     /// "cpu" or "gpu".
     pub backend: String,
     /// Where they were computed, in words (the adapter, or the CPU threads).
@@ -169,6 +182,10 @@ fn no_split() -> String {
     QuadSplit::None.id().to_owned()
 }
 
+fn float32() -> String {
+    Dtype::Float32.id().to_owned()
+}
+
 impl WeightsMetadata {
     pub fn new(record: &BindRecord) -> Self {
         let method = record.options.method;
@@ -204,6 +221,7 @@ impl WeightsMetadata {
                 .map(|(parameter, value)| (parameter.key.id().to_owned(), value))
                 .into_iter()
                 .collect(),
+            dtype: float32(),
             backend: record.backend.to_owned(),
             device: record.device.to_owned(),
             seconds: record.seconds,
@@ -288,6 +306,20 @@ impl WeightsMetadata {
         Ok(options)
     }
 
+    /// The stored dtype, checked by [`Dtype::parse`] (the parser of `--dtype`).
+    pub fn checked_dtype(&self, path: &Path) -> Result<Dtype, MetadataError> {
+        Dtype::parse(&self.dtype).map_err(|error| MetadataError::Field {
+            path: path.to_owned(),
+            field: "dtype",
+            reason: error.to_string(),
+        })
+    }
+
+    /// The stored dtype; float32 for a value [`Self::checked_dtype`] refuses.
+    pub fn dtype(&self) -> Dtype {
+        Dtype::parse(&self.dtype).unwrap_or_default()
+    }
+
     /// Whether these weights belong to `points` and `cage`: the same number of
     /// rows and cage vertices and triangles, and the same digests.
     pub fn check_inputs(
@@ -358,6 +390,7 @@ impl WeightsMetadata {
             ));
         }
         let options = self.options(path)?;
+        self.checked_dtype(path)?;
         let layout = options.method.spec().columns;
         let expected = match layout {
             ColumnLayout::CageVertices => self.cage.vertices,
@@ -464,100 +497,4 @@ pub fn read_metadata(path: &Path) -> Result<WeightsMetadata, MetadataError> {
         })?;
     metadata.check_consistent(path)?;
     Ok(metadata)
-}
-
-/// Write weights, their class mask and their metadata together: all three
-/// replace their files, or none does ([`OutputSet`]). Green coordinates go to a
-/// `.npz` (φ and ψ), the rest to a `.npy`.
-pub fn save_weights_set(
-    path: &Path,
-    weights: &Weights,
-    metadata: &WeightsMetadata,
-    classes: &[i8],
-) -> Result<(), MetadataError> {
-    if classes.len() != weights.rows || metadata.rows != weights.rows {
-        return Err(MetadataError::Field {
-            path: path.to_owned(),
-            field: "rows",
-            reason: format!(
-                "{} weights rows, {} classes and {} rows in the metadata",
-                weights.rows,
-                classes.len(),
-                metadata.rows
-            ),
-        });
-    }
-    let outputs = OutputSet::create(&[path, &classes_path(path), &metadata_path(path)])?;
-    let preamble = npy_preamble(path, weights.rows, weights.cols)?;
-    let json = metadata.to_json_pretty();
-    let npz = metadata.columns_layout == layout_id(ColumnLayout::CageVerticesThenTriangles);
-    outputs.finish_seekable(|index, out| match index {
-        0 if npz => write_npz(out, path, weights, metadata.cage.vertices),
-        0 => {
-            out.write_all(&preamble)?;
-            write_f32_values(out, &weights.values)
-        }
-        1 => write_classes_npy_to(out, classes),
-        _ => out.write_all(json.as_bytes()),
-    })?;
-    Ok(())
-}
-
-/// Weights read back with what was written beside them.
-pub struct LoadedWeights {
-    pub weights: Weights,
-    pub metadata: WeightsMetadata,
-    pub options: BindOptions,
-    pub classes: Vec<i8>,
-}
-
-/// Read weights written by [`save_weights_set`] or `pmvc bind`: the metadata
-/// first, then the arrays with the shapes it states (checked as `pmvc deform
-/// --weights` checks them: finite values, cage-vertex rows summing to 1 within
-/// [`super::npy::ROW_SUM_TOLERANCE`]), then the class mask.
-pub fn load_weights_set(path: &Path) -> Result<LoadedWeights, MetadataError> {
-    let json = metadata_path(path);
-    if !json.exists() {
-        return Err(MetadataError::Read {
-            path: json,
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!(
-                    "no metadata beside {}: weights are read with the JSON `pmvc bind` writes next to them",
-                    shown_path(path)
-                ),
-            ),
-        });
-    }
-    let metadata = read_metadata(&json)?;
-    let options = metadata.check_consistent(&json)?;
-    let (rows, vertices, triangles) = (
-        metadata.rows,
-        metadata.cage.vertices,
-        metadata.cage.triangles,
-    );
-    let weights = match options.method.spec().columns {
-        ColumnLayout::CageVerticesThenTriangles => read_npz(path, rows, vertices, triangles)?,
-        ColumnLayout::CageVertices => read_npy(path, ExpectedArray::cage_vertices(rows, vertices))?,
-    };
-    // A bare file name beside the weights: the metadata never points elsewhere.
-    let name = Path::new(&metadata.classes.file);
-    if name.file_name() != Some(name.as_os_str()) {
-        return Err(MetadataError::Field {
-            path: json,
-            field: "classes.file",
-            reason: format!(
-                "{:?} is not a file name beside the weights",
-                metadata.classes.file
-            ),
-        });
-    }
-    let classes_file = path.with_file_name(name);
-    let classes = read_classes_npy(&classes_file, rows)?;
-    Ok(LoadedWeights {
-        weights,
-        metadata,
-        options,
-        classes,
-    })
 }

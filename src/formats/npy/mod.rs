@@ -1,6 +1,6 @@
-//! Weights as NumPy `.npy` files (little-endian float32, C order, shape (rows,
-//! columns)): what `pmvc bind` writes (version 1.0) and `pmvc deform --weights`
-//! reads (versions 1.0 to 3.0, header in [`header`]). Writing goes
+//! Weights as NumPy `.npy` files (little-endian float32, or float64 where asked
+//! for, C order, shape (rows, columns)): what `pmvc bind` writes (version 1.0)
+//! and `pmvc deform --weights` reads (versions 1.0 to 3.0, header in [`header`]). Writing goes
 //! through a temporary file that is renamed over the target; reading checks every
 //! declared size before anything that size is allocated.
 
@@ -8,7 +8,7 @@ pub mod header;
 pub(crate) mod points;
 
 use crate::budget::{bytes_for, check_memory, TooLarge};
-use crate::coords::Weights;
+use crate::coords::{Dtype, WeightValue, Weights, WeightsF64};
 use crate::formats::{shown_path, PendingOutput, WriteError};
 use header::{read_fully, read_header, shape_text, HeaderError, NpyHeader};
 use std::io::Read;
@@ -36,19 +36,26 @@ pub enum NpyError {
     FortranOrder { at: ArrayAt },
     #[error("{at}: expected little-endian float32 weights ('<f4'), found dtype '{}'; convert with .astype('<f4')", dtype.escape_debug())]
     Dtype { at: ArrayAt, dtype: String },
+    #[error("{at}: expected little-endian {} weights ('{}'), as its metadata says, found dtype '{}'", expected.id(), expected.descr(), dtype.escape_debug())]
+    DtypeOf {
+        at: ArrayAt,
+        dtype: String,
+        expected: Dtype,
+    },
     #[error("{at}: declares shape {}, but the mesh has {} vertices and the cage {} {}, so it must be ({}, {})", shape_text(declared), expected.rows, expected.cols, expected.columns, expected.rows, expected.cols)]
     ShapeMismatch {
         at: ArrayAt,
         declared: Vec<u64>,
         expected: ExpectedArray,
     },
-    #[error("{at}: truncated: its shape ({rows}, {cols}) needs {needed} bytes of float32 values, but the file holds {present}")]
+    #[error("{at}: truncated: its shape ({rows}, {cols}) needs {needed} bytes of {} values, but the file holds {present}", dtype.id())]
     Truncated {
         at: ArrayAt,
         rows: usize,
         cols: usize,
         needed: u64,
         present: u64,
+        dtype: Dtype,
     },
     #[error("{at}: holds more than the {needed} bytes of values its shape ({rows}, {cols}) needs{}", present.map(|p| format!(" ({p})")).unwrap_or_default())]
     TrailingBytes {
@@ -66,7 +73,7 @@ pub enum NpyError {
         /// 1-based, as the message shows it.
         row: usize,
         column: usize,
-        value: f32,
+        value: f64,
     },
     #[error("{at}: row {row}'s weights sum to {sum}, not 1 (allowed: ±{tolerance:.1e}); every row of {} must sum to 1", expected.what_sums())]
     RowSum {
@@ -159,12 +166,20 @@ pub fn write_npy(path: &Path, weights: &Weights) -> Result<(), NpyError> {
 
 /// The size of the `.npy` file [`write_npy`] writes for a `rows` × `cols` matrix.
 pub fn npy_file_bytes(rows: usize, cols: usize) -> u64 {
-    (npy_header(rows, cols).len() + 10) as u64 + 4 * rows as u64 * cols as u64
+    npy_file_bytes_of(rows, cols, Dtype::Float32)
 }
 
-fn npy_header(rows: usize, cols: usize) -> String {
-    let mut header =
-        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+/// [`npy_file_bytes`] for values of `dtype`.
+pub fn npy_file_bytes_of(rows: usize, cols: usize, dtype: Dtype) -> u64 {
+    (npy_header(rows, cols, dtype).len() + 10) as u64
+        + dtype.size() as u64 * rows as u64 * cols as u64
+}
+
+fn npy_header(rows: usize, cols: usize, dtype: Dtype) -> String {
+    let mut header = format!(
+        "{{'descr': '{}', 'fortran_order': False, 'shape': ({rows}, {cols}), }}",
+        dtype.descr()
+    );
     // Magic, version, length and header end on a 64-byte boundary, with a newline.
     let padded = (10 + header.len() + 1).div_ceil(64) * 64 - 10;
     header.extend(std::iter::repeat_n(' ', padded - 1 - header.len()));
@@ -175,7 +190,17 @@ fn npy_header(rows: usize, cols: usize) -> String {
 /// The bytes before the values of a `rows` × `cols` float32 `.npy` file: magic,
 /// version, header length and header. For writers that stream the values.
 pub fn npy_preamble(path: &Path, rows: usize, cols: usize) -> Result<Vec<u8>, NpyError> {
-    let header = npy_header(rows, cols);
+    npy_preamble_of(path, rows, cols, Dtype::Float32)
+}
+
+/// [`npy_preamble`] for values of `dtype`.
+pub fn npy_preamble_of(
+    path: &Path,
+    rows: usize,
+    cols: usize,
+    dtype: Dtype,
+) -> Result<Vec<u8>, NpyError> {
+    let header = npy_header(rows, cols, dtype);
     let header_len = u16::try_from(header.len()).map_err(|_| NpyError::HeaderTooLong {
         path: path.to_owned(),
         rows,
@@ -189,6 +214,37 @@ pub fn npy_preamble(path: &Path, rows: usize, cols: usize) -> Result<Vec<u8>, Np
 
 /// `values` as little-endian float32.
 pub fn write_f32_values(out: &mut dyn std::io::Write, values: &[f32]) -> std::io::Result<()> {
+    write_values(out, values)
+}
+
+/// A value's little-endian bytes, for [`write_values`] and the readers.
+pub trait LeBytes: WeightValue + bytemuck::Pod {
+    fn extend_le(self, bytes: &mut Vec<u8>);
+    fn from_le(bytes: &[u8]) -> Self;
+}
+
+impl LeBytes for f32 {
+    fn extend_le(self, bytes: &mut Vec<u8>) {
+        bytes.extend(self.to_le_bytes());
+    }
+    fn from_le(bytes: &[u8]) -> Self {
+        f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])
+    }
+}
+
+impl LeBytes for f64 {
+    fn extend_le(self, bytes: &mut Vec<u8>) {
+        bytes.extend(self.to_le_bytes());
+    }
+    fn from_le(bytes: &[u8]) -> Self {
+        let mut array = [0u8; 8];
+        array.copy_from_slice(&bytes[..8]);
+        f64::from_le_bytes(array)
+    }
+}
+
+/// `values` as little-endian float32 or float64.
+pub fn write_values<T: LeBytes>(out: &mut dyn std::io::Write, values: &[T]) -> std::io::Result<()> {
     if cfg!(target_endian = "little") {
         // The values' own bytes: one write, past the writer's buffer, with no copy.
         return out.write_all(bytemuck::cast_slice(values));
@@ -197,7 +253,9 @@ pub fn write_f32_values(out: &mut dyn std::io::Write, values: &[f32]) -> std::io
     let mut block = Vec::with_capacity(1 << 16);
     for values in values.chunks(1 << 14) {
         block.clear();
-        block.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        for &value in values {
+            value.extend_le(&mut block);
+        }
         out.write_all(&block)?;
     }
     Ok(())
@@ -224,9 +282,9 @@ pub const ROW_SUM_TOLERANCE: f64 = 1e-4;
 
 /// The sum of `row` and the tolerance it was held to, when it is further from 1
 /// than [`ROW_SUM_TOLERANCE`] allows.
-pub fn row_sum_off(row: &[f32]) -> Option<(f64, f64)> {
+pub fn row_sum_off<T: WeightValue>(row: &[T]) -> Option<(f64, f64)> {
     let (sum, magnitude) = row.iter().fold((0.0f64, 0.0f64), |(sum, magnitude), &w| {
-        (sum + f64::from(w), magnitude + f64::from(w).abs())
+        (sum + w.to_f64(), magnitude + w.to_f64().abs())
     });
     let tolerance = ROW_SUM_TOLERANCE * magnitude.max(1.0);
     let off = sum.is_nan() || (sum - 1.0).abs() > tolerance;
@@ -239,16 +297,42 @@ pub fn row_sum_off(row: &[f32]) -> Option<(f64, f64)> {
 /// matrix is allocated (and that allocation against the memory available); every
 /// value must be finite and, where `expected` says so, every row must sum to 1.
 pub fn read_npy(path: &Path, expected: ExpectedArray) -> Result<Weights, NpyError> {
+    let values = read_npy_values::<f32>(path, expected)?;
+    Ok(Weights {
+        rows: expected.rows,
+        cols: expected.cols,
+        values,
+    })
+}
+
+/// [`read_npy`] of a float64 file (`'<f8'`), as `pmvc bind --dtype f64` writes it.
+pub fn read_npy_f64(path: &Path, expected: ExpectedArray) -> Result<WeightsF64, NpyError> {
+    let values = read_npy_values::<f64>(path, expected)?;
+    Ok(WeightsF64 {
+        rows: expected.rows,
+        cols: expected.cols,
+        values,
+    })
+}
+
+fn read_npy_values<T: LeBytes>(path: &Path, expected: ExpectedArray) -> Result<Vec<T>, NpyError> {
     let at = ArrayAt {
         path: path.to_owned(),
         array: None,
     };
     let (file, present) = open(path)?;
     let mut reader = std::io::BufReader::new(file);
-    let data_present = read_array_header(&mut reader, present, &at, expected)?;
-    let mut weights = allocate(&at, expected.rows, expected.cols)?;
-    read_values(&mut reader, &at, expected, data_present, &mut weights, 0)?;
-    Ok(weights)
+    let data_present = read_array_header(&mut reader, present, &at, expected, T::DTYPE)?;
+    let mut values = allocate::<T>(&at, expected.rows, expected.cols)?;
+    read_values(
+        &mut reader,
+        &at,
+        expected,
+        data_present,
+        (&mut values, expected.cols),
+        0,
+    )?;
+    Ok(values)
 }
 
 /// The file and, for a regular file, its size.
@@ -267,20 +351,22 @@ pub(super) fn open(path: &Path) -> Result<(std::fs::File, Option<u64>), NpyError
     Ok((file, metadata.is_file().then_some(metadata.len())))
 }
 
-/// Read the header of an array whose stream holds `present` bytes (when known)
-/// and check it against `expected`; returns the bytes of values present.
+/// Read the header of an array of `dtype` whose stream holds `present` bytes
+/// (when known) and check it against `expected`; returns the bytes of values
+/// present.
 pub(super) fn read_array_header(
     reader: &mut impl Read,
     present: Option<u64>,
     at: &ArrayAt,
     expected: ExpectedArray,
+    dtype: Dtype,
 ) -> Result<Option<u64>, NpyError> {
     let header = read_header(reader, present).map_err(|source| NpyError::Header {
         at: at.clone(),
         source,
     })?;
     let data_present = present.map(|present| present.saturating_sub(header.data_offset));
-    check_header(&header, at, expected, data_present)?;
+    check_header(&header, at, expected, data_present, dtype)?;
     Ok(data_present)
 }
 
@@ -289,12 +375,20 @@ fn check_header(
     at: &ArrayAt,
     expected: ExpectedArray,
     data_present: Option<u64>,
+    dtype: Dtype,
 ) -> Result<(), NpyError> {
     let at = || at.clone();
-    if header.descr != "<f4" {
-        return Err(NpyError::Dtype {
-            at: at(),
-            dtype: header.descr.clone(),
+    if header.descr != dtype.descr() {
+        return Err(match dtype {
+            Dtype::Float32 => NpyError::Dtype {
+                at: at(),
+                dtype: header.descr.clone(),
+            },
+            Dtype::Float64 => NpyError::DtypeOf {
+                at: at(),
+                dtype: header.descr.clone(),
+                expected: dtype,
+            },
         });
     }
     if header.fortran_order {
@@ -313,7 +407,7 @@ fn check_header(
             expected,
         });
     }
-    let needed = value_bytes(expected.rows, expected.cols);
+    let needed = value_bytes(expected.rows, expected.cols, dtype);
     let (rows, cols) = (expected.rows, expected.cols);
     match data_present {
         Some(present) if present < needed => Err(NpyError::Truncated {
@@ -322,6 +416,7 @@ fn check_header(
             cols,
             needed,
             present,
+            dtype,
         }),
         Some(present) if present > needed => Err(NpyError::TrailingBytes {
             at: at(),
@@ -334,40 +429,48 @@ fn check_header(
     }
 }
 
-fn value_bytes(rows: usize, cols: usize) -> u64 {
-    bytes_for(rows as u64, bytes_for(cols as u64, 4))
+fn value_bytes(rows: usize, cols: usize, dtype: Dtype) -> u64 {
+    bytes_for(rows as u64, bytes_for(cols as u64, dtype.size() as u64))
 }
 
-/// A zero matrix of `rows` × `cols`, once the memory for it is known to be there.
-pub(super) fn allocate(at: &ArrayAt, rows: usize, cols: usize) -> Result<Weights, NpyError> {
+/// A zero matrix of `rows` × `cols` values, once the memory for it is known to
+/// be there.
+pub(super) fn allocate<T: WeightValue>(
+    at: &ArrayAt,
+    rows: usize,
+    cols: usize,
+) -> Result<Vec<T>, NpyError> {
     check_memory(
-        || format!("the weights ({rows} × {cols} float32)"),
-        value_bytes(rows, cols),
+        || format!("the weights ({rows} × {cols} {})", T::DTYPE.id()),
+        value_bytes(rows, cols, T::DTYPE),
     )
     .map_err(|source| NpyError::TooLarge {
         at: at.clone(),
         source,
     })?;
-    Ok(Weights::zeros(rows, cols))
+    Ok(vec![T::default(); rows * cols])
 }
 
 /// Read the values of an array whose header [`read_array_header`] accepted into
-/// columns `first_column..` of `weights`, row by row, checking each value and
+/// columns `first_column..` of a row-major matrix (its values and its number of
+/// columns), row by row, checking each value and
 /// (where `expected` says so) each row's sum.
-pub(super) fn read_values(
+pub(super) fn read_values<T: LeBytes>(
     reader: &mut impl Read,
     at: &ArrayAt,
     expected: ExpectedArray,
     data_present: Option<u64>,
-    weights: &mut Weights,
+    (values, total_cols): (&mut [T], usize),
     first_column: usize,
 ) -> Result<(), NpyError> {
     let (rows, cols) = (expected.rows, expected.cols);
+    let dtype = T::DTYPE;
+    let size = dtype.size();
     let read_error = |source| NpyError::Read {
         path: at.path.clone(),
         source,
     };
-    let mut buffer = vec![0u8; cols * 4];
+    let mut buffer = vec![0u8; cols * size];
     // Rows of no columns hold nothing to read (and may be many); an empty row
     // that must sum to 1 is refused at the first.
     let rows_to_read = if cols == 0 && !expected.rows_sum_to_one {
@@ -382,20 +485,21 @@ pub(super) fn read_values(
                 at: at.clone(),
                 rows,
                 cols,
-                needed: value_bytes(rows, cols),
-                present: value_bytes(row, cols) + filled as u64,
+                needed: value_bytes(rows, cols, dtype),
+                present: value_bytes(row, cols, dtype) + filled as u64,
+                dtype,
             });
         }
-        let start = row * weights.cols + first_column;
-        let out = &mut weights.values[start..start + cols];
-        for (column, (value, bytes)) in out.iter_mut().zip(buffer.chunks_exact(4)).enumerate() {
-            *value = f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-            if !value.is_finite() {
+        let start = row * total_cols + first_column;
+        let out = &mut values[start..start + cols];
+        for (column, (value, bytes)) in out.iter_mut().zip(buffer.chunks_exact(size)).enumerate() {
+            *value = T::from_le(bytes);
+            if !value.to_f64().is_finite() {
                 return Err(NpyError::NonFinite {
                     at: at.clone(),
                     row: row + 1,
                     column: column + 1,
-                    value: *value,
+                    value: value.to_f64(),
                 });
             }
         }
@@ -415,7 +519,7 @@ pub(super) fn read_values(
             at: at.clone(),
             rows,
             cols,
-            needed: value_bytes(rows, cols),
+            needed: value_bytes(rows, cols, dtype),
             present: data_present,
         });
     }
@@ -423,117 +527,4 @@ pub(super) fn read_values(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn expected(rows: usize, cols: usize) -> ExpectedArray {
-        ExpectedArray::cage_vertices(rows, cols)
-    }
-
-    fn write_file(header: &str, values: &[f32]) -> (tempfile::TempDir, PathBuf) {
-        let folder = tempfile::tempdir().expect("temporary folder");
-        let path = folder.path().join("w.npy");
-        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
-        bytes.extend((header.len() as u16).to_le_bytes());
-        bytes.extend(header.as_bytes());
-        bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
-        std::fs::write(&path, bytes).expect("write");
-        (folder, path)
-    }
-
-    fn header(shape: &str) -> String {
-        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}\n")
-    }
-
-    #[test]
-    fn written_weights_read_back() {
-        let folder = tempfile::tempdir().expect("temporary folder");
-        let path = folder.path().join("w.npy");
-        let weights = Weights {
-            rows: 2,
-            cols: 3,
-            values: vec![0.25, 0.25, 0.5, -0.5, 1.0, 0.5],
-        };
-        write_npy(&path, &weights).expect("written");
-        assert_eq!(
-            npy_file_bytes(2, 3),
-            std::fs::metadata(&path).unwrap().len()
-        );
-        assert_eq!(read_npy(&path, expected(2, 3)).expect("read"), weights);
-    }
-
-    #[test]
-    fn a_truncated_file_is_reported_as_truncated() {
-        let (_folder, path) = write_file(&header("(2, 2)"), &[0.5, 0.5, 0.25]);
-        let message = read_npy(&path, expected(2, 2)).unwrap_err().to_string();
-        assert!(
-            message.contains("truncated")
-                && message.contains("(2, 2)")
-                && message.contains("needs 16 bytes")
-                && message.contains("holds 12"),
-            "{message}"
-        );
-    }
-
-    #[test]
-    fn a_shape_that_does_not_fit_is_refused_before_anything_is_allocated() {
-        let (_folder, path) = write_file(&header("(4294967296, 4294967296)"), &[1.0]);
-        let message = read_npy(&path, expected(8, 8)).unwrap_err().to_string();
-        assert!(
-            message.contains("(4294967296, 4294967296)") && message.contains("must be (8, 8)"),
-            "{message}"
-        );
-    }
-
-    #[test]
-    fn non_finite_weights_are_refused_by_row_and_column() {
-        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-            let (_folder, path) = write_file(&header("(2, 2)"), &[0.5, 0.5, 1.0, bad]);
-            let message = read_npy(&path, expected(2, 2)).unwrap_err().to_string();
-            assert!(
-                message.contains("w.npy: row 2, column 2 is") && message.contains("finite"),
-                "{message}"
-            );
-        }
-    }
-
-    #[test]
-    fn rows_must_sum_to_one() {
-        let (_folder, path) = write_file(&header("(2, 2)"), &[0.5, 0.5, 0.0, 0.0]);
-        let message = read_npy(&path, expected(2, 2)).unwrap_err().to_string();
-        assert!(
-            message.contains("row 2's weights sum to 0, not 1") && message.contains("1.0e-4"),
-            "{message}"
-        );
-        // Within f32 rounding is accepted; negative weights count by magnitude.
-        let near = [0.3f32, 0.7 + 4e-5, 3.0, -2.0];
-        let (_folder, path) = write_file(&header("(2, 2)"), &near);
-        assert_eq!(read_npy(&path, expected(2, 2)).expect("read").values, near);
-    }
-
-    #[test]
-    fn other_dtypes_orders_and_extra_bytes_are_named() {
-        let cases = [
-            (
-                "{'descr': '<f8', 'fortran_order': False, 'shape': (1, 1), }",
-                "found dtype '<f8'",
-            ),
-            (
-                "{'descr': '<f4', 'fortran_order': True, 'shape': (1, 1), }",
-                "fortran_order True",
-            ),
-            (
-                "{'descr': '<f4', 'fortran_order': False, 'shape': (1,), }",
-                "found shape (1,)",
-            ),
-        ];
-        for (text, expected_text) in cases {
-            let (_folder, path) = write_file(text, &[1.0]);
-            let message = read_npy(&path, expected(1, 1)).unwrap_err().to_string();
-            assert!(message.contains(expected_text), "{message}");
-        }
-        let (_folder, path) = write_file(&header("(1, 1)"), &[1.0, 1.0]);
-        let message = read_npy(&path, expected(1, 1)).unwrap_err().to_string();
-        assert!(message.contains("more than the 4 bytes"), "{message}");
-    }
-}
+mod tests;

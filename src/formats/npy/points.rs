@@ -168,6 +168,8 @@ pub(crate) fn read_points_npy(path: &Path, max_points: usize) -> Result<MeshFile
             ..Default::default()
         },
         obj_text: None,
+        node_transform: None,
+        object_note: None,
     })
 }
 

@@ -5,6 +5,7 @@
 //! polygons (cut by [`triangulate_polygon`]). Checked, then dropped: `vt`, `vn`,
 //! `o`/`g` groups and `usemtl`. Skipped: comments, `l` polylines, `mtllib` and
 //! unknown keywords. There are no line continuations, as tobj had none.
+//! One `o` object is read alone by name through [`pick_object`] ([`objects`]).
 //!
 //! The text is cut into pieces at line ends and read on every core: a first pass
 //! counts each piece's lines, vertices, texture coordinates, normals and faces, so
@@ -31,6 +32,7 @@
 //! rules, in the order tobj met them. tobj stays only as the tests' reference:
 //! nothing it read is left to it, so it is no fallback.
 
+mod objects;
 mod reader;
 
 use super::{LoadError, MeshFile, MeshFormat};
@@ -54,7 +56,38 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
         format: MeshFormat::Obj,
         mesh,
         obj_text: Some(text),
+        node_transform: None,
+        object_note: None,
     })
+}
+
+pub(in crate::formats) use objects::object_names;
+
+/// Object `object` of the OBJ `file` (read whole) as a mesh file of its own,
+/// or, without a name, `file` with a note where it has several objects.
+pub(super) fn pick_object(
+    path: &Path,
+    mut file: MeshFile,
+    object: Option<&str>,
+) -> Result<MeshFile, LoadError> {
+    let Some(text) = file.obj_text.as_deref() else {
+        return Ok(file);
+    };
+    let Some(name) = object else {
+        let names = object_names(text);
+        if names.len() > 1 {
+            file.object_note = Some(format!(
+                "the file has {}, read together as one mesh",
+                super::object_list(&names)
+            ));
+        }
+        return Ok(file);
+    };
+    let picked = objects::object_text(text, name).map_err(|source| LoadError::Object {
+        path: path.to_owned(),
+        source,
+    })?;
+    parse_obj(path, picked)
 }
 
 /// `text` cut after the first line end past every `bytes` bytes.

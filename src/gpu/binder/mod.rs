@@ -331,7 +331,8 @@ fn run(
     let started = Instant::now();
     let options = input.options;
     let patches = input.cage.has_quads() && options.split_applied(&input.cage).is_none();
-    let has_kernel = crate::gpu::kernels::Kernel::of_work(options.method, patches).is_some();
+    let has_kernel = !options.pmvc_exact()
+        && crate::gpu::kernels::Kernel::of_work(options.method, patches).is_some();
     match backend {
         Backend::Gpu(_) if has_kernel && !config.cpu_weights && !config.gpu_buffer => {
             Err(BindError::NothingKept)

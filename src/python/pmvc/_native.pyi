@@ -33,8 +33,9 @@ class Cage:
 
     def __init__(self, vertices: ArrayLike, faces: Faces) -> None: ...
     @staticmethod
-    def load(path: Path) -> "Cage":
-        """Read and validate an OBJ or OFF file. Raises FileError (naming the
+    def load(path: Path, object: Optional[str] = None) -> "Cage":
+        """Read and validate an OBJ, OFF or glTF file (object ``object`` of a
+        file with several, as :func:`load_mesh`). Raises FileError (naming the
         file and line) or CageError."""
         ...
     @property
@@ -84,8 +85,10 @@ class Weights:
     loaded)."""
 
     @property
-    def matrix(self) -> npt.NDArray[np.float32]:
-        """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes."""
+    def matrix(self) -> Union[npt.NDArray[np.float32], npt.NDArray[np.float64]]:
+        """float32 (points, columns), bit-for-bit what ``pmvc bind`` writes;
+        float64 where ``dtype=numpy.float64`` was asked for (as ``pmvc bind
+        --dtype f64``; ``metadata["dtype"]`` says which)."""
         ...
     @property
     def classes(self) -> npt.NDArray[np.int8]:
@@ -134,28 +137,32 @@ class Weights:
 
 def load_mesh(
     path: Path,
+    object: Optional[str] = None,
 ) -> Tuple[npt.NDArray[np.float64], Union[npt.NDArray[np.int64], List[List[int]]]]:
     """Read an OBJ, OFF or glTF file, or a .npy point set: ``(vertices,
     faces)``, vertices float64 (n, 3) in file order; faces an int64 array (m, 3)
     of 0-based indices when every face is a triangle ((0, 3) for a point set),
-    else a list of polygons (lists of indices)."""
+    else a list of polygons (lists of indices). ``object`` names one object of
+    a file with several (an OBJ's ``o`` name, a glTF node's or mesh's name);
+    without it a PmvcWarning names them where there are several."""
     ...
 
 def bind(
     points: ArrayLike,
     cage: CageLike,
     method: str = "pmvc",
-    resolution: int = 32,
+    resolution: Union[int, str] = 32,
     grid: int = 64,
     backend: str = "auto",
     progress: Optional[Progress] = None,
     triangulate: Optional[str] = None,
     pmvc_kernel: str = "auto",
     strict: bool = False,
+    dtype: npt.DTypeLike = "float32",
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
-    ``resolution`` is PMVC's cube-map resolution, ``grid`` harmonic
+    ``resolution`` is PMVC's cube-map resolution (or ``"exact"``), ``grid`` harmonic
     coordinates' grid; each is read only by its family and checked against its
     range. Quads are bilinear patches (MVC on them is QMVC) unless
     ``triangulate`` is "shorter" or "longer", which splits them along that
@@ -163,7 +170,9 @@ def bind(
     predicted faster for this bind), "cpu" or "gpu". ``pmvc_kernel``: PMVC's GPU
     kernel, "auto", "tiles" or "bands" (as ``pmvc bind --pmvc-kernel``; "bands"
     reproduces GPU weights bound before the tile kernel). ``strict=True``
-    raises InputError before binding when points lie outside the cage. ``cage``
+    raises InputError before binding when points lie outside the cage.
+    ``dtype=numpy.float64`` keeps every row as computed, without rounding it to
+    float32 (bound on the CPU; not for harmonic coordinates). ``cage``
     is a Cage or a ``(V, F)`` pair. The GIL is released; Ctrl-C cancels within
     about a second."""
     ...
@@ -179,7 +188,7 @@ def deform(
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
     bound first with ``parameters`` (resolution, grid, backend, progress,
-    triangulate, pmvc_kernel, strict); with ``weights``, ``strict=True``
+    triangulate, pmvc_kernel, strict, dtype); with ``weights``, ``strict=True``
     refuses weights with rows outside the cage."""
     ...
 
