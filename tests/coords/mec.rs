@@ -7,7 +7,7 @@
 
 use glam::{DMat3, DQuat, DVec3};
 use pmvc::coords::{
-    bind_cpu, cubemap::TexelTable, mec, weights_at, BindOptions, BindProgress, Method, RowScratch,
+    bind_cpu, mec, weights_at, BindOptions, BindProgress, Method, PmvcIntegration, RowScratch,
 };
 use pmvc::geometry::procedural_quads::{cage_from_polygons, quad_comb, twisted_box};
 use pmvc::geometry::{classify_points, procedural, quads, Cage, PointClass};
@@ -36,7 +36,7 @@ fn row(cage: &Cage, x: DVec3) -> Vec<f64> {
         PointClass::Inside,
         cage,
         Method::Mec,
-        &TexelTable::new(1),
+        &PmvcIntegration::of(BindOptions::for_method(Method::Mec)),
         &mut out,
         &mut RowScratch::default(),
     );

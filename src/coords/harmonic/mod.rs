@@ -299,7 +299,15 @@ fn fill_boundary_and_outside(
         .for_each_init(
             || (vec![0.0f64; columns], super::RowScratch::default()),
             |(row_f64, scratch), (row, (&x, &class))| {
-                super::weights_at(x, class, cage, super::Method::Mvc, &integration, row_f64, scratch);
+                super::weights_at(
+                    x,
+                    class,
+                    cage,
+                    super::Method::Mvc,
+                    &integration,
+                    row_f64,
+                    scratch,
+                );
                 for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
                     *out = value as f32;
                 }
