@@ -2,7 +2,7 @@
 //! and on the shared evaluation data, on the CPU and on a GPU adapter. Reports medians over repeated runs, as markdown on
 //! stdout and optionally as JSON.
 
-use crate::coords::{BindOptions, BindProgress, Method, QuadSplit, EXACT_RESOLUTION};
+use crate::coords::{BindOptions, BindProgress, Method, QuadSplit, QuadSupport, EXACT_RESOLUTION};
 use crate::formats::shown_path;
 use crate::geometry::{procedural, Cage, PointClass};
 use crate::gpu::{Backend, BindConfig, BindInput, Binder, GpuContext, PmvcKernel};
@@ -181,6 +181,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         (Method::Pmvc, 32),
         (Method::Pmvc, 64),
         (Method::Pmvc, EXACT_RESOLUTION),
+        (Method::Mec, 0),
         (Method::Harmonic, 64),
         (Method::Harmonic, 128),
     ];
@@ -452,11 +453,19 @@ fn bench_shared_data(
         } else {
             &[QuadSplit::None]
         };
-        let mut configurations: Vec<_> =
-            [(Method::Mvc, 0), (Method::Pmvc, 32), (Method::Harmonic, 64)]
-                .into_iter()
-                .flat_map(|(method, value)| splits.iter().map(move |&split| (method, value, split)))
-                .collect();
+        // Every family at its default parameter, so that a new family gets rows;
+        // a family that binds triangles only splits quads itself: one row.
+        let mut configurations: Vec<_> = Method::ALL
+            .into_iter()
+            .flat_map(|method| {
+                let value = method.spec().parameter.map_or(0, |p| p.default);
+                let patches = matches!(method.spec().quads, QuadSupport::Patches { .. });
+                splits
+                    .iter()
+                    .filter(move |&&split| patches || split == QuadSplit::None)
+                    .map(move |&split| (method, value, split))
+            })
+            .collect();
         // Exact PMVC split a cage's quads themselves: one row.
         configurations.push((Method::Pmvc, EXACT_RESOLUTION, QuadSplit::None));
         rows.extend(bench_scene_split(

@@ -24,6 +24,9 @@ pub enum Method {
     /// Green coordinates (Lipman, Levin, Cohen-Or 2008), closed form: one column per
     /// cage vertex (φ) and one per cage triangle (ψ).
     Green,
+    /// Maximum entropy coordinates (Hormann and Sukumar 2008), by a convex
+    /// minimisation in three unknowns per point.
+    Mec,
 }
 
 /// One set of weights a viewer holds: a family as bound with the viewer's
@@ -360,9 +363,28 @@ const GREEN: FamilySpec = FamilySpec {
     quads_reason: "Green coordinates for quad cages are another method, Thiery and Boubekeur 2022, not yet offered",
 };
 
+const MEC: FamilySpec = FamilySpec {
+    id: "mec",
+    name: "MEC",
+    summary: "maximum entropy coordinates: positive and smooth, a small convex solve per point",
+    parameter: None,
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
+    quads: QuadSupport::Patches { name: "MEC" },
+    quads_reason: "",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 4] = [Method::Mvc, Method::Pmvc, Method::Harmonic, Method::Green];
+    pub const ALL: [Method; 5] = [
+        Method::Mvc,
+        Method::Pmvc,
+        Method::Harmonic,
+        Method::Green,
+        Method::Mec,
+    ];
 
     pub fn spec(self) -> &'static FamilySpec {
         match self {
@@ -370,6 +392,7 @@ impl Method {
             Method::Pmvc => &PMVC,
             Method::Harmonic => &HARMONIC,
             Method::Green => &GREEN,
+            Method::Mec => &MEC,
         }
     }
 

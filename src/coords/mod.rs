@@ -1,12 +1,14 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
-//! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), and the dense
-//! weights matrix they fill. Nothing here touches the GPU or the UI.
+//! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
+//! coordinates ([`mec`]), and the dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
 //!   cage diagonal), every family gives the barycentric coordinates of the
-//!   touching triangle, which is the limit of each of them there;
+//!   touching triangle, which is the limit of each of them there (MEC's only on
+//!   well-shaped triangles: near slivers and quads it tends elsewhere, see
+//!   docs/coordinates.md);
 //! - outside, every family uses MVC. MVC is finite off the surface (its total weight
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
 //!   reproduces the rest pose by linear precision, and meets every family
@@ -25,6 +27,7 @@ pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;
+pub mod mec;
 pub mod mvc;
 pub mod parameter_values;
 pub mod pmvc;
@@ -450,14 +453,8 @@ pub fn bind_rows<T: WeightValue>(
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
-            || {
-                (
-                    vec![0.0f64; cols],
-                    mvc::MvcScratch::default(),
-                    pmvc::PmvcScratch::default(),
-                )
-            },
-            |(row_f64, mvc_scratch, pmvc_scratch), (block, block_rows)| {
+            || (vec![0.0f64; cols], RowScratch::default()),
+            |(row_f64, scratch), (block, block_rows)| {
                 if progress.is_cancelled() {
                     return Err(Cancelled);
                 }
@@ -472,8 +469,7 @@ pub fn bind_rows<T: WeightValue>(
                             options.method,
                             &integration,
                             row_f64,
-                            mvc_scratch,
-                            pmvc_scratch,
+                            scratch,
                         );
                     }
                     for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
@@ -495,9 +491,16 @@ fn green_row(green_cage: &green::GreenCage, x: DVec3, out: &mut [f64]) {
     }
 }
 
+/// Per-thread buffers of the families computed row by row, reused across rows.
+#[derive(Debug, Default)]
+pub struct RowScratch {
+    pub mvc: mvc::MvcScratch,
+    pub pmvc: pmvc::PmvcScratch,
+    pub mec: mec::MecScratch,
+}
+
 /// Coordinates of one point, following the policy of the module doc. `out` holds
 /// the method's columns ([`Method::columns`]).
-#[allow(clippy::too_many_arguments)]
 pub fn weights_at(
     x: DVec3,
     class: PointClass,
@@ -505,9 +508,13 @@ pub fn weights_at(
     method: Method,
     integration: &PmvcIntegration,
     out: &mut [f64],
-    mvc_scratch: &mut mvc::MvcScratch,
-    pmvc_scratch: &mut pmvc::PmvcScratch,
+    scratch: &mut RowScratch,
 ) {
+    let RowScratch {
+        mvc: mvc_scratch,
+        pmvc: pmvc_scratch,
+        mec: mec_scratch,
+    } = scratch;
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
         // in `bind_rows`.
@@ -551,6 +558,13 @@ pub fn weights_at(
                 if !integration.weights_inside(x, cage, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the
                     // surface or in a cage defect). Follow the outside policy.
+                    mvc::mvc_weights(x, cage, out, mvc_scratch);
+                }
+            }
+            Method::Mec => {
+                if mec::mec_weights_inside(x, cage, out, mec_scratch).is_err() {
+                    // Only a point not strictly inside the hull has no solution
+                    // (numerically on the surface): the outside policy, as PMVC.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);
                 }
             }

@@ -80,19 +80,30 @@ fn a_software_adapter_never_wins_pmvc_against_two_cpu_threads() {
     }
 }
 
+/// Harmonic coordinates, MEC and any family added without a kernel.
 #[test]
-fn harmonic_coordinates_always_bind_on_the_cpu() {
-    let prediction = predict(
-        &work(Method::Harmonic, 10_000_000, 1_523, 1),
-        &device(AdapterClass::Discrete, Pipelines::Ready),
-    );
-    assert_eq!(prediction.gpu_s, None);
-    assert!(!prediction.gpu_wins());
-    assert!(
-        prediction.explain().contains("no GPU kernel"),
-        "{}",
-        prediction.explain()
-    );
+fn families_without_a_kernel_always_bind_on_the_cpu() {
+    let cpu_only: Vec<Method> = Method::ALL
+        .into_iter()
+        .filter(|&method| Kernel::of(method).is_none())
+        .collect();
+    assert!(cpu_only.contains(&Method::Harmonic) && cpu_only.contains(&Method::Mec));
+    for method in cpu_only {
+        let scene = work(method, 10_000_000, 1_523, 1);
+        let prediction = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Ready));
+        assert_eq!(prediction.gpu_s, None);
+        assert!(!prediction.gpu_wins());
+        assert!(
+            prediction.explain().contains("no GPU kernel"),
+            "{}",
+            prediction.explain()
+        );
+        assert_eq!(
+            scene.no_kernel_reason(),
+            Some("this family has no GPU kernel")
+        );
+        assert!(!decide(BackendRequest::Auto, None, &scene).on_gpu(method));
+    }
 }
 
 #[test]

@@ -222,7 +222,7 @@ impl PyWeights {
         self.classes.bind(py).clone()
     }
 
-    /// The family's id: "mvc", "pmvc", "harmonic" or "green".
+    /// The family's id, e.g. "pmvc" (:func:`families` lists them all).
     #[getter(method)]
     fn method_id(&self) -> &'static str {
         self.method().id()

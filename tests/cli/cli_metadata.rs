@@ -10,7 +10,8 @@ use crate::common;
 use cli_support::*;
 use common::*;
 use glam::DVec3;
-use pmvc::coords::Method;
+use pmvc::coords::family::ColumnLayout;
+use pmvc::coords::{Method, Parameter};
 use pmvc::geometry::Cage;
 use std::path::{Path, PathBuf};
 
@@ -68,16 +69,25 @@ fn bind_writes_metadata_and_row_classes_for_every_family() {
         "the scene has rows of each class"
     );
     for method in Method::ALL {
-        let (extension, parameter, extra): (_, serde_json::Value, &[&str]) = match method {
-            Method::Pmvc => (
-                "npy",
-                serde_json::json!({"resolution": 8}),
-                &["--resolution", "8"],
-            ),
-            Method::Harmonic => ("npy", serde_json::json!({"grid": 16}), &["--grid", "16"]),
-            Method::Green => ("npz", serde_json::json!({}), &[]),
-            Method::Mvc => ("npy", serde_json::json!({}), &[]),
+        // Read from the family's spec, so that a new family is covered unedited.
+        let extension = match method.spec().columns {
+            ColumnLayout::CageVerticesThenTriangles => "npz",
+            ColumnLayout::CageVertices => "npy",
         };
+        let (parameter, extra) = match method.spec().parameter {
+            None => (serde_json::json!({}), Vec::new()),
+            Some(spec) => {
+                // Small values, for speed.
+                let (value, text) = match spec.key {
+                    Parameter::Resolution => (8, "8"),
+                    Parameter::Grid => (16, "16"),
+                };
+                let mut parameter = serde_json::Map::new();
+                parameter.insert(spec.key.id().to_owned(), value.into());
+                (parameter.into(), vec![spec.flag, text])
+            }
+        };
+        let extra = &extra[..];
         let out = dir.path().join(format!("{}.{extension}", method.id()));
         let output = bind(&mesh, &cage_path, method.id(), &out, extra);
         assert!(output.status.success(), "{method:?}: {}", stderr(&output));

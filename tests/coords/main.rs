@@ -1,4 +1,4 @@
-//! Coordinates: MVC, PMVC, harmonic and Green coordinates against references and
+//! Coordinates: MVC, PMVC, harmonic, Green and maximum entropy coordinates against references and
 //! their properties, far-field exactness, origin offsets, weights metadata and
 //! the figures the docs quote. Builds without features
 //! (`cargo test --no-default-features --test coords`); the parts that run the
@@ -15,5 +15,6 @@ mod green;
 mod green_family;
 mod green_gallery;
 mod harmonic;
+mod mec;
 mod origin_offsets;
 mod weights_metadata;

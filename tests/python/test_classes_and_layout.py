@@ -127,8 +127,9 @@ def test_a_npy_point_set_loads_as_points_without_faces(tmp_path, test_points):
 
 def test_families_lists_every_family_with_its_parameters_and_promise():
     families = {family["id"]: family for family in pmvc.families()}
-    assert list(families) == ["mvc", "pmvc", "harmonic", "green"]
+    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec"]
     assert families["pmvc"]["positive_inside"] and not families["mvc"]["positive_inside"]
+    assert families["mec"]["positive_inside"] and not families["mec"]["gpu_kernel"]
     assert [p["id"] for p in families["pmvc"]["parameters"]] == ["resolution"]
     assert families["harmonic"]["parameters"][0]["default"] == 64
     assert families["green"]["columns_layout"] == "cage_vertices_then_triangles"

@@ -22,7 +22,7 @@ mod patches;
 mod sample;
 mod solve;
 
-use super::{mvc, BindProgress, Cancelled, Weights};
+use super::{BindProgress, Cancelled, Weights};
 use crate::geometry::{Cage, PointClass};
 use glam::DVec3;
 use grid::{inside_nodes, Frame, Level};
@@ -297,14 +297,8 @@ fn fill_boundary_and_outside(
         .zip(points.par_iter().zip(classes))
         .filter(|(_, (_, class))| !matches!(class, PointClass::Inside))
         .for_each_init(
-            || {
-                (
-                    vec![0.0f64; columns],
-                    mvc::MvcScratch::default(),
-                    super::pmvc::PmvcScratch::default(),
-                )
-            },
-            |(row_f64, mvc_scratch, pmvc_scratch), (row, (&x, &class))| {
+            || (vec![0.0f64; columns], super::RowScratch::default()),
+            |(row_f64, scratch), (row, (&x, &class))| {
                 super::weights_at(
                     x,
                     class,
@@ -312,8 +306,7 @@ fn fill_boundary_and_outside(
                     super::Method::Mvc,
                     &integration,
                     row_f64,
-                    mvc_scratch,
-                    pmvc_scratch,
+                    scratch,
                 );
                 for (out, &value) in row.iter_mut().zip(row_f64.iter()) {
                     *out = value as f32;
