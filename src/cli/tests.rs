@@ -87,7 +87,7 @@ fn view_flags_set_the_editors_views() {
     assert_eq!(options.view.layout, Layout::SideBySide);
     assert_eq!(
         options.view.compared.iter().collect::<Vec<_>>(),
-        Method::ALL.to_vec()
+        [Method::Mvc, Method::Pmvc, Method::Harmonic, Method::Green]
     );
     let options = edit_options(&["--view", "mvc", "--negativity"]);
     assert_eq!(options.view.layout, Layout::Single);

@@ -40,12 +40,7 @@ pub(super) fn method_from(id: &str) -> PyResult<Method> {
 /// A parameter's value from Python, checked by its spec's one `validate`.
 pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) -> PyResult<u32> {
     let spec = parameter.spec();
-    if let Ok(name) = value.extract::<String>() {
-        return spec
-            .parse(&name)
-            .map_err(|cause| error(Kind::Parameter, format!("{}: {cause}", parameter.id())));
-    }
-    let value: i128 = value.extract().map_err(|_| {
+    let refused = || {
         let names: Vec<String> = spec
             .named
             .iter()
@@ -59,7 +54,17 @@ pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) ->
                 names.concat()
             ),
         )
-    })?;
+    };
+    // A string is a value's name ("exact"); numbers come as numbers.
+    if let Ok(name) = value.extract::<String>() {
+        return spec
+            .named
+            .iter()
+            .find(|named| named.name.eq_ignore_ascii_case(name.trim()))
+            .map(|named| named.value)
+            .ok_or_else(refused);
+    }
+    let value: i128 = value.extract().map_err(|_| refused())?;
     // Below zero or past u64 it is out of range all the same; the spec's
     // message gives the range.
     let clamped = u64::try_from(value).unwrap_or(u64::MAX);
