@@ -49,6 +49,7 @@ mod screenshot;
 mod scripted_drag;
 pub mod session;
 pub mod session_checks;
+mod session_json;
 mod session_paths;
 pub mod shortcuts;
 pub mod timeline;

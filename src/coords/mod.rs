@@ -361,23 +361,38 @@ pub fn bind_cpu(
             harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
         return Ok(weights);
     }
-    let columns = options.method.columns(cage);
+    let (cols, values) = every_row(points, classes, cage, options, progress)?;
+    Ok(Weights {
+        rows: points.len(),
+        cols,
+        values,
+    })
+}
+
+/// Every row of `points`, bound by [`bind_rows`] into values of type `T`, after
+/// the memory they take is checked; with the number of columns.
+fn every_row<T: WeightValue>(
+    points: &[DVec3],
+    classes: &[PointClass],
+    cage: &Cage,
+    options: BindOptions,
+    progress: &BindProgress,
+) -> Result<(usize, Vec<T>), BindFailure> {
+    let columns = options.method.columns(&options.cage_to_bind(cage));
+    let value_bytes = std::mem::size_of::<T>();
     crate::budget::check_memory(
-        || format!("the weights ({} rows × {columns} columns)", points.len()),
-        crate::budget::bytes_for(points.len() as u64, 4 * columns as u64),
+        || {
+            format!(
+                "the weights ({} rows × {columns} columns × {value_bytes} bytes)",
+                points.len()
+            )
+        },
+        crate::budget::bytes_for(points.len() as u64, (value_bytes * columns) as u64),
     )?;
-    let mut weights = Weights::zeros(points.len(), columns);
+    let mut values = vec![T::from_f64(0.0); points.len() * columns];
     let rows: Vec<usize> = (0..points.len()).collect();
-    bind_rows(
-        points,
-        classes,
-        cage,
-        options,
-        &rows,
-        &mut weights.values,
-        progress,
-    )?;
-    Ok(weights)
+    bind_rows(points, classes, cage, options, &rows, &mut values, progress)?;
+    Ok((columns, values))
 }
 
 /// [`bind_cpu`] into float64 weights: every row as computed, without the
@@ -392,17 +407,17 @@ pub fn bind_cpu_f64(
     progress: &BindProgress,
 ) -> Result<WeightsF64, BindFailure> {
     options.validate()?;
-    let columns = options.method.columns(&options.cage_to_bind(cage));
-    crate::budget::check_memory(
-        || {
-            format!(
-                "the weights ({} rows × {columns} columns × 8 bytes)",
-                points.len()
-            )
-        },
-        crate::budget::bytes_for(points.len() as u64, 8 * columns as u64),
-    )?;
     if options.method == Method::Harmonic {
+        let columns = options.method.columns(cage) as u64;
+        crate::budget::check_memory(
+            || {
+                format!(
+                    "the weights ({} rows × {columns} columns × 8 bytes)",
+                    points.len()
+                )
+            },
+            crate::budget::bytes_for(points.len() as u64, 8 * columns),
+        )?;
         let weights = bind_cpu(points, classes, cage, options, progress)?;
         return Ok(WeightsF64 {
             rows: weights.rows,
@@ -410,18 +425,12 @@ pub fn bind_cpu_f64(
             values: weights.values.iter().map(|&w| f64::from(w)).collect(),
         });
     }
-    let mut weights = WeightsF64::zeros(points.len(), columns);
-    let rows: Vec<usize> = (0..points.len()).collect();
-    bind_rows(
-        points,
-        classes,
-        cage,
-        options,
-        &rows,
-        &mut weights.values,
-        progress,
-    )?;
-    Ok(weights)
+    let (cols, values) = every_row(points, classes, cage, options, progress)?;
+    Ok(WeightsF64 {
+        rows: points.len(),
+        cols,
+        values,
+    })
 }
 
 /// The one row loop of every CPU bind: fill `out` (`rows.len()` × the method's

@@ -9,7 +9,7 @@
 //!
 //! - [`arrays`]: array-likes in (checked: shape, dtype, finite values, indices),
 //!   numpy arrays out.
-//! - [`scene`]: `Cage`, `load_mesh`, `classify`, `generate_cage`, `families`.
+//! - [`scene`]: `Cage`, `load_mesh`, `classify`, `generate_cage`; [`families`]: `families`.
 //! - [`binding`]: `bind` and `deform`, run off the GIL with progress and Ctrl-C.
 //! - [`weights`]: the `Weights` class, `save_weights` and `load_weights`.
 //! - [`errors`]: library errors as `pmvc.PmvcError` subclasses.
@@ -23,6 +23,7 @@ mod arrays;
 mod bind_arguments;
 mod binding;
 mod errors;
+mod families;
 mod scene;
 mod weights;
 
@@ -38,7 +39,7 @@ fn _native(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(weights::restore_weights, module)?)?;
     module.add_function(wrap_pyfunction!(scene::classify, module)?)?;
     module.add_function(wrap_pyfunction!(scene::generate_cage, module)?)?;
-    module.add_function(wrap_pyfunction!(scene::families, module)?)?;
+    module.add_function(wrap_pyfunction!(families::families, module)?)?;
     module.add_function(wrap_pyfunction!(binding::bind, module)?)?;
     module.add_function(wrap_pyfunction!(binding::deform, module)?)?;
     module.add_function(wrap_pyfunction!(weights::save_weights, module)?)?;

@@ -1,11 +1,16 @@
-//! What quitting and opening another scene wait for: the unsaved-work
+//! Files and unsaved work: opening, saving and exporting (each refusing to
+//! write over what the scene was read from) and the file dialogs' answers;
+//! what quitting and opening another scene wait for: the unsaved-work
 //! question and its answers, autosave, and recovery of work an editor left
 //! behind.
 
 use super::{EditorApp, Waiting};
-use crate::app::actions::{Action, FileAction, RecoverAnswer, UnsavedAnswer};
+use crate::app::actions::{Action, FileAction, FileRole, RecoverAnswer, UnsavedAnswer};
 use crate::app::commands::Command;
 use crate::app::files::{self, SceneChange};
+use crate::app::recent::RecentEntry;
+use crate::app::session::SessionSettings;
+use crate::app::ui::file_dialog::DialogAnswer;
 use crate::app::ui::unsaved_dialog::Question;
 use std::path::Path;
 
@@ -148,4 +153,225 @@ impl EditorApp {
         let now = self.run.clock;
         recovery.write(now, self.model.document(), &settings)
     }
+}
+
+impl EditorApp {
+    /// `positions` read from `path` as the pose, once checked; the pose is
+    /// then on disk.
+    pub(super) fn take_pose(
+        &mut self,
+        path: &Path,
+        checked: Result<Vec<glam::DVec3>, String>,
+    ) -> bool {
+        match checked {
+            Ok(pose) => {
+                self.apply(Command::edit_pose(pose));
+                self.apply(Command::MarkSaved);
+                self.info(format!("loaded pose {}", crate::formats::shown_path(path)));
+                true
+            }
+            Err(error) => {
+                self.error(error);
+                false
+            }
+        }
+    }
+
+    // ---- files ----------------------------------------------------------------------
+
+    pub(super) fn open_file_now(&mut self, role: FileRole, path: &Path) -> bool {
+        let change = files::open_file(role, path, self.model.document());
+        self.change_scene(change)
+    }
+
+    pub(super) fn open_pair_now(&mut self, mesh: &Path, cage: &Path) -> bool {
+        self.change_scene(files::open_pair(mesh, cage))
+    }
+
+    pub(super) fn open_session_now(&mut self, path: &Path) -> bool {
+        self.change_scene(files::open_session(path))
+    }
+
+    pub(super) fn open_recent_now(&mut self, entry: &RecentEntry) -> bool {
+        let opened = match entry {
+            RecentEntry::Session(path) => self.open_session_now(path),
+            RecentEntry::Scene { mesh, cage } => self.open_pair_now(mesh, cage),
+            RecentEntry::Mesh(path) => self.open_file_now(FileRole::Mesh, path),
+            RecentEntry::Cage(path) => self.open_file_now(FileRole::Cage, path),
+        };
+        if !opened {
+            self.files.recent.forget(entry);
+        }
+        opened
+    }
+
+    pub(super) fn load_pose_now(&mut self, path: &Path) -> bool {
+        let checked = files::read_pose(path, self.model.document());
+        self.take_pose(path, checked)
+    }
+
+    /// Whether `path` may be written by anything but Save session: never the
+    /// session file the scene came from (the mesh and cage are refused by the
+    /// writers in `files`).
+    fn refuse_overwriting_session(&mut self, path: &Path) -> bool {
+        let session = self.files.session_path.as_deref();
+        match files::refuse_overwriting_inputs(path, self.model.document(), session) {
+            Ok(()) => false,
+            Err(error) => {
+                self.error(error);
+                true
+            }
+        }
+    }
+
+    pub(super) fn save_pose_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        let saved = self.report(files::save_pose(path, self.model.document()));
+        if saved {
+            self.apply(Command::MarkSaved);
+        }
+        saved
+    }
+
+    pub(super) fn save_cage_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        self.report(files::save_cage(path, self.model.document()))
+    }
+
+    /// What a session keeps besides the document.
+    pub(super) fn session_settings(&self) -> SessionSettings {
+        SessionSettings {
+            bind_options: self.binding.options,
+            view: self.views.settings,
+            cameras: self.views.viewport.camera_list(),
+        }
+    }
+
+    pub(super) fn save_session_now(&mut self, path: &Path) -> bool {
+        let settings = self.session_settings();
+        let saved = self.report(files::save_session(path, self.model.document(), &settings));
+        if saved {
+            self.apply(Command::MarkSessionSaved);
+            self.files.session_path = Some(path.to_owned());
+            self.files
+                .recent
+                .remember(RecentEntry::Session(path.to_owned()));
+        }
+        saved
+    }
+
+    pub(super) fn export_deformed_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        let method = self.binding.active_method();
+        self.report(files::export_deformed(path, self.model.document(), method))
+    }
+
+    pub(super) fn export_gltf_now(&mut self, path: &Path, base: files::GltfBase) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        let (document, method) = (self.model.document(), self.binding.active_method());
+        let exported = files::export_gltf(path, document, method, base);
+        self.report(exported)
+    }
+
+    pub(super) fn export_coloured_mesh_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        let wanted = self.wanted_methods_now();
+        let exported = self
+            .views
+            .export_coloured_mesh(path, self.model.document(), &wanted);
+        self.report(exported)
+    }
+
+    pub(super) fn save_image_now(&mut self, path: &Path) -> bool {
+        if self.refuse_overwriting_session(path) {
+            return false;
+        }
+        self.files.image_request.ask(path);
+        true
+    }
+
+    /// Ask for a file for `action` and carry it out: the system's dialog when it
+    /// works, else the in-window one (which answers in a later frame).
+    pub(super) fn ask_for_file_now(&mut self, action: FileAction) {
+        let name = match action {
+            FileAction::SaveSession => Some(files::session_name(self.model.document())),
+            FileAction::SaveCage => Some(files::cage_name(self.model.document())),
+            _ => None,
+        };
+        match self.panels.file_dialogs.ask(action, name) {
+            DialogAnswer::Chosen(path) => {
+                self.finish_file_action(action, &path);
+            }
+            DialogAnswer::Cancelled => self.file_action_cancelled(action),
+            DialogAnswer::InWindow { fell_back } => {
+                if fell_back {
+                    self.info(
+                        "the system's file dialog did not open (no desktop portal?): using the \
+                         in-window dialog (File > In-window file dialog)",
+                    );
+                }
+            }
+        }
+    }
+
+    /// Carry out `action` on `path`; true when it succeeded.
+    pub(super) fn finish_file_action(&mut self, action: FileAction, path: &Path) -> bool {
+        self.panels.file_dialogs.remember_folder(path);
+        let done = match action {
+            FileAction::OpenMesh => self.open_file_now(FileRole::Mesh, path),
+            FileAction::OpenCage => self.open_file_now(FileRole::Cage, path),
+            FileAction::LoadPose => self.load_pose_now(path),
+            FileAction::SavePose => self.save_pose_now(path),
+            FileAction::SaveCage => self.save_cage_now(path),
+            FileAction::ExportMesh => self.export_deformed_now(path),
+            FileAction::OpenSession => self.open_session_now(path),
+            FileAction::SaveSession => self.save_session_now(path),
+            FileAction::SaveImage => self.save_image_now(path),
+            FileAction::ExportColouredMesh => self.export_coloured_mesh_now(path),
+            FileAction::ExportGltf => self.export_gltf_now(path, files::GltfBase::Rest),
+            FileAction::ExportGltfPosedBase => self.export_gltf_now(path, files::GltfBase::Pose),
+        };
+        if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
+            if done {
+                self.go_on_after_save();
+            } else if !self.panels.file_dialogs.is_open() {
+                // The system's dialog is gone with the error: the user answers
+                // again when quitting or opening again.
+                self.files.waiting = None;
+            }
+        }
+        done
+    }
+
+    pub(super) fn file_action_cancelled(&mut self, action: FileAction) {
+        if matches!(action, FileAction::SavePose | FileAction::SaveSession) {
+            self.files.waiting = None;
+        }
+    }
+
+    /// The in-window dialog's file: carried out, the dialog closes; failed, it
+    /// stays and says why, so another file can be chosen.
+    pub(super) fn in_window_answer(&mut self, action: FileAction, path: &Path) {
+        let notices_before = self.panels.notices.all().len();
+        let done = self.finish_file_action(action, path);
+        let failed = (!done).then(|| {
+            let notices = self.panels.notices.all();
+            (notices.get(notices_before..))
+                .and_then(|new| new.iter().rev().find(|n| n.is_error))
+                .map_or_else(|| "failed".into(), |n| n.text.clone())
+        });
+        self.panels.file_dialogs.answered(failed);
+    }
+
+    // ---- the Generate cage window -----------------------------------------------------
 }

@@ -1,0 +1,69 @@
+//! `families()`: every family as data, for scripts and the Blender add-on.
+
+use crate::coords::family::ColumnLayout;
+use crate::coords::Method;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+/// Every coordinate family: a list of dicts with ``id`` (the ``method``
+/// argument), ``name``, ``summary``, ``parameters`` (each with ``id``,
+/// ``label``, ``default``, ``min``, ``max`` and the editor's ``choices``),
+/// ``positive_inside`` (whether weights inside the cage are never negative),
+/// ``outside_policy``, ``columns_layout``, ``gpu_kernel`` (whether
+/// ``backend="gpu"`` runs it on the GPU on a cage of triangles; otherwise it
+/// binds on the CPU) and ``gpu_kernel_quads`` (the same on a cage whose quads
+/// the family binds as bilinear patches: MVC there is QMVC, CPU only).
+#[pyfunction]
+pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let list = PyList::empty(py);
+    for method in Method::ALL {
+        let spec = method.spec();
+        let family = PyDict::new(py);
+        family.set_item("id", spec.id)?;
+        family.set_item("name", spec.name)?;
+        family.set_item("summary", spec.summary)?;
+        let parameters = PyList::empty(py);
+        if let Some(parameter) = spec.parameter {
+            let entry = PyDict::new(py);
+            entry.set_item("id", parameter.key.id())?;
+            entry.set_item("label", parameter.label)?;
+            entry.set_item("default", parameter.default)?;
+            entry.set_item("min", parameter.min)?;
+            entry.set_item("max", parameter.max)?;
+            let choices = PyList::empty(py);
+            for &choice in parameter.choices {
+                match parameter.name_of(choice) {
+                    Some(name) => choices.append(name)?,
+                    None => choices.append(choice)?,
+                }
+            }
+            entry.set_item("choices", choices)?;
+            let named: Vec<&str> = parameter.named.iter().map(|n| n.name).collect();
+            entry.set_item("named", named)?;
+            parameters.append(entry)?;
+        }
+        family.set_item("parameters", parameters)?;
+        family.set_item("positive_inside", spec.positive_inside)?;
+        family.set_item("outside_policy", spec.outside_policy)?;
+        family.set_item("columns_layout", columns_layout(spec.columns))?;
+        family.set_item(
+            "gpu_kernel",
+            crate::gpu::kernels::Kernel::of_work(method, false).is_some(),
+        )?;
+        let on_quads = matches!(spec.quads, crate::coords::QuadSupport::Patches { .. });
+        family.set_item(
+            "gpu_kernel_quads",
+            crate::gpu::kernels::Kernel::of_work(method, on_quads).is_some(),
+        )?;
+        list.append(family)?;
+    }
+    Ok(list)
+}
+
+/// The name saved files give a column layout.
+pub(super) fn columns_layout(layout: ColumnLayout) -> &'static str {
+    match layout {
+        ColumnLayout::CageVertices => "cage_vertices",
+        ColumnLayout::CageVerticesThenTriangles => "cage_vertices_then_triangles",
+    }
+}
