@@ -29,49 +29,6 @@ pub enum Method {
     Mec,
 }
 
-/// One set of weights a viewer holds: a family as bound with the viewer's
-/// setting for quads, or its triangulated twin, the same family bound with the
-/// cage's quads split along a diagonal, to show what the split does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct WeightsId {
-    pub method: Method,
-    pub split_twin: Option<crate::geometry::QuadSplit>,
-}
-
-impl WeightsId {
-    /// `method` as the viewer binds it.
-    pub const fn of(method: Method) -> Self {
-        Self {
-            method,
-            split_twin: None,
-        }
-    }
-
-    /// `method` with the quads split along `split`'s diagonal.
-    pub fn twin(method: Method, split: crate::geometry::QuadSplit) -> Self {
-        Self {
-            method,
-            split_twin: Some(split),
-        }
-    }
-}
-
-impl From<Method> for WeightsId {
-    fn from(method: Method) -> Self {
-        Self::of(method)
-    }
-}
-
-impl std::fmt::Display for WeightsId {
-    /// "PMVC", or "PMVC (shorter split)" for a twin.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.split_twin {
-            None => write!(f, "{}", self.method.name()),
-            Some(split) => write!(f, "{} ({} split)", self.method.name(), split.id()),
-        }
-    }
-}
-
 /// A family's one integer parameter (a resolution, a grid size).
 #[derive(Clone, Copy, Debug)]
 pub struct ParameterSpec {

@@ -35,19 +35,21 @@ mod progress;
 pub mod qmvc;
 pub mod quality;
 pub mod split_effect;
+mod weights_id;
 
 pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass, PointClasses};
 pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
     FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
-    WeightsId, DEFAULT_RESOLUTION, EXACT_RESOLUTION,
+    DEFAULT_RESOLUTION, EXACT_RESOLUTION,
 };
 use glam::DVec3;
 pub use pmvc::PmvcIntegration;
 pub use progress::{BindProgress, Cancelled};
 pub use quality::WeightQuality;
 use rayon::prelude::*;
+pub use weights_id::{Twin, WeightsId};
 
 /// How many of `total` points lie outside the cage, and the first few (0-based,
 /// ascending `outside`): the warning of a bind with outside points, and the
