@@ -27,6 +27,9 @@ pub enum Method {
     /// Maximum entropy coordinates (Hormann and Sukumar 2008), by a convex
     /// minimisation in three unknowns per point.
     Mec,
+    /// Maximum likelihood coordinates (Chang, Deng, Hormann 2023), by a convex
+    /// maximisation in three unknowns per point.
+    Mlc,
 }
 
 /// One set of weights a viewer holds: a family as bound with the viewer's
@@ -376,14 +379,31 @@ const MEC: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const MLC: FamilySpec = FamilySpec {
+    id: "mlc",
+    name: "MLC",
+    summary: "maximum likelihood coordinates: positive and smooth, a small convex solve per point",
+    parameter: None,
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
+    // Inside, MLC read only the vertex positions, so a quad is taken as it is
+    // (splitting it changes nothing there); on a quad the surface policy gives
+    // the bilinear basis (docs/coordinates.md, MLC).
+    quads: QuadSupport::Patches { name: "MLC" },
+    quads_reason: "",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
         Method::Green,
         Method::Mec,
+        Method::Mlc,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -393,6 +413,7 @@ impl Method {
             Method::Harmonic => &HARMONIC,
             Method::Green => &GREEN,
             Method::Mec => &MEC,
+            Method::Mlc => &MLC,
         }
     }
 
