@@ -388,9 +388,7 @@ const MLC: FamilySpec = FamilySpec {
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
     rows_independent: true,
-    // Inside, MLC read only the vertex positions, so a quad is taken as it is
-    // (splitting it changes nothing there); on a quad the surface policy gives
-    // the bilinear basis (docs/coordinates.md, MLC).
+    // Inside only vertex positions count: splitting a quad would change nothing.
     quads: QuadSupport::Patches { name: "MLC" },
     quads_reason: "",
 };

@@ -1,13 +1,15 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
 //! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
-//! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), and the dense weights matrix they fill. Nothing here touches the GPU or the UI.
+//! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), and the
+//! dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
 //!   cage diagonal), every family gives the barycentric coordinates of the
 //!   touching triangle, which is the limit of each of them there (MEC's only on
-//!   well-shaped triangles: near slivers and quads it tends elsewhere, see
+//!   well-shaped triangles: near slivers and quads it tends elsewhere; MLC's
+//!   only on hull triangles whose plane holds no other vertex; see
 //!   docs/coordinates.md);
 //! - outside, every family uses MVC. MVC is finite off the surface (its total weight
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
