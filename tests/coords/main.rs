@@ -17,5 +17,6 @@ mod green_gallery;
 mod harmonic;
 mod mec;
 mod mlc;
+mod mlc_smoothing;
 mod origin_offsets;
 mod weights_metadata;

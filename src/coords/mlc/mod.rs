@@ -14,14 +14,13 @@
 //! The paper smooths the projected vertices before the likelihood step (in 3D:
 //! each vertex's direction replaced by the normalised sum of the mean unit
 //! vectors of its faces' spherical triangles, decomposed back as mean value
-//! coordinates decompose them); this module leaves that step out. The
-//! decomposition divides by `uⱼ·nₖ`, which tends to zero as `x` nears a face
-//! plane, and flips sign on faces seen from behind: near the cage the smoothed
-//! directions lose their digits or stop surrounding the centre, and the
-//! maximiser no longer exists (docs/coordinates.md, MLC). Without it the dual
-//! has a maximiser at every point strictly inside the cage: `x` is then inside
-//! the hull of the vertices, so the `uᵢ` surround the centre, the polytope is
-//! bounded and the concave dual tends to −∞ on its boundary.
+//! coordinates decompose them); this module leaves that step out. Smoothed
+//! directions need not surround the centre, and near the cage they often do
+//! not (measured in docs/coordinates.md, MLC): there the dual is unbounded and
+//! has no maximiser. Without the step the dual has a maximiser at every point
+//! strictly inside the cage: `x` is then inside the hull of the vertices, so
+//! the `uᵢ` surround the centre, the polytope is bounded and the concave dual
+//! tends to −∞ on its boundary.
 //!
 //! The dual is minus a self-concordant barrier, so Newton's method with a
 //! backtracking line search converges from `φ = 0` at every inside point. Near
