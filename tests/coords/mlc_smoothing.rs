@@ -10,14 +10,17 @@
 use glam::{DMat3, DVec3};
 use pmvc::geometry::{classify_points, procedural, Cage, PointClass};
 
-/// The smoothed directions and, per vertex, its direction as a combination of
-/// the projected corner directions: `ũᵢ = Σⱼ T[i][j] uⱼ`.
-fn smoothed(cage: &Cage, x: DVec3) -> (Vec<DVec3>, Vec<Vec<(usize, f64)>>, Vec<f64>) {
+/// Per vertex, its smoothed direction as a combination of the projected
+/// directions, `ũᵢ = Σⱼ T[i][j] uⱼ`, as `(j, T[i][j])` pairs.
+type Combination = Vec<Vec<(usize, f64)>>;
+
+/// The smoothed directions, their combinations and the distances `rᵢ`.
+fn smoothed(cage: &Cage, x: DVec3) -> (Vec<DVec3>, Combination, Vec<f64>) {
     let offsets: Vec<DVec3> = cage.positions().iter().map(|&v| v - x).collect();
     let r: Vec<f64> = offsets.iter().map(|d| d.length()).collect();
     let u: Vec<DVec3> = offsets.iter().zip(&r).map(|(d, r)| *d / *r).collect();
     let mut sums = vec![DVec3::ZERO; u.len()];
-    let mut combination: Vec<Vec<(usize, f64)>> = vec![Vec::new(); u.len()];
+    let mut combination: Combination = vec![Vec::new(); u.len()];
     for corners in cage.triangles() {
         let [a, b, c] = corners.map(|i| u[i as usize]);
         // The integral of the unit vector over the spherical triangle is half the
