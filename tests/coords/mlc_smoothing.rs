@@ -50,12 +50,35 @@ fn smoothed(cage: &Cage, x: DVec3) -> (Vec<DVec3>, Combination, Vec<f64>) {
     (sums, combination, r)
 }
 
+/// The weights of probabilities `p` on the smoothed directions:
+/// `qⱼ = Σᵢ T[i][j] pᵢ`, then `wⱼ ∝ qⱼ / rⱼ`.
+fn mapped_back(combination: &Combination, r: &[f64], p: &[f64]) -> Vec<f64> {
+    let mut q = vec![0.0; r.len()];
+    for (i, entries) in combination.iter().enumerate() {
+        for &(j, t) in entries {
+            q[j] += t * p[i];
+        }
+    }
+    let total: f64 = q.iter().zip(r).map(|(q, r)| q / r).sum();
+    q.iter().zip(r).map(|(q, r)| q / r / total).collect()
+}
+
+/// `|Σ wᵢ (vᵢ − x)|` in cage diagonals.
+fn linear_precision(cage: &Cage, x: DVec3, w: &[f64]) -> f64 {
+    let moved: DVec3 = w
+        .iter()
+        .zip(cage.positions())
+        .map(|(w, &v)| *w * (v - x))
+        .sum();
+    moved.length() / cage.diagonal()
+}
+
 /// How the likelihood step on the smoothed directions ended.
 enum Outcome {
     Maximum(Vec<f64>),
     /// Newton reached a `φ` with every `φ·ũᵢ > 0`: every slack grows along it
-    /// without bound, so the dual has no maximum.
-    Unbounded,
+    /// without bound, so the dual has no maximum. The `pᵢ` there.
+    Unbounded(Vec<f64>),
     /// Newton stopped short of 1e-13 (this test's solver, not the definition).
     Stalled,
 }
@@ -79,7 +102,7 @@ fn likelihood(directions: &[DVec3]) -> Outcome {
         // outside their hull: the dual grows without bound along it.
         let total: f64 = p.iter().sum();
         if directions.iter().all(|u| phi.dot(*u) > 0.0) {
-            return Outcome::Unbounded;
+            return Outcome::Unbounded(p);
         }
         if g.length() <= 1e-13 && (total - 1.0).abs() <= 1e-9 {
             return Outcome::Maximum(p);
@@ -134,7 +157,7 @@ fn mlc_smoothing_figures() {
     for (name, cage) in cages {
         for h in [8e-2, 2e-2, 1e-3, 1e-6] {
             let (mut points, mut failed, mut stalled) = (0, 0, 0);
-            let (mut precision, mut min) = (0.0f64, f64::INFINITY);
+            let (mut precision, mut min, mut unbounded) = (0.0f64, f64::INFINITY, 0.0f64);
             for t in 0..cage.triangle_count() {
                 let [a, b, c] = cage.triangle(t);
                 let inward = -(b - a).cross(c - a).normalize();
@@ -151,8 +174,10 @@ fn mlc_smoothing_figures() {
                     let (directions, combination, r) = smoothed(&cage, x);
                     let p = match likelihood(&directions) {
                         Outcome::Maximum(p) => p,
-                        Outcome::Unbounded => {
+                        Outcome::Unbounded(p) => {
                             failed += 1;
+                            let w = mapped_back(&combination, &r, &p);
+                            unbounded = unbounded.max(linear_precision(&cage, x, &w));
                             continue;
                         }
                         Outcome::Stalled => {
@@ -160,25 +185,14 @@ fn mlc_smoothing_figures() {
                             continue;
                         }
                     };
-                    let mut q = vec![0.0; r.len()];
-                    for (i, entries) in combination.iter().enumerate() {
-                        for &(j, t) in entries {
-                            q[j] += t * p[i];
-                        }
-                    }
-                    let total: f64 = q.iter().zip(&r).map(|(q, r)| q / r).sum();
-                    let w: Vec<f64> = q.iter().zip(&r).map(|(q, r)| q / r / total).collect();
-                    let moved: DVec3 = w
-                        .iter()
-                        .zip(cage.positions())
-                        .map(|(w, &v)| *w * (v - x))
-                        .sum();
-                    precision = precision.max(moved.length() / cage.diagonal());
+                    let w = mapped_back(&combination, &r, &p);
+                    precision = precision.max(linear_precision(&cage, x, &w));
                     min = min.min(w.iter().copied().fold(f64::INFINITY, f64::min));
                 }
             }
             println!(
-                "{name}, {h} of the diagonal from a face: {failed} of {points} points without a maximiser, {stalled} stalled; \
+                "{name}, {h} of the diagonal from a face: {failed} of {points} points without a maximiser \
+                 (the weights where Newton proved it reproduce the point to {unbounded:.1e}), {stalled} stalled; \
                  the others: linear precision {precision:.1e}, smallest weight {min:.1e}"
             );
         }
