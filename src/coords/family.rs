@@ -27,6 +27,9 @@ pub enum Method {
     /// Maximum entropy coordinates (Hormann and Sukumar 2008), by a convex
     /// minimisation in three unknowns per point.
     Mec,
+    /// Maximum likelihood coordinates (Chang, Deng, Hormann 2023), by a convex
+    /// maximisation in three unknowns per point.
+    Mlc,
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -333,14 +336,29 @@ const MEC: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const MLC: FamilySpec = FamilySpec {
+    id: "mlc",
+    name: "MLC",
+    summary: "maximum likelihood coordinates: positive and smooth, a small convex solve per point",
+    parameter: None,
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
+    // Inside only vertex positions count: splitting a quad would change nothing.
+    quads: QuadSupport::Patches { name: "MLC" },
+    quads_reason: "",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
         Method::Green,
         Method::Mec,
+        Method::Mlc,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -350,6 +368,7 @@ impl Method {
             Method::Harmonic => &HARMONIC,
             Method::Green => &GREEN,
             Method::Mec => &MEC,
+            Method::Mlc => &MLC,
         }
     }
 
