@@ -66,6 +66,9 @@ fn the_difference_view_shows_pmvc_against_exact_pmvc() {
         "8² against exact: {quantisation}, MVC against PMVC: {between_families} (diagonal {diagonal})"
     );
 
+    harness.run_steps(4);
+    harness.snapshot_options("editor_exact_twin_difference", &snapshot_options());
+
     // With exact as the setting there is nothing left to compare it with:
     // the view goes back to comparing families.
     harness
