@@ -154,7 +154,13 @@ pub struct ExactPmvcStats {
     pub scanned: usize,
     /// Of those, pairs whose bounding cones overlap.
     pub cones_overlapping: usize,
-    /// Of those, pairs where s overlaps t and is in front of it.
+    /// Of those, pairs the sides of their planes put s behind t.
+    pub behind: usize,
+    /// Of the rest, pairs with an edge plane separating the two.
+    pub separated: usize,
+    /// Of the rest, pairs whose order took a ray through their overlap.
+    pub probed: usize,
+    /// Pairs where s overlaps t and is in front of it.
     pub occluding: usize,
     /// Pieces an occluder cut or hid.
     pub splits: usize,
