@@ -361,17 +361,3 @@ fn armadillo_size_phases() {
     );
     report("armadillo-size", cage, &measure(cage, &points));
 }
-
-#[test]
-#[ignore = "temporary"]
-fn dump_weights() {
-    let scene = procedural::table1_scene("armadillo-size").expect("a scene");
-    let mut bytes = Vec::new();
-    let mut out = vec![0.0; scene.cage.vertex_count()];
-    let scratch = &mut ExactPmvcScratch::default();
-    for &x in scene.points.iter().step_by(5) {
-        exact_pmvc_weights_inside(x, &scene.cage, &mut out, scratch).expect("inside");
-        bytes.extend(out.iter().flat_map(|w| w.to_le_bytes()));
-    }
-    std::fs::write(std::env::var("DUMP").expect("DUMP"), bytes).expect("written");
-}
