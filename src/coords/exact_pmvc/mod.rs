@@ -113,9 +113,10 @@
 //! edge plane, none needing a ray, and 407 occluding (339 cuts, 106 visible
 //! pieces). Cutting is the small part: the scan stops at a candidate once it
 //! is hidden, and without the cuts (so without that stop) finding the pieces
-//! took 480 µs (measured with the variants below in place). Beast: 9754 pairs scanned, 2234 with cones meeting, 316
-//! occluding; the icosphere, where every triangle is at about the same
-//! distance: 913,313 scanned, 16,159 with cones meeting, none occluding.
+//! took 480 µs (measured with the variants below in place). Beast: 9754
+//! pairs scanned, 2234 with cones meeting, 316 occluding; the icosphere,
+//! where every triangle is at about the same distance: 913,313 scanned,
+//! 16,159 with cones meeting, none occluding.
 //!
 //! Tried and not kept, for gaining less than the noise of these figures
 //! (under 3 % on armadillo-size, the same weights bit for bit): testing the
@@ -123,9 +124,9 @@
 //! bounding ball (wholly beyond t's plane) and their cone against t's edge
 //! planes before reading them (a quarter of the pairs with cones meeting);
 //! trying the candidates that last hid a whole one first (48 of the 181 per
-//! point hidden at once); and looking at each pair once for both orders,
-//! which loses the stop at hidden candidates and scans half as many pairs
-//! again. A grid of directions listing the candidates by cube-map cell (to
+//! point hidden at once). Looking at each pair once for both orders loses
+//! the stop at hidden candidates, scans half as many pairs again and was a
+//! quarter slower. A grid of directions listing the candidates by cube-map cell (to
 //! scan only those sharing a cell) halved the icosphere's time but doubled
 //! the hand's and Beast's, whose large triangles fill many cells. Commands:
 //! `cargo test --release --no-default-features --lib coords::exact_pmvc::measure
