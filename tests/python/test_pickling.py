@@ -177,7 +177,7 @@ def test_a_raised_error_pickles(tmp_path):
 
 
 def test_a_tampered_pickle_is_refused_with_a_reason(comb_cage, comb_points):
-    restore, (vertices, triangles, triangle_faces, path) = comb_cage.__reduce__()
+    restore, (vertices, triangles, triangle_faces, path, _) = comb_cage.__reduce__()
     bad = triangles.copy()
     bad[5, 1] = len(vertices)
     with pytest.raises(pmvc.InputError, match="pickled cage: triangles: face 5 refers to vertex 40"):
@@ -215,7 +215,7 @@ def test_misaligned_arrays_are_read_as_they_are(comb_cage, comb_points):
     expected = pmvc.bind(points, comb_cage, method="mvc", backend="cpu")
     weights = pmvc.bind(misaligned(points), comb_cage, method="mvc", backend="cpu")
     assert weights.matrix.tobytes() == expected.matrix.tobytes()
-    restore, (vertices, triangles, triangle_faces, path) = comb_cage.__reduce__()
+    restore, (vertices, triangles, triangle_faces, path, _) = comb_cage.__reduce__()
     cage = restore(misaligned(vertices), misaligned(triangles), misaligned(triangle_faces), path)
     assert_same_cage(comb_cage, cage, "misaligned")
     restore, (matrix, classes, metadata, path) = expected.__reduce__()

@@ -78,6 +78,12 @@ class Cage:
     def path(self) -> Optional[str]:
         """The file it was read from, or None."""
         ...
+    @property
+    def object(self) -> Optional[str]:
+        """The object of that file read as the cage (``Cage.load(path,
+        object="Cage")``), or None; ``bind`` records it in the weights'
+        metadata."""
+        ...
 
 class Weights:
     """The weights of a bind, and what a reader needs to trust them. Pickles
