@@ -458,7 +458,7 @@ pub fn bind_rows<T: WeightValue>(
         return Ok(());
     }
     let integration = PmvcIntegration::of(options);
-    let green_cage = (options.method == Method::Green).then(|| green::GreenCage::new(cage));
+    let green_cage = (options.method == Method::Green).then(|| green::QgcCage::new(cage));
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
@@ -491,9 +491,10 @@ pub fn bind_rows<T: WeightValue>(
         )
 }
 
-/// Green coordinates of `x` into one row (φ, then ψ); NaN for a point they cannot
-/// take (not finite), which the bind's validation rejects beforehand.
-fn green_row(green_cage: &green::GreenCage, x: DVec3, out: &mut [f64]) {
+/// Green coordinates (QGC on quads) of `x` into one row (φ, then ψ); NaN for a
+/// point they cannot take (not finite), which the bind's validation rejects
+/// beforehand.
+fn green_row(green_cage: &green::QgcCage, x: DVec3, out: &mut [f64]) {
     let (phi, psi) = out.split_at_mut(green_cage.vertex_count());
     if green_cage.coordinates(x, phi, psi).is_err() {
         out.fill(f64::NAN);
@@ -527,7 +528,7 @@ pub fn weights_at(
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
         // in `bind_rows`.
-        green_row(&green::GreenCage::new(cage), x, out);
+        green_row(&green::QgcCage::new(cage), x, out);
         return;
     }
     match class {

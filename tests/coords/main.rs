@@ -17,4 +17,5 @@ mod green_gallery;
 mod harmonic;
 mod mec;
 mod origin_offsets;
+mod qgc;
 mod weights_metadata;
