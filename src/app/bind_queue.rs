@@ -370,7 +370,7 @@ fn run(
     // chunks when it does not, or when the job ran on the CPU.
     let gpu_buffer = match &backend {
         Backend::Gpu(context) => {
-            let columns = options.method.columns(&prepared.cage);
+            let columns = options.columns(&prepared.cage);
             let rows_per_chunk = ChunkLimits::of(&context.limits).rows_per_chunk(columns);
             prepared.points.len() as u64 <= rows_per_chunk
         }

@@ -145,6 +145,13 @@ impl BindOptions {
         crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
+    /// Weights columns per point of a bind of `cage` with these options: the
+    /// family's [`Method::columns`] of the cage it binds (Green's differ with
+    /// the quads as patches or split).
+    pub fn columns(&self, cage: &Cage) -> usize {
+        self.method.columns(&self.cage_to_bind(cage))
+    }
+
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
     pub fn pmvc_exact(&self) -> bool {
         self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION

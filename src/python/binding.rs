@@ -297,7 +297,7 @@ pub(super) fn bind_points(
     let backend = decision.backend;
     let device = backend.clone();
     let rows = points.len();
-    let columns = options.method.columns(&cage.cage);
+    let columns = options.columns(&cage.cage);
     let size = dtype.size();
     crate::budget::check_memory(
         || format!("the weights ({rows} rows × {columns} columns × {size} bytes)"),

@@ -392,7 +392,7 @@ impl Document {
         outside: Arc<[u32]>,
     ) -> bool {
         let fits = set.weights.rows == self.mesh.positions.len()
-            && set.weights.cols == id.method.columns(&self.cage)
+            && set.weights.cols == set.options.columns(&self.cage)
             && id.split_twin.is_none_or(|split| split == set.options.quads);
         if fits {
             match id.split_twin {

@@ -32,6 +32,7 @@ fn the_quadtree_converges_at_every_height_above_the_patch() {
     let frame = bent();
     for height in [0.5, 1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8] {
         let (mut raw_worst, mut projected_worst) = (0.0f64, 0.0f64);
+        let mut residual_worst = 0.0f64;
         for (u, v) in [(0.3, 0.4), (0.9, 0.95), (0.02, 0.5), (0.5, 0.0)] {
             let normal = frame.normal_at(u, v).normalize();
             // Below the patch: on its inner side.
@@ -40,6 +41,15 @@ fn the_quadtree_converges_at_every_height_above_the_patch() {
             let raw = frame.quadrature(x, &QUADTREE);
             let projected = frame.integrals(x, &QUADTREE);
             raw_worst = raw_worst.max(largest_difference(&raw, &fine));
+            // What the quadrature alone misses of the closed-form sums: its
+            // share of the rest pose's error, over the quad's size.
+            let (angle, moment) = frame.halves_closed_form(x);
+            let sum: DVec3 = (0..4)
+                .map(|k| raw.phi[k] * (frame.corners[k] - x) + raw.psi[k] * frame.corner_normals[k])
+                .sum();
+            residual_worst = residual_worst
+                .max((sum - moment).length() / frame.size)
+                .max((raw.solid_angle - angle).abs() / (4.0 * PI));
             projected_worst = projected_worst.max(largest_difference(&projected, &fine));
         }
         eprintln!(
