@@ -350,3 +350,86 @@ fn quads_are_patches_not_their_split_and_a_stretch_is_not_a_similarity() {
     let stretched = |p: DVec3| DVec3::new(2.0 * p.x, p.y, p.z);
     assert!(similarity_error(&cage, stretched) > 1e-3);
 }
+
+fn qmvc_data() -> Option<std::path::PathBuf> {
+    let candidates = [
+        std::env::var_os("PMVC_QMVC_DATA").map(std::path::PathBuf::from),
+        Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/qmvc")),
+    ];
+    candidates.into_iter().flatten().find(|path| path.is_dir())
+}
+
+#[test]
+fn on_the_ogre_qgc_reproduce_similarities_and_differ_from_the_split() {
+    let Some(data) = qmvc_data() else {
+        eprintln!("not run: ../shared/data/qmvc is missing");
+        return;
+    };
+    let load = |name: &str| {
+        pmvc::formats::load_mesh(&data.join(name))
+            .unwrap()
+            .mesh
+            .positions
+    };
+    let (cage, _) = pmvc::formats::load_cage(&data.join("Ogre_Cage.obj")).unwrap();
+    assert!(cage.has_quads());
+    // Every 20th vertex, for speed.
+    let points: Vec<DVec3> = load("Ogre.obj").into_iter().step_by(20).collect();
+    let deform = |options: BindOptions, pose: &[DVec3]| {
+        let classes = options.classify(&cage, &points);
+        let started = std::time::Instant::now();
+        let weights = bind_cpu_f64(
+            &points,
+            &classes.classes,
+            &cage,
+            options,
+            &BindProgress::new(points.len()),
+        )
+        .unwrap();
+        let seconds = started.elapsed().as_secs_f64();
+        let moves = options
+            .method
+            .column_displacements(&options.cage_to_bind(&cage), pose);
+        let moved: Vec<DVec3> = (0..points.len())
+            .map(|row| {
+                let w = &weights.values[row * weights.cols..(row + 1) * weights.cols];
+                points[row] + w.iter().zip(&moves).map(|(&w, &d)| w * d).sum::<DVec3>()
+            })
+            .collect();
+        (moved, seconds)
+    };
+    let qgc = BindOptions::for_method(Method::Green);
+    let centre = cage.positions().iter().sum::<DVec3>() / cage.vertex_count() as f64;
+    let map = |p: DVec3| centre + 1.7 * (rotation() * (p - centre)) + DVec3::new(0.3, -0.2, 0.1);
+    let similar: Vec<DVec3> = cage.positions().iter().map(|&p| map(p)).collect();
+    let (moved, seconds) = deform(qgc, &similar);
+    let worst = points
+        .iter()
+        .zip(&moved)
+        .map(|(&x, &y)| (map(x) - y).length())
+        .fold(0.0, f64::max)
+        / cage.diagonal();
+    let target = load("Ogre_Cage_Deformed.obj");
+    let (posed, _) = deform(qgc, &target);
+    let split = BindOptions {
+        quads: pmvc::geometry::QuadSplit::Shorter,
+        ..qgc
+    };
+    let (split_posed, split_seconds) = deform(split, &target);
+    let apart = posed
+        .iter()
+        .zip(&split_posed)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max)
+        / cage.diagonal();
+    eprintln!(
+        "Ogre, {} points, {} quads: similarity error {worst:.1e} of the diagonal; at the \
+         target pose QGC and the shorter split's Green coordinates {:.2}% of the diagonal \
+         apart; bind {seconds:.2} s (split {split_seconds:.2} s)",
+        points.len(),
+        cage.quads().len(),
+        100.0 * apart
+    );
+    assert!(worst < 1e-8, "{worst}");
+    assert!(apart > 1e-4, "{apart}");
+}
