@@ -396,7 +396,9 @@ fn run(
             let quality = WeightQuality::measure_columns(
                 &weights,
                 &prepared.points,
-                &options.method.rest_columns(&prepared.cage),
+                &options
+                    .method
+                    .rest_columns(&options.cage_to_bind(&prepared.cage)),
                 options.method.vertex_columns(&prepared.cage),
                 &outside,
             );

@@ -152,6 +152,12 @@ impl BindOptions {
         self.method.columns(&self.cage_to_bind(cage))
     }
 
+    /// [`Method::column_displacements`] on the cage these options bind.
+    pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+        self.method
+            .column_displacements(&self.cage_to_bind(cage), pose)
+    }
+
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
     pub fn pmvc_exact(&self) -> bool {
         self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
