@@ -32,6 +32,13 @@ pub enum Action {
     FileCancelled(FileAction),
     /// Open a file as the mesh or the cage.
     Open(FileRole, PathBuf),
+    /// Read another object of the mesh's or the cage's file in its place
+    /// (`None`: the file's default, an OBJ's objects together or a glTF's
+    /// first mesh).
+    OpenObject {
+        role: FileRole,
+        object: Option<String>,
+    },
     /// Open a mesh and its cage together.
     OpenPair {
         mesh: PathBuf,

@@ -124,18 +124,7 @@ impl Binding {
             .iter()
             .filter_map(|pane| match pane {
                 super::compare::Pane::Difference { against, .. } => {
-                    let split = against.split_twin?;
-                    // A twin bound as the family itself is not a twin; one of a
-                    // family that takes only triangles would change nothing.
-                    let takes_patches =
-                        matches!(against.method.spec().quads, QuadSupport::Patches { .. });
-                    if !takes_patches || split == self.options_for(against.method).quads {
-                        return None;
-                    }
-                    Some(BindOptions {
-                        quads: split,
-                        ..self.options_for(against.method)
-                    })
+                    against.twin?.options(self.options_for(against.method))
                 }
                 super::compare::Pane::Method(_) => None,
             })
@@ -158,7 +147,7 @@ impl Binding {
             }
         }
         for options in self.wanted_twins(view) {
-            let id = crate::coords::WeightsId::twin(options.method, options.quads);
+            let id = crate::coords::WeightsId::of_bind(&options, &self.options_for(options.method));
             let current = document
                 .bound_id(id)
                 .is_some_and(|set| set.options.same_weights_as(&options));

@@ -5,7 +5,7 @@
 //! Methods are data here: nothing below names a coordinate family except the
 //! defaults.
 
-use crate::coords::{quality, Method, QuadSplit, Weights, WeightsId};
+use crate::coords::{quality, Method, QuadSplit, Twin, Weights, WeightsId};
 use crate::render::colormap::Scale;
 use crate::render::Colouring;
 use glam::{DVec3, Mat4, Vec3};
@@ -147,6 +147,11 @@ pub struct ViewSettings {
     /// `difference`) with its triangulated twin, bound with the cage's quads split
     /// along this diagonal, instead of with the first family.
     pub difference_split: Option<QuadSplit>,
+    /// When set (and no split is), the difference compares the shown family
+    /// with itself at its parameter's reference value: PMVC at a cube-map
+    /// resolution against exact PMVC.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub difference_reference: bool,
     /// In the side-by-side layout, one more view of the difference.
     pub difference_pane: bool,
     /// The difference view's colour scale ends here (a fraction of the cage
@@ -230,6 +235,7 @@ impl Default for ViewSettings {
             compared: MethodSet::of(&[Method::Mvc, Method::Pmvc]),
             difference: [Method::Mvc, Method::Pmvc],
             difference_split: None,
+            difference_reference: false,
             difference_pane: false,
             difference_limit: None,
             cameras_locked: true,
@@ -246,9 +252,10 @@ impl ViewSettings {
     /// The difference pane of [`Self::difference`].
     pub fn difference_pane_kind(&self) -> Pane {
         let [against, shown] = self.difference;
-        let against = match self.difference_split {
-            Some(split) => WeightsId::twin(shown, split),
-            None => WeightsId::of(against),
+        let against = match (self.difference_split, self.difference_reference) {
+            (Some(split), _) => WeightsId::split(shown, split),
+            (None, true) => WeightsId::twin(shown, Twin::Reference),
+            (None, false) => WeightsId::of(against),
         };
         Pane::Difference { against, shown }
     }

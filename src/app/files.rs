@@ -14,7 +14,7 @@ use super::session::{self, SessionSettings};
 use crate::coords::{BindOptions, Method};
 use crate::formats::shown_path;
 use crate::formats::{
-    load_cage_object, load_mesh, refuse_same_file, write_atomically, write_cage_and_pose,
+    load_cage_object, load_mesh_object, refuse_same_file, write_atomically, write_cage_and_pose,
     write_deformed_mesh, write_mesh_with_normals, write_polygons_obj_to, MeshFile,
 };
 use crate::geometry::{polygons_of, subdivide_midpoint, TriMesh};
@@ -133,15 +133,21 @@ pub fn open_session(path: &Path) -> Result<SceneChange, String> {
     Ok(change)
 }
 
-/// A mesh and its cage together.
-pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, String> {
-    let mut mesh = load_mesh(mesh_path).map_err(|error| error.to_string())?;
-    let (cage, report, cage_note) =
-        load_cage_object(cage_path, None).map_err(|error| error.to_string())?;
+/// A mesh and its cage together, each the object of its file named in
+/// `objects` (the file's default where none is).
+pub fn open_pair(
+    mesh_path: &Path,
+    cage_path: &Path,
+    objects: ObjectNames,
+) -> Result<SceneChange, String> {
+    let mut mesh = load_mesh_object(mesh_path, objects.mesh).map_err(|error| error.to_string())?;
+    let (cage, report, cage_read) =
+        load_cage_object(cage_path, objects.cage).map_err(|error| error.to_string())?;
     let mut notes = object_note(mesh_path, mesh.object_note.take());
-    notes.extend(object_note(cage_path, cage_note));
+    notes.extend(object_note(cage_path, cage_read.note));
     let document = Document::new(file_title(mesh_path), mesh.mesh.clone(), cage)
-        .with_files(Some(mesh), Some(cage_path.to_owned()));
+        .with_files(Some(mesh), Some(cage_path.to_owned()))
+        .with_cage_objects(cage_read.objects);
     let action = format!(
         "open {} and {}",
         file_title(mesh_path),
@@ -157,19 +163,39 @@ pub fn open_pair(mesh_path: &Path, cage_path: &Path) -> Result<SceneChange, Stri
     Ok(change)
 }
 
-/// A file's note of which of its objects was read, as a notice naming it.
-fn object_note(path: &Path, note: Option<String>) -> Vec<String> {
-    note.map(|note| format!("{}: {note}", shown_path(path)))
-        .into_iter()
-        .collect()
+/// Which object of the mesh file and of the cage file to read (`pmvc edit
+/// --mesh-object`, the side panel's choice); `None`: the file's default.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ObjectNames<'a> {
+    pub mesh: Option<&'a str>,
+    pub cage: Option<&'a str>,
 }
 
-/// The mesh replaced (the cage kept) or the cage replaced (the mesh kept). A
-/// mesh the current cage holds none of sits in a loose box instead.
-pub fn open_file(role: FileRole, path: &Path, current: &Document) -> Result<SceneChange, String> {
+/// A file's note of which of its objects was read, as a notice naming it,
+/// with where to choose another.
+fn object_note(path: &Path, note: Option<String>) -> Vec<String> {
+    note.map(|note| {
+        format!(
+            "{}: {note}; choose another in the side panel",
+            shown_path(path)
+        )
+    })
+    .into_iter()
+    .collect()
+}
+
+/// The mesh replaced (the cage kept) or the cage replaced (the mesh kept),
+/// by object `object` of the file (its default where `None`). A mesh the
+/// current cage holds none of sits in a loose box instead.
+pub fn open_file(
+    role: FileRole,
+    path: &Path,
+    object: Option<&str>,
+    current: &Document,
+) -> Result<SceneChange, String> {
     let (document, notes) = match role {
         FileRole::Mesh => {
-            let mut file = load_mesh(path).map_err(|error| error.to_string())?;
+            let mut file = load_mesh_object(path, object).map_err(|error| error.to_string())?;
             if !cage_reaches(current.cage(), &file.mesh) {
                 return mesh_in_box(path, file);
             }
@@ -179,16 +205,20 @@ pub fn open_file(role: FileRole, path: &Path, current: &Document) -> Result<Scen
                 file.mesh.clone(),
                 (**current.cage()).clone(),
             )
-            .with_files(Some(file), current.cage_path().map(Into::into));
+            .with_files(Some(file), current.cage_path().map(Into::into))
+            .with_cage_objects(current.cage_objects().clone());
             (document, notes)
         }
         FileRole::Cage => {
-            let (cage, report, note) =
-                load_cage_object(path, None).map_err(|error| error.to_string())?;
-            let mut notes = object_note(path, note);
+            let (cage, report, read) =
+                load_cage_object(path, object).map_err(|error| error.to_string())?;
+            let mut notes = object_note(path, read.note);
             notes.extend(report.messages());
             let rest = cage.positions().to_vec();
-            (current.with_cage(cage, Some(path.to_owned()), rest), notes)
+            let document = current
+                .with_cage(cage, Some(path.to_owned()), rest)
+                .with_cage_objects(read.objects);
+            (document, notes)
         }
     };
     let (role_name, entry) = match role {
@@ -204,8 +234,8 @@ pub fn open_file(role: FileRole, path: &Path, current: &Document) -> Result<Scen
 }
 
 /// A mesh with no cage (`pmvc edit MESH`).
-pub fn open_mesh_alone(path: &Path) -> Result<SceneChange, String> {
-    let file = load_mesh(path).map_err(|error| error.to_string())?;
+pub fn open_mesh_alone(path: &Path, object: Option<&str>) -> Result<SceneChange, String> {
+    let file = load_mesh_object(path, object).map_err(|error| error.to_string())?;
     let mut change = mesh_in_box(path, file)?;
     change.recent = None;
     Ok(change)
@@ -308,7 +338,7 @@ pub fn use_generated_cage(current: &Document, proposal: Proposal) -> SceneChange
 
 /// A pose file's positions: a cage-shaped OBJ/OFF with one vertex per cage vertex.
 pub fn read_pose(path: &Path, current: &Document) -> Result<Vec<DVec3>, String> {
-    let file = load_mesh(path).map_err(|error| error.to_string())?;
+    let file = crate::formats::load_mesh(path).map_err(|error| error.to_string())?;
     check_pose(path, file.mesh.positions, current)
 }
 
@@ -488,6 +518,7 @@ pub fn export_gltf(
                 obj_text: None,
                 node_transform: None,
                 object_note: None,
+                objects: Default::default(),
             };
             &made
         }

@@ -12,6 +12,10 @@ pub struct EditorOptions {
     /// loose box and the Generate cage window offers a cage.
     pub mesh: Option<PathBuf>,
     pub cage: Option<PathBuf>,
+    /// The objects of those files to read (`--mesh-object`, `--cage-object`);
+    /// `None`: each file's default.
+    pub mesh_object: Option<String>,
+    pub cage_object: Option<String>,
     /// A session to open (instead of `mesh` and `cage`).
     pub session: Option<PathBuf>,
     /// A pose (cage OBJ with the same vertex count) applied once loaded.

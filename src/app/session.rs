@@ -17,8 +17,9 @@ use super::session_paths::{folder_of, session_folder};
 use crate::budget::read_limited;
 use crate::coords::{BindOptions, Method, Parameter, ParameterError, QuadSplit};
 use crate::formats::{
-    load_cage, load_mesh, not_a_regular_file, refuse_same_file, shown_path, write_atomically,
-    write_deformed_mesh, write_obj, CageLoadError, LoadError, MeshFile, WriteError,
+    load_cage_object, load_mesh_object, not_a_regular_file, refuse_same_file, shown_path,
+    write_atomically, write_deformed_mesh, write_obj, CageLoadError, FileObjects, LoadError,
+    MeshFile, WriteError,
 };
 use crate::geometry::{Cage, TriMesh};
 use crate::render::{OrbitCamera, SceneOrigin};
@@ -89,6 +90,13 @@ pub struct SessionFile {
     pub title: String,
     pub mesh: MeshSource,
     pub cage: CageSource,
+    /// The object of the mesh file that is the mesh, where one was chosen by
+    /// name (absent: the file's default, as in sessions from before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh_object: Option<String>,
+    /// The object of the cage file that is the cage, where one was chosen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cage_object: Option<String>,
     /// One position per cage vertex.
     pub pose: Vec<[f64; 3]>,
     #[serde(default)]
@@ -246,14 +254,16 @@ pub fn save_session(
     settings: &SessionSettings,
 ) -> Result<(), SessionError> {
     let folder = folder_of(path);
-    let mesh = mesh_source(path, &folder, document)?;
-    let cage = cage_source(&folder, document);
+    let (mesh, mesh_object) = mesh_source(path, &folder, document)?;
+    let (cage, cage_object) = cage_source(&folder, document);
     let origin = SceneOrigin::of_cage(document.cage().positions());
     let session = SessionFile {
         pmvc_session: SESSION_VERSION,
         title: document.title().to_owned(),
         mesh,
         cage,
+        mesh_object,
+        cage_object,
         pose: document.pose().iter().copied().map(to_array).collect(),
         named_poses: document
             .named_poses()
@@ -296,14 +306,15 @@ fn mesh_source(
     session: &Path,
     folder: &Path,
     document: &Document,
-) -> Result<MeshSource, SessionError> {
+) -> Result<(MeshSource, Option<String>), SessionError> {
     if let Some(scene) = document.bundled() {
-        return Ok(MeshSource::Bundled(scene.id().to_owned()));
+        return Ok((MeshSource::Bundled(scene.id().to_owned()), None));
     }
     let positions = &document.mesh().positions;
     if let Some(file) = document.mesh_file() {
         if &file.mesh.positions == positions {
-            return Ok(MeshSource::File(relative_to(&file.path, folder)));
+            let source = MeshSource::File(relative_to(&file.path, folder));
+            return Ok((source, file.objects.read.clone()));
         }
     }
     // The mesh rests elsewhere than any file says: keep it beside the session.
@@ -319,29 +330,33 @@ fn mesh_source(
         Some(file) => write_deformed_mesh(file, positions, &sidecar).map(drop)?,
         None => write_obj(&sidecar, document.mesh())?,
     }
-    Ok(MeshSource::File(relative_to(&sidecar, folder)))
+    // The sidecar holds the one object written.
+    Ok((MeshSource::File(relative_to(&sidecar, folder)), None))
 }
 
-fn cage_source(folder: &Path, document: &Document) -> CageSource {
+/// Where the rest cage comes from, and which object of its file it is.
+fn cage_source(folder: &Path, document: &Document) -> (CageSource, Option<String>) {
     let cage = document.cage();
     let same = |other: &Cage| {
         other.positions() == cage.positions() && other.triangles() == cage.triangles()
     };
     if let Some(scene) = document.bundled() {
         if scene.build().is_ok_and(|(_, bundled)| same(&bundled)) {
-            return CageSource::Bundled(scene.id().to_owned());
+            return (CageSource::Bundled(scene.id().to_owned()), None);
         }
     }
     if let Some(path) = document.cage_path() {
-        if load_cage(path).is_ok_and(|(file_cage, _)| same(&file_cage)) {
-            return CageSource::File(relative_to(path, folder));
+        let object = document.cage_objects().read.clone();
+        if load_cage_object(path, object.as_deref()).is_ok_and(|(file_cage, ..)| same(&file_cage)) {
+            return (CageSource::File(relative_to(path, folder)), object);
         }
     }
-    CageSource::Inline {
+    let inline = CageSource::Inline {
         positions: cage.positions().iter().copied().map(to_array).collect(),
         triangles: cage.triangles().to_vec(),
         faces: cage.has_quads().then(|| cage.polygons()),
-    }
+    };
+    (inline, None)
 }
 
 /// Read the session at `path` and everything it names. Nothing is changed on
@@ -427,19 +442,25 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
                 (bundled.build().map_err(cage_error)?.0, None, Some(bundled))
             }
             MeshSource::File(file) => {
-                let file = load_mesh(&folder.join(file)).map_err(|source| SessionError::Mesh {
-                    path: path.to_owned(),
-                    source,
+                let object = session.mesh_object.as_deref();
+                let file = load_mesh_object(&folder.join(file), object).map_err(|source| {
+                    SessionError::Mesh {
+                        path: path.to_owned(),
+                        source,
+                    }
                 })?;
                 (file.mesh.clone(), Some(file), None)
             }
         };
+    let mut cage_objects = FileObjects::default();
     let (cage, cage_path) = match &session.cage {
         CageSource::Bundled(id) => (scene(id)?.build().map_err(cage_error)?.1, None),
         CageSource::File(file) => {
             let cage_path = folder.join(file);
-            let (cage, report) = load_cage(&cage_path).map_err(cage_error)?;
+            let object = session.cage_object.as_deref();
+            let (cage, report, read) = load_cage_object(&cage_path, object).map_err(cage_error)?;
             report.messages().into_iter().for_each(&mut note);
+            cage_objects = read.objects;
             (cage, Some(cage_path))
         }
         CageSource::Inline {
@@ -504,6 +525,7 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
 
     let mut document = Document::new(title, mesh, cage)
         .with_files(mesh_file, cage_path)
+        .with_cage_objects(cage_objects)
         .with_poses(pose, named_poses);
     if let Some(bundled) = bundled_mesh {
         document = document.bundled_as(bundled);

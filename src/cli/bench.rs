@@ -182,6 +182,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         (Method::Pmvc, 64),
         (Method::Pmvc, EXACT_RESOLUTION),
         (Method::Mec, 0),
+        (Method::Mlc, 0),
         (Method::Harmonic, 64),
         (Method::Harmonic, 128),
     ];

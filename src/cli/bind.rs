@@ -193,6 +193,8 @@ fn metadata_json(args: &BindArgs, input: &BoundInput, done: &BindDone) -> String
         seconds: done.seconds,
         mesh_file: &args.input.mesh.to_string_lossy(),
         cage_file: &args.input.cage.to_string_lossy(),
+        mesh_object: args.input.mesh_object.as_deref(),
+        cage_object: args.input.cage_object.as_deref(),
         weights_file: &args.out,
     });
     metadata.dtype = args.dtype.id().to_owned();

@@ -317,8 +317,8 @@ pub(super) fn read_cage(
     path: &std::path::Path,
     object: Option<&str>,
 ) -> Result<(Cage, geometry::CageReport)> {
-    let (cage, report, note) = crate::formats::load_cage_object(path, object)?;
-    if let Some(note) = note {
+    let (cage, report, read) = crate::formats::load_cage_object(path, object)?;
+    if let Some(note) = read.note {
         warn_line!(
             "pmvc: {}: note: {note}; --cage-object NAME reads one alone",
             shown_path(path)

@@ -253,6 +253,13 @@ pub struct EditArgs {
     pub mesh: Option<PathBuf>,
     /// Its cage.
     pub cage: Option<PathBuf>,
+    /// The object of the mesh file to open, where it has several (an OBJ's
+    /// `o` name, a glTF node or mesh name); the side panel offers the others.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name, requires = "mesh")]
+    pub mesh_object: Option<String>,
+    /// The object of the cage file that is the cage.
+    #[arg(long, value_name = "NAME", value_parser = parse_object_name, requires = "cage")]
+    pub cage_object: Option<String>,
     /// A session saved by the editor (File > Save session): mesh, cage, poses,
     /// method and views. Other options given with it override what it holds.
     #[arg(long, value_name = "FILE.json", conflicts_with_all = ["mesh", "cage"])]
@@ -378,6 +385,8 @@ impl EditArgs {
         crate::app::EditorOptions {
             mesh: self.mesh,
             cage: self.cage,
+            mesh_object: self.mesh_object,
+            cage_object: self.cage_object,
             session: self.session,
             pose: self.pose,
             resolution: self.resolution,

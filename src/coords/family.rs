@@ -28,49 +28,9 @@ pub enum Method {
     /// Maximum entropy coordinates (Hormann and Sukumar 2008), by a convex
     /// minimisation in three unknowns per point.
     Mec,
-}
-
-/// One set of weights a viewer holds: a family as bound with the viewer's
-/// setting for quads, or its triangulated twin, the same family bound with the
-/// cage's quads split along a diagonal, to show what the split does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct WeightsId {
-    pub method: Method,
-    pub split_twin: Option<crate::geometry::QuadSplit>,
-}
-
-impl WeightsId {
-    /// `method` as the viewer binds it.
-    pub const fn of(method: Method) -> Self {
-        Self {
-            method,
-            split_twin: None,
-        }
-    }
-
-    /// `method` with the quads split along `split`'s diagonal.
-    pub fn twin(method: Method, split: crate::geometry::QuadSplit) -> Self {
-        Self {
-            method,
-            split_twin: Some(split),
-        }
-    }
-}
-
-impl From<Method> for WeightsId {
-    fn from(method: Method) -> Self {
-        Self::of(method)
-    }
-}
-
-impl std::fmt::Display for WeightsId {
-    /// "PMVC", or "PMVC (shorter split)" for a twin.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.split_twin {
-            None => write!(f, "{}", self.method.name()),
-            Some(split) => write!(f, "{} ({} split)", self.method.name(), split.id()),
-        }
-    }
+    /// Maximum likelihood coordinates (Chang, Deng, Hormann 2023), by a convex
+    /// maximisation in three unknowns per point.
+    Mlc,
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -379,14 +339,29 @@ const MEC: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const MLC: FamilySpec = FamilySpec {
+    id: "mlc",
+    name: "MLC",
+    summary: "maximum likelihood coordinates: positive and smooth, a small convex solve per point",
+    parameter: None,
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: true,
+    // Inside only vertex positions count: splitting a quad would change nothing.
+    quads: QuadSupport::Patches { name: "MLC" },
+    quads_reason: "",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
         Method::Green,
         Method::Mec,
+        Method::Mlc,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -396,6 +371,7 @@ impl Method {
             Method::Harmonic => &HARMONIC,
             Method::Green => &GREEN,
             Method::Mec => &MEC,
+            Method::Mlc => &MLC,
         }
     }
 

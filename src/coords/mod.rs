@@ -1,13 +1,15 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
 //! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
-//! coordinates ([`mec`]), and the dense weights matrix they fill. Nothing here touches the GPU or the UI.
+//! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), and the
+//! dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
 //! - on the surface (within [`crate::geometry::classify::SURFACE_TOLERANCE`] of the
 //!   cage diagonal), every family gives the barycentric coordinates of the
 //!   touching triangle, which is the limit of each of them there (MEC's only on
-//!   well-shaped triangles: near slivers and quads it tends elsewhere, see
+//!   well-shaped triangles: near slivers and quads it tends elsewhere; MLC's
+//!   only on hull triangles whose plane holds no other vertex; see
 //!   docs/coordinates.md);
 //! - outside, every family uses MVC. MVC is finite off the surface (its total weight
 //!   is an alternating sum of decreasing `1/r` terms along every ray, so positive),
@@ -28,6 +30,7 @@ pub mod family;
 pub mod green;
 pub mod harmonic;
 pub mod mec;
+pub mod mlc;
 pub mod mvc;
 pub mod parameter_values;
 pub mod pmvc;
@@ -35,19 +38,21 @@ mod progress;
 pub mod qmvc;
 pub mod quality;
 pub mod split_effect;
+mod weights_id;
 
 pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass, PointClasses};
 pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
     FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
-    WeightsId, DEFAULT_RESOLUTION, EXACT_RESOLUTION,
+    DEFAULT_RESOLUTION, EXACT_RESOLUTION,
 };
 use glam::DVec3;
 pub use pmvc::PmvcIntegration;
 pub use progress::{BindProgress, Cancelled};
 pub use quality::WeightQuality;
 use rayon::prelude::*;
+pub use weights_id::{Twin, WeightsId};
 
 /// How many of `total` points lie outside the cage, and the first few (0-based,
 /// ascending `outside`): the warning of a bind with outside points, and the
@@ -520,6 +525,7 @@ pub struct RowScratch {
     pub mvc: mvc::MvcScratch,
     pub pmvc: pmvc::PmvcScratch,
     pub mec: mec::MecScratch,
+    pub mlc: mlc::MlcScratch,
 }
 
 /// Coordinates of one point, following the policy of the module doc. `out` holds
@@ -537,6 +543,7 @@ pub fn weights_at(
         mvc: mvc_scratch,
         pmvc: pmvc_scratch,
         mec: mec_scratch,
+        mlc: mlc_scratch,
     } = scratch;
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
@@ -588,6 +595,13 @@ pub fn weights_at(
                 if mec::mec_weights_inside(x, cage, out, mec_scratch).is_err() {
                     // Only a point not strictly inside the hull has no solution
                     // (numerically on the surface): the outside policy, as PMVC.
+                    mvc::mvc_weights(x, cage, out, mvc_scratch);
+                }
+            }
+            Method::Mlc => {
+                if mlc::mlc_weights_inside(x, cage, out, mlc_scratch).is_err() {
+                    // As MEC: only a point numerically on the surface (or on a
+                    // vertex) has no solution; the outside policy answers.
                     mvc::mvc_weights(x, cage, out, mvc_scratch);
                 }
             }

@@ -259,16 +259,27 @@ pub fn load_cage(path: &Path) -> Result<(Cage, CageReport), CageLoadError> {
     cage_from_file(path, load_mesh(path)?)
 }
 
-/// [`load_cage`] of object `object` ([`load_mesh_object`]), and the note of
-/// which object was read where none was asked for and the file has several.
+/// What a cage file said about its objects besides the cage.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CageObjects {
+    /// Which object was read, where none was asked for and the file has several.
+    pub note: Option<String>,
+    pub objects: super::FileObjects,
+}
+
+/// [`load_cage`] of object `object` ([`load_mesh_object`]), and which of the
+/// file's objects was read.
 pub fn load_cage_object(
     path: &Path,
     object: Option<&str>,
-) -> Result<(Cage, CageReport, Option<String>), CageLoadError> {
+) -> Result<(Cage, CageReport, CageObjects), CageLoadError> {
     let mut file = load_mesh_object(path, object)?;
-    let note = file.object_note.take();
+    let objects = CageObjects {
+        note: file.object_note.take(),
+        objects: std::mem::take(&mut file.objects),
+    };
     let (cage, report) = cage_from_file(path, file)?;
-    Ok((cage, report, note))
+    Ok((cage, report, objects))
 }
 
 /// Validate a mesh read from `path` as a cage; errors name the file.

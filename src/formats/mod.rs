@@ -24,7 +24,7 @@ pub use error::{object_list, shown_path, CageLoadError, LoadError, ObjectError, 
 pub use io::{
     cage_from_file, check_object_name, load_cage, load_cage_object, load_mesh, load_mesh_object,
     parse_mesh, write_cage_and_pose, write_deformed_mesh, write_mesh_with_normals, write_obj,
-    write_obj_to, write_polygons_obj_to,
+    write_obj_to, write_polygons_obj_to, CageObjects,
 };
 pub use mtllib::MovedLibrary;
 pub use npy::points::write_points_npy;
@@ -66,6 +66,26 @@ pub struct MeshFile {
     /// Where the file has several objects and none was asked for, which was
     /// read ("the file has 3 objects: …; …"), for the caller to say.
     pub object_note: Option<String>,
+    /// Which of the file's named objects this is, and what the others are.
+    pub objects: FileObjects,
+}
+
+/// The named objects of a file (an OBJ's `o` objects, a glTF's nodes and
+/// meshes), so that a caller can offer the others and record which was read.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FileObjects {
+    /// The object read by name; `None` for the file's default (an OBJ's
+    /// objects together, a glTF's first mesh).
+    pub read: Option<String>,
+    /// Every object of the file when it has two or more; empty otherwise.
+    pub names: Vec<String>,
+}
+
+impl FileObjects {
+    /// Whether the file has other objects to choose from.
+    pub fn has_choice(&self) -> bool {
+        self.names.len() > 1
+    }
 }
 
 /// What `path` is when it is not a regular file ("a named pipe", "a device",

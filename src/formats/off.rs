@@ -140,5 +140,6 @@ pub(super) fn parse_off(path: &Path, text: &str) -> Result<MeshFile, LoadError> 
         obj_text: None,
         node_transform: None,
         object_note: None,
+        objects: Default::default(),
     })
 }

@@ -80,14 +80,16 @@ fn a_software_adapter_never_wins_pmvc_against_two_cpu_threads() {
     }
 }
 
-/// Harmonic coordinates, MEC and any family added without a kernel.
+/// Harmonic coordinates, MEC, MLC and any family added without a kernel.
 #[test]
 fn families_without_a_kernel_always_bind_on_the_cpu() {
     let cpu_only: Vec<Method> = Method::ALL
         .into_iter()
         .filter(|&method| Kernel::of(method).is_none())
         .collect();
-    assert!(cpu_only.contains(&Method::Harmonic) && cpu_only.contains(&Method::Mec));
+    for family in [Method::Harmonic, Method::Mec, Method::Mlc] {
+        assert!(cpu_only.contains(&family), "{family}");
+    }
     for method in cpu_only {
         let scene = work(method, 10_000_000, 1_523, 1);
         let prediction = predict(&scene, &device(AdapterClass::Discrete, Pipelines::Ready));

@@ -381,6 +381,8 @@ pub(super) fn bind_points(
         seconds: elapsed.as_secs_f64(),
         mesh_file: "",
         cage_file: &cage_file,
+        mesh_object: None,
+        cage_object: cage.object.as_deref(),
         weights_file: Path::new(""),
     });
     metadata.dtype = dtype.id().to_owned();

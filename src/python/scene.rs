@@ -29,6 +29,8 @@ pub(super) struct PyCage {
     faces: Vec<Vec<u32>>,
     report: CageReport,
     pub(super) path: Option<PathBuf>,
+    /// The object of that file read by name (`Cage.load(path, object=)`).
+    pub(super) object: Option<String>,
     /// What the cage was validated from: its pickled state. Validating it
     /// again gives this cage bit for bit (validation is deterministic).
     source: Arc<geometry::TriMesh>,
@@ -58,6 +60,7 @@ impl PyCage {
             faces,
             report,
             path,
+            object: None,
             source,
         })
     }
@@ -116,13 +119,14 @@ pub(super) fn cage_argument<'py>(value: &Bound<'py, PyAny>) -> PyResult<CageArgu
 /// triangles and each triangle's face it was validated from, and its file.
 /// Checked and validated as any cage is, since a pickle is input like any other.
 #[pyfunction]
-#[pyo3(name = "_restore_cage", signature = (vertices, triangles, triangle_faces, path=None))]
+#[pyo3(name = "_restore_cage", signature = (vertices, triangles, triangle_faces, path=None, object=None))]
 pub(super) fn restore_cage(
     py: Python<'_>,
     vertices: &Bound<'_, PyAny>,
     triangles: &Bound<'_, PyAny>,
     triangle_faces: &Bound<'_, PyAny>,
     path: Option<PathBuf>,
+    object: Option<String>,
 ) -> PyResult<PyCage> {
     let what = "pickled cage";
     let positions = positions(vertices, &format!("{what}: vertices"))?;
@@ -167,7 +171,7 @@ pub(super) fn restore_cage(
             })
         })
         .collect::<PyResult<Vec<_>>>()?;
-    PyCage::validated(
+    let mut cage = PyCage::validated(
         geometry::TriMesh {
             positions,
             triangles,
@@ -175,7 +179,9 @@ pub(super) fn restore_cage(
         },
         path,
         py,
-    )
+    )?;
+    cage.object = object;
+    Ok(cage)
 }
 
 impl PyCage {
@@ -212,7 +218,9 @@ impl PyCage {
         object: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let file = read_object(py, path, object, "Cage.load")?;
-        Self::validated(file.mesh, Some(file.path), py)
+        let mut cage = Self::validated(file.mesh, Some(file.path), py)?;
+        cage.object = file.objects.read;
+        Ok(cage)
     }
 
     /// Vertex positions, float64, shape (m, 3), in file order (weights columns
@@ -292,6 +300,13 @@ impl PyCage {
         self.path.clone()
     }
 
+    /// The object of that file read as the cage (``Cage.load(path,
+    /// object="Cage")``), or None; ``bind`` records it in the weights' metadata.
+    #[getter]
+    fn object(&self) -> Option<String> {
+        self.object.clone()
+    }
+
     /// Pickling, ``copy`` and ``copy.deepcopy``: the vertices and triangles the
     /// cage was validated from (float64 and int64 arrays, so a pickle costs
     /// their bytes) and its file; loading validates them again, which gives
@@ -311,6 +326,7 @@ impl PyCage {
                 triangles_array(py, &source.triangles)?.into_any(),
                 PyArray1::from_vec(py, faces).into_any(),
                 path,
+                self.object.clone().into_pyobject(py)?.into_any(),
             ],
         )?;
         PyTuple::new(py, [restore, state.into_any()])

@@ -315,7 +315,7 @@ impl SceneGpu {
 
     /// The slot of weights `id`, if bound.
     pub fn slot(&self, id: WeightsId) -> Option<&WeightSlot> {
-        match id.split_twin {
+        match id.twin {
             None => self.slots.get(&id.method),
             Some(_) => self.twin_slots.get(&id.method),
         }
@@ -323,7 +323,7 @@ impl SceneGpu {
 
     /// Install or remove the weights `id`; bind groups that used the old ones go.
     pub fn set_slot(&mut self, id: WeightsId, slot: Option<WeightSlot>) {
-        let slots = match id.split_twin {
+        let slots = match id.twin {
             None => &mut self.slots,
             Some(_) => &mut self.twin_slots,
         };
@@ -331,7 +331,7 @@ impl SceneGpu {
             Some(slot) => slots.insert(id.method, slot),
             None => slots.remove(&id.method),
         };
-        let primary = id.split_twin.is_none();
+        let primary = id.twin.is_none();
         self.bind_groups.retain(|(shown, against), _| {
             !(primary && *shown == id.method) && against.is_none_or(|a| a.method != id.method)
         });

@@ -84,7 +84,11 @@ def test_export_weights_writes_what_pmvc_bind_writes(tmp_path):
     points, rest = coordinates(mesh_obj.data), coordinates(cage_obj.data)
     bound = pmvc.bind(points, pmvc.Cage(rest, cage_faces(cage_obj)), method="harmonic", grid=64, backend="cpu")
     assert np.array_equal(loaded.matrix, bound.matrix)
-    assert json.loads((tmp_path / "W.json").read_text())["method"] == "harmonic"
+    written = json.loads((tmp_path / "W.json").read_text())
+    assert written["method"] == "harmonic"
+    # The objects bound, by their Blender names, where `pmvc bind` names files.
+    assert (written["mesh"]["object"], written["cage"]["object"]) == (mesh_obj.name, cage_obj.name)
+    assert written["mesh"]["file"] == bpy.data.filepath
 
 
 def test_green_weights_are_exported_as_npz_as_pmvc_bind_writes_them(tmp_path, capfd):

@@ -179,3 +179,34 @@ fn objects_of_one_file_are_named_and_picked_by_name() {
     assert!(!output.status.success());
     assert!(stderr(&output).contains("an object name cannot be empty"));
 }
+
+#[test]
+fn the_weights_record_which_objects_were_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "scene.obj", &scene_obj(1.0));
+    let weights = dir.path().join("W.npy");
+    let output = pmvc(&[
+        "bind",
+        "--mesh",
+        path_str(&scene),
+        "--mesh-object",
+        "Mesh",
+        "--cage",
+        path_str(&scene),
+        "--cage-object",
+        "Cage",
+        "--method",
+        "mvc",
+        "--backend",
+        "cpu",
+        "--out",
+        path_str(&weights),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let metadata = pmvc::formats::metadata::read_metadata(&dir.path().join("W.json")).unwrap();
+    assert_eq!(metadata.mesh.object.as_deref(), Some("Mesh"));
+    assert_eq!(metadata.cage.object.as_deref(), Some("Cage"));
+    assert_eq!(metadata.mesh.points, 3);
+    let text = std::fs::read_to_string(dir.path().join("W.json")).unwrap();
+    assert!(text.contains("\"object\": \"Mesh\""), "{text}");
+}

@@ -226,6 +226,7 @@ pub fn parse_obj_with_tobj(path: &Path, text: String) -> Result<MeshFile, LoadEr
         obj_text: Some(text),
         node_transform: None,
         object_note: None,
+        objects: Default::default(),
     })
 }
 

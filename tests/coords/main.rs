@@ -1,4 +1,4 @@
-//! Coordinates: MVC, PMVC, harmonic, Green and maximum entropy coordinates against references and
+//! Coordinates: MVC, PMVC, harmonic, Green, maximum entropy and maximum likelihood coordinates against references and
 //! their properties, far-field exactness, origin offsets, weights metadata and
 //! the figures the docs quote. Builds without features
 //! (`cargo test --no-default-features --test coords`); the parts that run the
@@ -16,6 +16,8 @@ mod green_family;
 mod green_gallery;
 mod harmonic;
 mod mec;
+mod mlc;
+mod mlc_smoothing;
 mod origin_offsets;
 mod qgc;
 mod weights_metadata;

@@ -50,6 +50,8 @@ fn cpu_metadata(
         seconds: 0.25,
         mesh_file: "mesh.obj",
         cage_file: "cage.obj",
+        mesh_object: None,
+        cage_object: Some("Cage"),
         weights_file: path,
     })
 }

@@ -156,7 +156,7 @@ fn the_difference_view_compares_a_family_with_its_triangulated_twin() {
         Some(QuadSplit::Longer)
     );
     run_until_bound(&mut harness);
-    let twin = WeightsId::twin(Method::Pmvc, QuadSplit::Longer);
+    let twin = WeightsId::split(Method::Pmvc, QuadSplit::Longer);
     let twin_set = harness
         .state()
         .document()

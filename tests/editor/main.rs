@@ -22,6 +22,8 @@ mod editor_compare;
 #[cfg(feature = "ui-tests")]
 mod editor_drop;
 #[cfg(feature = "ui-tests")]
+mod editor_exact_twin;
+#[cfg(feature = "ui-tests")]
 mod editor_far_from_origin;
 #[cfg(feature = "ui-tests")]
 mod editor_files;
@@ -30,6 +32,8 @@ mod editor_green;
 mod editor_layout;
 #[cfg(feature = "ui-tests")]
 mod editor_model;
+#[cfg(feature = "ui-tests")]
+mod editor_objects;
 mod editor_offscreen;
 #[cfg(feature = "ui-tests")]
 mod editor_panels;

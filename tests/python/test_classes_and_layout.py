@@ -127,9 +127,11 @@ def test_a_npy_point_set_loads_as_points_without_faces(tmp_path, test_points):
 
 def test_families_lists_every_family_with_its_parameters_and_promise():
     families = {family["id"]: family for family in pmvc.families()}
-    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec"]
+    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec", "mlc"]
     assert families["pmvc"]["positive_inside"] and not families["mvc"]["positive_inside"]
-    assert families["mec"]["positive_inside"] and not families["mec"]["gpu_kernel"]
+    for positive_on_the_cpu in ("mec", "mlc"):
+        family = families[positive_on_the_cpu]
+        assert family["positive_inside"] and not family["gpu_kernel"]
     assert [p["id"] for p in families["pmvc"]["parameters"]] == ["resolution"]
     assert families["harmonic"]["parameters"][0]["default"] == 64
     assert families["green"]["columns_layout"] == "cage_vertices_then_triangles"

@@ -51,6 +51,29 @@ def test_an_object_is_read_by_name_its_vertices_reindexed(scene):
     assert cage.faces[0] == [0, 3, 2, 1]
 
 
+def test_the_cage_object_is_kept_through_pickling_and_recorded_by_bind(scene, tmp_path):
+    import pickle
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        vertices, _ = pmvc.load_mesh(scene, object="Mesh")
+        cage = pmvc.Cage.load(scene, object="Cage")
+    assert cage.object == "Cage"
+    assert pickle.loads(pickle.dumps(cage)).object == "Cage"
+    weights = pmvc.bind(vertices, cage, method="mvc")
+    path = tmp_path / "W.npy"
+    pmvc.save_weights(path, weights)
+    import json
+
+    record = json.loads(path.with_suffix(".json").read_text())["cage"]
+    assert (record["file"], record["object"]) == (str(scene), "Cage")
+    # A cage from arrays has no object, and says nothing of one.
+    unnamed = pmvc.Cage(cage.vertices, cage.faces)
+    assert unnamed.object is None
+    pmvc.save_weights(path, pmvc.bind(vertices, unnamed, method="mvc"))
+    assert "object" not in json.loads(path.with_suffix(".json").read_text())["cage"]
+
+
 def test_without_a_name_a_warning_names_the_objects_read_together(scene):
     with pytest.warns(pmvc.PmvcWarning, match="the file has 2 objects: 'Cage', 'Mesh', read together"):
         vertices, _ = pmvc.load_mesh(scene)

@@ -444,7 +444,13 @@ impl EditorApp {
 
     /// Open a mesh and its cage together.
     pub fn open_pair(&mut self, mesh: &Path, cage: &Path) -> bool {
-        self.open_pair_now(mesh, cage)
+        self.open_pair_now(mesh, cage, crate::app::files::ObjectNames::default())
+    }
+
+    /// Read object `object` of the mesh's (or the cage's) file in its place,
+    /// as the side panel's object choice does; `None`: the file's default.
+    pub fn choose_object(&mut self, role: FileRole, object: Option<&str>) -> bool {
+        self.reopen_object_now(role, object)
     }
 
     /// Open a File > Recent entry; one that no longer opens leaves the list.

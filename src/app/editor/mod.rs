@@ -261,9 +261,15 @@ impl EditorApp {
                 }
                 opened
             }
-            (Some(mesh), Some(cage), None) => self.open_pair(mesh, cage),
+            (Some(mesh), Some(cage), None) => {
+                let objects = super::files::ObjectNames {
+                    mesh: options.mesh_object.as_deref(),
+                    cage: options.cage_object.as_deref(),
+                };
+                self.open_pair_now(mesh, cage, objects)
+            }
             (Some(mesh), None, None) => {
-                let change = super::files::open_mesh_alone(mesh);
+                let change = super::files::open_mesh_alone(mesh, options.mesh_object.as_deref());
                 self.change_scene(change)
             }
             (None, None, None) => false,

@@ -56,8 +56,11 @@ impl EditorApp {
             Action::Open(role, path) => {
                 self.open_file_now(role, &path);
             }
+            Action::OpenObject { role, object } => {
+                self.reopen_object_now(role, object.as_deref());
+            }
             Action::OpenPair { mesh, cage } => {
-                self.open_pair_now(&mesh, &cage);
+                self.open_pair_now(&mesh, &cage, files::ObjectNames::default());
             }
             Action::OpenRecent(entry) => {
                 self.open_recent_now(&entry);
@@ -281,12 +284,8 @@ impl EditorApp {
             device: outcome.device,
             quality: outcome.quality,
         };
-        // A bind with other quads than the setting's is a triangulated twin.
-        let id = if options.quads == self.binding.options_for(method).quads {
-            crate::coords::WeightsId::of(method)
-        } else {
-            crate::coords::WeightsId::twin(method, options.quads)
-        };
+        // A bind with other options than the setting's is a twin.
+        let id = crate::coords::WeightsId::of_bind(&options, &self.binding.options_for(method));
         let installed = self.apply(Command::InstallWeights {
             id,
             set,

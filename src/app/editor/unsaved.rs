@@ -180,12 +180,43 @@ impl EditorApp {
     // ---- files ----------------------------------------------------------------------
 
     pub(super) fn open_file_now(&mut self, role: FileRole, path: &Path) -> bool {
-        let change = files::open_file(role, path, self.model.document());
+        self.open_object_now(role, path, None)
+    }
+
+    /// Object `object` of the file at `path` as the mesh or the cage.
+    pub(super) fn open_object_now(
+        &mut self,
+        role: FileRole,
+        path: &Path,
+        object: Option<&str>,
+    ) -> bool {
+        let change = files::open_file(role, path, object, self.model.document());
         self.change_scene(change)
     }
 
-    pub(super) fn open_pair_now(&mut self, mesh: &Path, cage: &Path) -> bool {
-        self.change_scene(files::open_pair(mesh, cage))
+    /// Another object of the current mesh's or cage's file in its place.
+    pub(super) fn reopen_object_now(&mut self, role: FileRole, object: Option<&str>) -> bool {
+        let document = self.model.document();
+        let path = match role {
+            FileRole::Mesh => document.mesh_file().map(|file| file.path.clone()),
+            FileRole::Cage => document.cage_path().map(Path::to_path_buf),
+        };
+        match path {
+            Some(path) => self.open_object_now(role, &path, object),
+            None => {
+                self.error("this scene was not read from a file with objects to choose from");
+                false
+            }
+        }
+    }
+
+    pub(super) fn open_pair_now(
+        &mut self,
+        mesh: &Path,
+        cage: &Path,
+        objects: files::ObjectNames,
+    ) -> bool {
+        self.change_scene(files::open_pair(mesh, cage, objects))
     }
 
     pub(super) fn open_session_now(&mut self, path: &Path) -> bool {
@@ -195,7 +226,9 @@ impl EditorApp {
     pub(super) fn open_recent_now(&mut self, entry: &RecentEntry) -> bool {
         let opened = match entry {
             RecentEntry::Session(path) => self.open_session_now(path),
-            RecentEntry::Scene { mesh, cage } => self.open_pair_now(mesh, cage),
+            RecentEntry::Scene { mesh, cage } => {
+                self.open_pair_now(mesh, cage, files::ObjectNames::default())
+            }
             RecentEntry::Mesh(path) => self.open_file_now(FileRole::Mesh, path),
             RecentEntry::Cage(path) => self.open_file_now(FileRole::Cage, path),
         };

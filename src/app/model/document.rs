@@ -8,8 +8,8 @@
 //! pose or the weights without the GPU copy and the caches learning about it.
 
 use crate::app::scenes::BundledScene;
-use crate::coords::{BindOptions, Method, WeightQuality, Weights, WeightsId};
-use crate::formats::MeshFile;
+use crate::coords::{BindOptions, Method, Twin, WeightQuality, Weights, WeightsId};
+use crate::formats::{FileObjects, MeshFile};
 use crate::geometry::{Cage, TriMesh};
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
@@ -58,13 +58,15 @@ pub struct Document {
     /// The cage at rest, as bound.
     cage: Arc<Cage>,
     cage_path: Option<PathBuf>,
+    /// Which object of the cage file is the cage, and the file's others.
+    cage_objects: FileObjects,
     /// The deformed cage: one position per cage vertex.
     pose: Vec<DVec3>,
     selection: BTreeSet<usize>,
     weight_sets: BTreeMap<Method, WeightSet>,
-    /// Each family's triangulated twin, for the difference view that shows what
-    /// splitting the quads does; its options say along which diagonal.
-    twin_sets: BTreeMap<Method, WeightSet>,
+    /// Each family's twin (quads split, or its reference parameter), for the
+    /// difference view that shows what that changes.
+    twin_sets: BTreeMap<Method, (Twin, WeightSet)>,
     /// Mesh vertices outside the cage, ascending; known once classified.
     outside: Arc<[u32]>,
     changes: Changes,
@@ -87,6 +89,7 @@ impl Document {
             mesh_file: None,
             cage: Arc::new(cage),
             cage_path: None,
+            cage_objects: FileObjects::default(),
             selection: BTreeSet::new(),
             weight_sets: BTreeMap::new(),
             twin_sets: BTreeMap::new(),
@@ -133,6 +136,12 @@ impl Document {
         self
     }
 
+    /// The same document, its cage object `objects` of the cage file.
+    pub fn with_cage_objects(mut self, objects: FileObjects) -> Self {
+        self.cage_objects = objects;
+        self
+    }
+
     /// The same mesh with another rest cage, posed as `pose`; weights, selection
     /// and history start afresh, since they belong to the old cage.
     pub fn with_cage(&self, cage: Cage, cage_path: Option<PathBuf>, pose: Vec<DVec3>) -> Self {
@@ -167,6 +176,11 @@ impl Document {
         self.cage_path.as_deref()
     }
 
+    /// Which object of the cage file is the cage ([`FileObjects::read`]).
+    pub fn cage_objects(&self) -> &FileObjects {
+        &self.cage_objects
+    }
+
     pub fn pose(&self) -> &[DVec3] {
         &self.pose
     }
@@ -199,11 +213,11 @@ impl Document {
 
     /// The weights `id`: a family's, or its twin's when bound along that split.
     pub fn bound_id(&self, id: WeightsId) -> Option<&WeightSet> {
-        match id.split_twin {
+        match id.twin {
             None => self.weight_sets.get(&id.method),
-            Some(split) => {
-                (self.twin_sets.get(&id.method)).filter(|set| set.options.quads == split)
-            }
+            Some(twin) => (self.twin_sets.get(&id.method))
+                .filter(|(held, _)| *held == twin)
+                .map(|(_, set)| set),
         }
     }
 
@@ -267,7 +281,7 @@ impl Document {
                 .chain(
                     self.twin_sets
                         .iter()
-                        .map(|(&m, set)| WeightsId::twin(m, set.options.quads)),
+                        .map(|(&m, &(twin, _))| WeightsId::twin(m, twin)),
                 )
                 .collect(),
         };
@@ -396,17 +410,17 @@ impl Document {
     ) -> bool {
         let fits = set.weights.rows == self.mesh.positions.len()
             && set.weights.cols == set.options.columns(&self.cage)
-            && id.split_twin.is_none_or(|split| split == set.options.quads);
+            && id.twin.is_none_or(|twin| twin.matches(&set.options));
         if fits {
-            match id.split_twin {
+            match id.twin {
                 None => {
                     self.weight_sets.insert(id.method, set);
                     // A twin is bound only to be compared with: the vertices
                     // outside are those of the cage as the setting binds it.
                     self.outside = outside;
                 }
-                Some(_) => {
-                    self.twin_sets.insert(id.method, set);
+                Some(twin) => {
+                    self.twin_sets.insert(id.method, (twin, set));
                 }
             };
             self.changes.weights.insert(id);

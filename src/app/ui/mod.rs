@@ -12,6 +12,7 @@ pub mod generate_cage;
 pub mod menu;
 pub mod named_poses;
 pub mod notices;
+pub mod object_choice;
 pub mod pose_panel;
 pub mod quality_table;
 pub mod recovery_dialog;

@@ -6,6 +6,7 @@ use crate::app::commands::{Command, GestureKind, POSE_EDIT};
 use crate::app::ctx::PanelContext;
 use crate::app::ui::named_poses::PoseBlend;
 use crate::app::ui::notices::Notices;
+use crate::app::ui::object_choice::object_choice;
 use crate::app::ui::pose_panel::PosePanel;
 use crate::app::ui::quality_table::quality_table;
 use crate::app::ui::statistics::StatisticsPanel;
@@ -30,6 +31,7 @@ pub fn side_panel(ui: &mut egui::Ui, cx: &mut PanelContext, sections: Sections) 
         cx.document().mesh().positions.len(),
         cx.document().pose().len()
     ));
+    object_choice(ui, cx);
     ui.separator();
     binding_section(ui, cx, &ctx);
     ui.separator();

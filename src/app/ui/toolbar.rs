@@ -5,7 +5,7 @@
 use crate::app::actions::Action;
 use crate::app::compare::{Layout, Overlay, ViewSettings, DIFFERENCE_LIMITS};
 use crate::app::ctx::PanelContext;
-use crate::coords::{Method, QuadSplit, QuadSupport};
+use crate::coords::{BindOptions, Method, QuadSplit, Twin, WeightsId};
 use crate::render::colormap::Scale;
 
 /// What the first run shows, in one line.
@@ -47,9 +47,9 @@ pub fn toolbar(ui: &mut egui::Ui, cx: &mut PanelContext) {
         match view.layout {
             Layout::SideBySide => comparison_controls(ui, &mut view, &mut later),
             Layout::Difference => {
-                let quads =
-                    (cx.document().cage().has_quads()).then_some(cx.shown().bind_options.quads);
-                difference_controls(ui, &mut view, &mut later, quads)
+                let has_quads = cx.document().cage().has_quads();
+                let setting = cx.shown().bind_options;
+                difference_controls(ui, &mut view, &mut later, setting, has_quads)
             }
             Layout::Single => {}
         }
@@ -135,37 +135,47 @@ fn comparison_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut V
     }
 }
 
-/// Which two methods the difference compares: "[MVC] vs [PMVC] shown", or on a
-/// cage with quads a family against its triangulated twin: "[split: shorter] vs
-/// [PMVC] shown".
+/// Which two methods the difference compares: "[MVC] vs [PMVC] shown", or a
+/// family against a twin of itself: on a cage with quads bound split along a
+/// diagonal ("[itself, split: shorter diagonal] vs [PMVC] shown"), or at its
+/// parameter's reference value ("[itself, exact] vs [PMVC] shown").
 fn difference_controls(
     ui: &mut egui::Ui,
     view: &mut ViewSettings,
     later: &mut Vec<Action>,
-    quads: Option<QuadSplit>,
+    setting: BindOptions,
+    has_quads: bool,
 ) {
     let shown = view.difference[1];
-    // The twins on offer: the shown family with its quads split another way
-    // than the setting binds them (`quads`), for a family that takes patches.
-    let twins: Vec<QuadSplit> = match quads {
-        Some(setting) if matches!(shown.spec().quads, QuadSupport::Patches { .. }) => {
-            [QuadSplit::Shorter, QuadSplit::Longer]
-                .into_iter()
-                .filter(|&split| split != setting)
-                .collect()
-        }
-        _ => Vec::new(),
+    let setting = BindOptions {
+        method: shown,
+        ..setting
     };
-    if view
-        .difference_split
-        .is_some_and(|split| !twins.contains(&split))
-    {
-        view.difference_split = None;
+    // The twins on offer: those that would differ from the shown family as
+    // the settings bind it.
+    let mut twins: Vec<Twin> = Vec::new();
+    if has_quads {
+        twins.extend([QuadSplit::Shorter, QuadSplit::Longer].map(Twin::Split));
     }
-    let twin_label = |split: QuadSplit| format!("itself, split: {} diagonal", split.id());
-    let mut against = (view.difference[0], view.difference_split);
+    twins.push(Twin::Reference);
+    twins.retain(|twin| twin.options(setting).is_some());
+    let held = match (view.difference_split, view.difference_reference) {
+        (Some(split), _) => Some(Twin::Split(split)),
+        (None, true) => Some(Twin::Reference),
+        (None, false) => None,
+    };
+    let mut against = (view.difference[0], held.filter(|twin| twins.contains(twin)));
+    let twin_label = |twin: Twin| match twin {
+        Twin::Split(split) => format!("itself, split: {} diagonal", split.id()),
+        Twin::Reference => {
+            let name = WeightsId::twin(shown, twin).to_string();
+            // "PMVC (exact)" → "itself, exact"
+            let inner = name.rsplit_once(" (").map_or(name.as_str(), |(_, r)| r);
+            format!("itself, {}", inner.trim_end_matches(')'))
+        }
+    };
     let selected = match against.1 {
-        Some(split) => twin_label(split),
+        Some(twin) => twin_label(twin),
         None => against.0.name().to_owned(),
     };
     egui::ComboBox::from_label("vs")
@@ -175,15 +185,27 @@ fn difference_controls(
                 ui.selectable_value(&mut against, (family, None), family.name());
             }
             let family = against.0;
-            for &split in &twins {
-                ui.selectable_value(&mut against, (family, Some(split)), twin_label(split))
-                    .on_hover_text(
+            for &twin in &twins {
+                let hover = match twin {
+                    Twin::Split(_) => {
                         "The shown family bound with the cage's quads split along this diagonal: \
-                         how far the invisible split moves the mesh",
-                    );
+                         how far the invisible split moves the mesh"
+                    }
+                    Twin::Reference => {
+                        "The shown family at its reference setting (PMVC: exact, no cube map): \
+                         how far the approximation moves the mesh (exact PMVC splits quads)"
+                    }
+                };
+                ui.selectable_value(&mut against, (family, Some(twin)), twin_label(twin))
+                    .on_hover_text(hover);
             }
         });
-    (view.difference[0], view.difference_split) = against;
+    view.difference[0] = against.0;
+    view.difference_split = match against.1 {
+        Some(Twin::Split(split)) => Some(split),
+        _ => None,
+    };
+    view.difference_reference = against.1 == Some(Twin::Reference);
     let mut chosen = shown;
     egui::ComboBox::from_label("shown")
         .selected_text(chosen.name())

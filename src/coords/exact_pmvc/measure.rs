@@ -116,7 +116,7 @@ struct Figures {
     exact_micros: f64,
     /// Per point: candidates, thin, scanned, cones overlapping, occluding,
     /// splits, fragments; and the most fragments at one point.
-    mean: [f64; 7],
+    mean: [f64; 10],
     fragments_max: usize,
     cube_micros: [f64; 2],
     cube_error: [f64; 2],
@@ -151,13 +151,16 @@ fn measure(cage: &Cage, points: &[DVec3]) -> Figures {
         cube_micros[k] = (cpu_nanos() - start) * 1e-3 / points.len() as f64;
         cube_error[k] = error;
     }
-    let mut mean = [0.0; 7];
+    let mut mean = [0.0; 10];
     for s in &stats {
         let values = [
             s.candidates,
             s.thin,
             s.scanned,
             s.cones_overlapping,
+            s.behind,
+            s.separated,
+            s.probed,
             s.occluding,
             s.splits,
             s.fragments,
@@ -178,13 +181,15 @@ fn measure(cage: &Cage, points: &[DVec3]) -> Figures {
 }
 
 fn report(name: &str, cage: &Cage, f: &Figures) {
-    let [candidates, thin, scanned, cones, occluding, splits, fragments] = f.mean;
+    let [candidates, thin, scanned, cones, behind, separated, probed, occluding, splits, fragments] =
+        f.mean;
     println!(
         "{name}: {} triangles, {} points ({} refused): exact {:.1} µs/point, \
          {fragments:.1} fragments/point (max {}); cube map 32² {:.1} µs/point (largest \
          weight error {:.1e}), 64² {:.1} µs/point ({:.1e})\n  per point: {candidates:.1} \
          candidates ({thin:.2} thin), {scanned:.0} pairs scanned, {cones:.0} with cones \
-         overlapping, {occluding:.0} occluding, {splits:.0} splits",
+         overlapping ({behind:.0} behind, {separated:.0} separated, {probed:.0} probed), \
+         {occluding:.0} occluding, {splits:.0} splits",
         cage.triangle_count(),
         f.points,
         f.refused,
@@ -316,4 +321,43 @@ fn thin_threshold() {
             within.len()
         );
     }
+}
+
+/// Where the time goes on the armadillo-size scene of `pmvc bench` (every
+/// fifth of its points): setting up the candidates, finding the visible
+/// pieces, and integrating them, each timed by difference on the same points.
+#[test]
+#[ignore = "a measurement: run in release with --ignored --nocapture"]
+fn armadillo_size_phases() {
+    let scene = procedural::table1_scene("armadillo-size").expect("a scene");
+    let cage = &scene.cage;
+    let points: Vec<DVec3> = scene.points.iter().step_by(5).copied().collect();
+    let scratch = &mut ExactPmvcScratch::default();
+    let per_point = |start: f64| (cpu_nanos() - start) * 1e-3 / points.len() as f64;
+    let start = cpu_nanos();
+    for &x in &points {
+        set_up(x, cage, scratch).expect("inside");
+    }
+    let set_up_micros = per_point(start);
+    let start = cpu_nanos();
+    for &x in &points {
+        set_up(x, cage, scratch).expect("inside");
+        for t in 0..scratch.candidates.len() {
+            visible_pieces(t, scratch);
+        }
+    }
+    let visibility_micros = per_point(start) - set_up_micros;
+    let mut out = vec![0.0; cage.vertex_count()];
+    let start = cpu_nanos();
+    for &x in &points {
+        exact_pmvc_weights_inside(x, cage, &mut out, scratch).expect("inside");
+    }
+    let total_micros = per_point(start);
+    println!(
+        "armadillo-size phases, {} points: total {total_micros:.1} µs/point: set-up \
+         {set_up_micros:.1}, visibility {visibility_micros:.1}, integration {:.1}",
+        points.len(),
+        total_micros - set_up_micros - visibility_micros
+    );
+    report("armadillo-size", cage, &measure(cage, &points));
 }

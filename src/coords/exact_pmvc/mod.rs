@@ -88,29 +88,50 @@
 //! Cost per point, one thread, release build, CPU time, against the cube map
 //! for the same points (the artist cages of `../shared/data/qmvc`, quads split
 //! along the shorter diagonal, at about 2000 of their mesh's inside vertices;
-//! the procedural cages at points spread inside):
+//! the procedural cages at points spread inside; armadillo-size at every
+//! fifth of `pmvc bench`'s points), on 2 cores shared with other builds
+//! (load average 5 to 6):
 //!
 //! | cage | triangles | exact | fragments (max) | cube 32² | cube 64² | cube 64² largest error |
 //! |---|---|---|---|---|---|---|
-//! | ManHead | 20 | 13 µs | 20 (27) | 12 µs | 43 µs | 4.7e-4 |
-//! | Bench | 44 | 28 µs | 30 (44) | 16 µs | 50 µs | 1.7e-3 |
-//! | comb | 60 | 53 µs | 40 (70) | 18 µs | 55 µs | 1.4e-3 |
-//! | FireHydrant | 92 | 95 µs | 71 (84) | 21 µs | 50 µs | 2.8e-3 |
-//! | Ogre | 232 | 200 µs | 93 (212) | 26 µs | 58 µs | 1.5e-3 |
-//! | Beast | 300 | 226 µs | 97 (235) | 30 µs | 69 µs | 5.0e-4 |
-//! | hand-size | 500 | 800 µs | 207 (370) | 64 µs | 133 µs | 2.4e-3 |
-//! | icosphere | 1280 | 2.9 ms | 1280 | 104 µs | 139 µs | 2.6e-5 |
+//! | ManHead | 20 | 17 µs | 20 (27) | 19 µs | 60 µs | 4.7e-4 |
+//! | Bench | 44 | 36 µs | 30 (44) | 22 µs | 68 µs | 1.7e-3 |
+//! | comb | 60 | 82 µs | 40 (70) | 28 µs | 82 µs | 1.4e-3 |
+//! | FireHydrant | 92 | 123 µs | 71 (84) | 24 µs | 68 µs | 2.8e-3 |
+//! | armadillo-size | 216 | 339 µs | 106 (176) | 47 µs | 116 µs | 1.8e-3 |
+//! | Ogre | 232 | 256 µs | 93 (212) | 34 µs | 84 µs | 1.5e-3 |
+//! | Beast | 300 | 280 µs | 97 (235) | 40 µs | 85 µs | 5.0e-4 |
+//! | hand-size | 500 | 1.06 ms | 207 (370) | 89 µs | 173 µs | 2.4e-3 |
+//! | icosphere | 1280 | 3.8 ms | 1280 | 128 µs | 176 µs | 2.6e-5 |
 //!
 //! The time goes to the pairs of candidates: every candidate scans those not
-//! wholly farther than itself, which grows as the square of their number
-//! (Beast: 9754 pairs scanned per point, 2234 with bounding cones meeting, 316
-//! occluding; the icosphere, where every triangle is at about the same
-//! distance: 913,313 scanned), then to cutting pieces. A grid of directions
-//! listing the candidates by cube-map cell (to scan only those sharing a
-//! cell) halved the icosphere's time but doubled the hand's and Beast's,
-//! whose large triangles fill many cells; it is not used. Commands:
+//! wholly farther than itself, which grows as the square of their number,
+//! then to cutting pieces. On armadillo-size, per point: set-up 27 µs (8 %),
+//! finding the visible pieces 294 µs (86 %), integrating them 19 µs (6 %);
+//! 181 candidates, 11,101 pairs scanned, 5053 with bounding cones meeting, of
+//! which 1852 are behind by the sides of the planes, 2793 separated by an
+//! edge plane, none needing a ray, and 407 occluding (339 cuts, 106 visible
+//! pieces). Cutting is the small part: the scan stops at a candidate once it
+//! is hidden, and without the cuts (so without that stop) finding the pieces
+//! took 480 µs (measured with the variants below in place). Beast: 9754
+//! pairs scanned, 2234 with cones meeting, 316 occluding; the icosphere,
+//! where every triangle is at about the same distance: 913,313 scanned,
+//! 16,159 with cones meeting, none occluding.
+//!
+//! Tried and not kept, for gaining less than the noise of these figures
+//! (under 3 % on armadillo-size, the same weights bit for bit): testing the
+//! pairs that share no corner with no branch; ruling candidates out by a
+//! bounding ball (wholly beyond t's plane) and their cone against t's edge
+//! planes before reading them (a quarter of the pairs with cones meeting);
+//! trying the candidates that last hid a whole one first (48 of the 181 per
+//! point hidden at once). Looking at each pair once for both orders loses
+//! the stop at hidden candidates, scans half as many pairs again and was a
+//! quarter slower. A grid of directions listing the candidates by cube-map cell (to
+//! scan only those sharing a cell) halved the icosphere's time but doubled
+//! the hand's and Beast's, whose large triangles fill many cells. Commands:
 //! `cargo test --release --no-default-features --lib coords::exact_pmvc::measure
-//! -- --ignored --nocapture --test-threads 1`.
+//! -- --ignored --nocapture --test-threads 1` (`armadillo_size_phases` for the
+//! phases).
 
 #[cfg(test)]
 mod measure;
@@ -154,7 +175,13 @@ pub struct ExactPmvcStats {
     pub scanned: usize,
     /// Of those, pairs whose bounding cones overlap.
     pub cones_overlapping: usize,
-    /// Of those, pairs where s overlaps t and is in front of it.
+    /// Of those, pairs the sides of their planes put s behind t.
+    pub behind: usize,
+    /// Of the rest, pairs with an edge plane separating the two.
+    pub separated: usize,
+    /// Of the rest, pairs whose order took a ray through their overlap.
+    pub probed: usize,
+    /// Pairs where s overlaps t and is in front of it.
     pub occluding: usize,
     /// Pieces an occluder cut or hid.
     pub splits: usize,

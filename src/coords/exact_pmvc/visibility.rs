@@ -109,13 +109,19 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
         let occluder = &candidates[s];
         // The cheaper tests first: depth by planes, then overlap.
         let order = order(target, occluder, relative);
-        if matches!(order, Order::Behind) || triangles_separated(target, occluder, directions) {
+        if matches!(order, Order::Behind) {
+            stats.behind += 1;
             continue;
         }
-        if matches!(order, Order::Probe)
-            && !probe_in_front(target, occluder, directions, work, cut, sides)
-        {
+        if triangles_separated(target, occluder, directions) {
+            stats.separated += 1;
             continue;
+        }
+        if matches!(order, Order::Probe) {
+            stats.probed += 1;
+            if !probe_in_front(target, occluder, directions, work, cut, sides) {
+                continue;
+            }
         }
         next.clear();
         stats.occluding += 1;

@@ -6,7 +6,7 @@ use super::super::obj::{parse_obj, MAX_VERTICES};
 use super::buffers::{split_glb, Buffers};
 use super::hierarchy::check_hierarchy;
 use super::json_size::JsonSize;
-use super::objects::{default_note, pick_object};
+use super::objects::{default_note, objects, pick_object};
 use super::MeshPick;
 use crate::budget::human_bytes;
 use crate::budget::{available_memory, bytes_for, check_memory, read_limited};
@@ -112,6 +112,14 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], pick: &MeshPick) -> Result<MeshFile
     if *pick == MeshPick::First {
         file.object_note = default_note(&document, mesh.index());
     }
+    let names: Vec<String> = objects(&document).into_iter().map(|o| o.name).collect();
+    file.objects = crate::formats::FileObjects {
+        read: match pick {
+            MeshPick::Object(name) | MeshPick::Name(name) => Some(name.clone()),
+            MeshPick::First | MeshPick::Index(_) => None,
+        },
+        names: if names.len() > 1 { names } else { Vec::new() },
+    };
     Ok(file)
 }
 

@@ -92,6 +92,10 @@ pub struct ClassesRecord {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MeshRecord {
     pub file: String,
+    /// The object of the file that was bound, where one was named
+    /// (`--mesh-object`, a Blender object).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
     pub points: usize,
     /// [`positions_digest`] of the points.
     pub digest: String,
@@ -101,6 +105,9 @@ pub struct MeshRecord {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CageRecord {
     pub file: String,
+    /// The object of the file that is the cage, where one was named.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
     pub vertices: usize,
     /// Triangles after quads and polygons were split ([`Cage::triangles`]).
     pub triangles: usize,
@@ -179,6 +186,9 @@ pub struct BindRecord<'a> {
     /// The input files as the user named them ("" for arrays from memory).
     pub mesh_file: &'a str,
     pub cage_file: &'a str,
+    /// The objects of those files that were read, where one was named.
+    pub mesh_object: Option<&'a str>,
+    pub cage_object: Option<&'a str>,
     /// Where the weights go: the mask's name is derived from it.
     pub weights_file: &'a Path,
 }
@@ -259,11 +269,13 @@ impl WeightsMetadata {
             },
             mesh: MeshRecord {
                 file: record.mesh_file.to_owned(),
+                object: record.mesh_object.map(str::to_owned),
                 points: record.points.len(),
                 digest: positions_digest(record.points),
             },
             cage: CageRecord {
                 file: record.cage_file.to_owned(),
+                object: record.cage_object.map(str::to_owned),
                 vertices: record.cage.vertex_count(),
                 triangles: record.cage.triangle_count(),
                 quads: record.cage.quads().len(),

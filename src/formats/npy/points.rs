@@ -170,6 +170,7 @@ pub(crate) fn read_points_npy(path: &Path, max_points: usize) -> Result<MeshFile
         obj_text: None,
         node_transform: None,
         object_note: None,
+        objects: Default::default(),
     })
 }
 

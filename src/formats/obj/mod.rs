@@ -58,6 +58,7 @@ pub(super) fn parse_obj(path: &Path, text: String) -> Result<MeshFile, LoadError
         obj_text: Some(text),
         node_transform: None,
         object_note: None,
+        objects: Default::default(),
     })
 }
 
@@ -73,13 +74,14 @@ pub(super) fn pick_object(
     let Some(text) = file.obj_text.as_deref() else {
         return Ok(file);
     };
+    let names = object_names(text);
     let Some(name) = object else {
-        let names = object_names(text);
         if names.len() > 1 {
             file.object_note = Some(format!(
                 "the file has {}, read together as one mesh",
                 super::object_list(&names)
             ));
+            file.objects.names = names;
         }
         return Ok(file);
     };
@@ -87,7 +89,12 @@ pub(super) fn pick_object(
         path: path.to_owned(),
         source,
     })?;
-    parse_obj(path, picked)
+    let mut file = parse_obj(path, picked)?;
+    file.objects = super::FileObjects {
+        read: Some(name.to_owned()),
+        names: if names.len() > 1 { names } else { Vec::new() },
+    };
+    Ok(file)
 }
 
 /// `text` cut after the first line end past every `bytes` bytes.

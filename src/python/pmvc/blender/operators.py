@@ -1,6 +1,7 @@
 """The operators: bind (in the background in the UI, with progress and Esc),
 unbind, rebind, bake_shape_key, export_weights and show_coordinate."""
 
+import json
 import threading
 
 import bpy
@@ -9,6 +10,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 import pmvc
+from pmvc import _native
 
 from . import binding, deform, store
 
@@ -214,7 +216,7 @@ class PMVC_OT_export_weights(bpy.types.Operator, ExportHelper):
     def execute(self, context):
         try:
             obj = bound_object(context)
-            weights = store.load(obj).weights
+            weights = with_objects_named(store.load(obj).weights, obj)
             path = self.filepath
             if weights.triangles is not None and path.lower().endswith(".npy"):
                 path = path[:-4] + ".npz"  # Green's φ and ψ, as `pmvc bind` writes them
@@ -224,6 +226,19 @@ class PMVC_OT_export_weights(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         self.report({"INFO"}, f"{obj.name}: weights written to {path} (with .classes.npy and .json)")
         return {"FINISHED"}
+
+
+def with_objects_named(weights, obj):
+    """``weights`` whose metadata names the .blend file and the mesh and cage
+    objects, where ``pmvc bind`` names its input files and objects."""
+    metadata = json.loads(weights.__reduce__()[1][2])
+    blend = bpy.data.filepath  # "" for a file never saved, as for arrays
+    _, _, cage_obj = store.summary(obj)
+    for record, named in (("mesh", obj), ("cage", cage_obj)):
+        metadata[record]["file"] = blend
+        if named is not None:
+            metadata[record]["object"] = named.name
+    return _native._restore_weights(weights.matrix, weights.classes, json.dumps(metadata), None)
 
 
 class PMVC_OT_show_coordinate(bpy.types.Operator):
