@@ -370,7 +370,7 @@ fn run(
     // chunks when it does not, or when the job ran on the CPU.
     let gpu_buffer = match &backend {
         Backend::Gpu(context) => {
-            let columns = options.method.columns(&prepared.cage);
+            let columns = options.columns(&prepared.cage);
             let rows_per_chunk = ChunkLimits::of(&context.limits).rows_per_chunk(columns);
             prepared.points.len() as u64 <= rows_per_chunk
         }
@@ -396,7 +396,9 @@ fn run(
             let quality = WeightQuality::measure_columns(
                 &weights,
                 &prepared.points,
-                &options.method.rest_columns(&prepared.cage),
+                &options
+                    .method
+                    .rest_columns(&options.cage_to_bind(&prepared.cage)),
                 options.method.vertex_columns(&prepared.cage),
                 &outside,
             );

@@ -72,10 +72,9 @@ impl Binding {
     }
 
     /// The options `method` is bound with: its family's current parameters, and
-    /// the quads as the setting says. A family that takes only triangles (Green)
-    /// is bound on the cage's own triangles, split along the shorter diagonal,
-    /// whatever the setting: its ψ columns follow those triangles everywhere
-    /// the editor moves them.
+    /// the quads as the setting says. A family that takes only triangles (none
+    /// today: Green on quads is QGC) is bound on the cage's own triangles,
+    /// split along the shorter diagonal, whatever the setting.
     pub fn options_for(&self, method: Method) -> BindOptions {
         let quads = match method.spec().quads {
             QuadSupport::Patches { .. } => self.options.quads,

@@ -26,9 +26,10 @@ impl Views {
                 return Some(Arc::clone(positions));
             }
         }
-        let weights = &document.bound_id(id)?.weights;
-        let moves = id
-            .method
+        let set = document.bound_id(id)?;
+        let weights = &set.weights;
+        let moves = set
+            .options
             .column_displacements(document.cage(), document.pose());
         let positions = Arc::new(compare::deform(
             weights,

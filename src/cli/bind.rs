@@ -134,7 +134,7 @@ pub(super) fn bind(args: &BindArgs) -> Result<()> {
         .join()
         .map_err(|_| anyhow::anyhow!("internal error: the adapter probe panicked"))??;
     let rows = input.mesh.mesh.positions.len();
-    let columns = method.columns(&input.cage);
+    let columns = args.method.options().columns(&input.cage);
     // Opened before the work, so that a full disk or an unwritable folder is
     // reported now, and a signal during the bind removes the temporary files.
     let mut paths = vec![args.out.as_path()];

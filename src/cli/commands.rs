@@ -56,7 +56,7 @@ pub(super) struct InputRules<'a> {
 pub(super) fn load_input(input: &CageInput, rules: &InputRules) -> Result<BoundInput> {
     let mesh = read_mesh(&input.mesh, input.mesh_object.as_deref())?;
     let (cage, report) = read_cage(&input.cage, input.cage_object.as_deref())?;
-    let columns = rules.options.method.columns(&cage);
+    let columns = rules.options.columns(&cage);
     let rows = (rules.resident_rows)(mesh.mesh.positions.len(), columns);
     check_weights_fit(rows, columns, &input.mesh)?;
     for message in report.messages() {

@@ -135,8 +135,7 @@ pub struct MethodChoice {
     /// Split the cage's quads into triangles along their shorter or longer diagonal
     /// before binding, as before quads were bilinear patches, to reproduce earlier
     /// results or see how much the split moves the mesh. Without it, quads stay
-    /// bilinear patches (MVC on quads is then QMVC); Green coordinates, which take
-    /// only triangles, split along the shorter diagonal.
+    /// bilinear patches (MVC on quads is then QMVC, Green coordinates QGC).
     #[arg(long, value_enum, value_name = "DIAGONAL")]
     pub triangulate: Option<TriangulateArg>,
     /// Where binding runs (harmonic coordinates always bind on the CPU).

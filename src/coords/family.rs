@@ -22,7 +22,8 @@ pub enum Method {
     /// Harmonic coordinates (Joshi et al. 2007), by a grid solve of Laplace's equation.
     Harmonic,
     /// Green coordinates (Lipman, Levin, Cohen-Or 2008), closed form: one column per
-    /// cage vertex (φ) and one per cage triangle (ψ).
+    /// cage vertex (φ) and one per cage triangle (ψ); on bilinear quads, QGC
+    /// (Thiery and Boubekeur 2022): four ψ per quad.
     Green,
     /// Maximum entropy coordinates (Hormann and Sukumar 2008), by a convex
     /// minimisation in three unknowns per point.
@@ -187,7 +188,9 @@ pub enum ColumnLayout {
     /// One weight per cage vertex.
     CageVertices,
     /// One per cage vertex, then one per cage triangle in [`Cage::triangles`] order
-    /// (Green coordinates' φ, then ψ).
+    /// (Green coordinates' φ, then ψ). On a cage bound with quads (QGC): one per
+    /// lone triangle ([`Cage::lone_triangles`]), then four per quad, one per
+    /// corner in the quad's order ([`super::green::face_columns`]).
     CageVerticesThenTriangles,
 }
 
@@ -319,8 +322,8 @@ const GREEN: FamilySpec = FamilySpec {
     outside_policy: "vertices outside the cage get Green's exterior extension: the inside \
          coordinates continued through the nearest cage triangle, exact at rest and continuous across it",
     rows_independent: true,
-    quads: QuadSupport::Triangles,
-    quads_reason: "Green coordinates for quad cages are another method, Thiery and Boubekeur 2022, not yet offered",
+    quads: QuadSupport::Patches { name: "QGC" },
+    quads_reason: "",
 };
 
 const MEC: FamilySpec = FamilySpec {
@@ -397,17 +400,20 @@ impl Method {
     pub fn columns(self, cage: &Cage) -> usize {
         match self.spec().columns {
             ColumnLayout::CageVertices => cage.vertex_count(),
-            ColumnLayout::CageVerticesThenTriangles => cage.vertex_count() + cage.triangle_count(),
+            ColumnLayout::CageVerticesThenTriangles => {
+                cage.vertex_count() + super::green::face_columns(cage)
+            }
         }
     }
 
     /// The vector each weights column multiplies at rest: the cage positions, then
-    /// for Green coordinates each triangle's unit outward normal. A row reproduces
-    /// its point when Σₖ wₖ cₖ equals it (linear precision).
+    /// for Green coordinates each triangle's unit outward normal (on a cage with
+    /// quads, QGC: each lone triangle's, then each quad's four corner normals
+    /// `Nₖ`). A row reproduces its point when Σₖ wₖ cₖ equals it (linear precision).
     pub fn rest_columns(self, rest: &Cage) -> Vec<DVec3> {
         let mut columns = rest.positions().to_vec();
         if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
-            columns.extend(rest_normals(rest));
+            columns.extend(super::green::rest_face_vectors(rest));
         }
         columns
     }
@@ -416,7 +422,8 @@ impl Method {
     /// vertex then moves by Σₖ wₖ dₖ (the displacement form, exact at rest for any
     /// weights). For a cage vertex's column this is `pose − rest`; for a triangle's
     /// (Green coordinates) it is `sⱼ nⱼ' − nⱼ`, the stretched deformed normal less
-    /// the rest normal. A pose of the wrong length moves nothing.
+    /// the rest normal, and for a quad corner's (QGC) `σₖ Nₖ' − Nₖ`. A pose of the
+    /// wrong length moves nothing.
     pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
         let mut moves: Vec<DVec3> = pose
             .iter()
@@ -424,11 +431,11 @@ impl Method {
             .map(|(posed, rested)| *posed - *rested)
             .collect();
         if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
-            match super::green::face_vectors(rest, pose) {
+            match super::green::qgc_face_vectors(rest, pose) {
                 Ok(faces) => moves.extend(
                     faces
                         .into_iter()
-                        .zip(rest_normals(rest))
+                        .zip(super::green::rest_face_vectors(rest))
                         .map(|(posed, rested)| posed - rested),
                 ),
                 Err(_) => moves.resize(self.columns(rest), DVec3::ZERO),
@@ -442,14 +449,6 @@ impl Method {
     pub fn vertex_columns(self, cage: &Cage) -> usize {
         cage.vertex_count()
     }
-}
-
-/// Each cage triangle's unit outward normal (zero for a degenerate one).
-fn rest_normals(cage: &Cage) -> impl Iterator<Item = DVec3> + '_ {
-    cage.triangles().iter().map(|&corners| {
-        let [a, b, c] = corners.map(|i| cage.positions()[i as usize]);
-        (b - a).cross(c - a).normalize_or_zero()
-    })
 }
 
 /// Saved files name a family by its identifier ("pmvc"), so adding or reordering

@@ -150,6 +150,19 @@ impl BindOptions {
         crate::geometry::classify_points(&self.cage_to_bind(cage), points)
     }
 
+    /// Weights columns per point of a bind of `cage` with these options: the
+    /// family's [`Method::columns`] of the cage it binds (Green's differ with
+    /// the quads as patches or split).
+    pub fn columns(&self, cage: &Cage) -> usize {
+        self.method.columns(&self.cage_to_bind(cage))
+    }
+
+    /// [`Method::column_displacements`] on the cage these options bind.
+    pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+        self.method
+            .column_displacements(&self.cage_to_bind(cage), pose)
+    }
+
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
     pub fn pmvc_exact(&self) -> bool {
         self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
@@ -463,7 +476,7 @@ pub fn bind_rows<T: WeightValue>(
         return Ok(());
     }
     let integration = PmvcIntegration::of(options);
-    let green_cage = (options.method == Method::Green).then(|| green::GreenCage::new(cage));
+    let green_cage = (options.method == Method::Green).then(|| green::QgcCage::new(cage));
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
@@ -496,9 +509,10 @@ pub fn bind_rows<T: WeightValue>(
         )
 }
 
-/// Green coordinates of `x` into one row (φ, then ψ); NaN for a point they cannot
-/// take (not finite), which the bind's validation rejects beforehand.
-fn green_row(green_cage: &green::GreenCage, x: DVec3, out: &mut [f64]) {
+/// Green coordinates (QGC on quads) of `x` into one row (φ, then ψ); NaN for a
+/// point they cannot take (not finite), which the bind's validation rejects
+/// beforehand.
+fn green_row(green_cage: &green::QgcCage, x: DVec3, out: &mut [f64]) {
     let (phi, psi) = out.split_at_mut(green_cage.vertex_count());
     if green_cage.coordinates(x, phi, psi).is_err() {
         out.fill(f64::NAN);
@@ -534,7 +548,7 @@ pub fn weights_at(
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
         // in `bind_rows`.
-        green_row(&green::GreenCage::new(cage), x, out);
+        green_row(&green::QgcCage::new(cage), x, out);
         return;
     }
     match class {

@@ -133,6 +133,9 @@ impl Work {
             (None, _) if self.pmvc_exact => {
                 Some("exact PMVC integrate on the CPU: they have no GPU kernel")
             }
+            (None, Some(Kernel::Green)) => {
+                Some("Green on a cage with quads is QGC, which has no GPU kernel")
+            }
             (None, Some(_)) => Some("MVC on a cage with quads is QMVC, which has no GPU kernel"),
             (None, None) => Some("this family has no GPU kernel"),
         }

@@ -178,12 +178,21 @@ fn mvc_on_a_cage_with_quads_is_qmvc_and_binds_on_the_cpu_saying_why() {
     );
     let decision = decide(BackendRequest::Cpu, None, &quads);
     assert!(!decision.on_gpu(Method::Mvc));
-    // PMVC and Green keep their kernels on the same cage.
-    for method in [Method::Pmvc, Method::Green] {
-        let other = Work { method, ..quads };
-        assert!(other.kernel().is_some(), "{method:?}");
-        assert_eq!(other.no_kernel_reason(), None);
-    }
+    // PMVC keeps its kernel on the same cage; Green there is QGC, which has none.
+    let pmvc = Work {
+        method: Method::Pmvc,
+        ..quads
+    };
+    assert!(pmvc.kernel().is_some());
+    assert_eq!(pmvc.no_kernel_reason(), None);
+    let green = Work {
+        method: Method::Green,
+        ..quads
+    };
+    assert_eq!(green.kernel(), None);
+    assert!(green
+        .no_kernel_reason()
+        .is_some_and(|why| why.contains("QGC")));
 }
 
 #[test]
@@ -197,7 +206,15 @@ fn work_counts_the_quads_a_family_binds_as_patches() {
     };
     assert_eq!(Work::of(split, 10, &cage).kernel(), Some(Kernel::Mvc));
     let green = Work::of(BindOptions::for_method(Method::Green), 10, &cage);
-    assert_eq!((green.cage_quads, green.kernel()), (0, Some(Kernel::Green)));
+    assert_eq!((green.cage_quads, green.kernel()), (6, None));
+    let green_split = BindOptions {
+        quads: crate::geometry::QuadSplit::Shorter,
+        ..BindOptions::for_method(Method::Green)
+    };
+    assert_eq!(
+        Work::of(green_split, 10, &cage).kernel(),
+        Some(Kernel::Green)
+    );
 }
 
 #[test]

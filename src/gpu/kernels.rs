@@ -28,8 +28,8 @@ impl Kernel {
     }
 
     /// The kernel that binds `method` on `cage` (the cage the family binds, see
-    /// `BindOptions::cage_to_bind`). MVC on a cage with quads is QMVC, which has
-    /// none: those binds run on the CPU.
+    /// `BindOptions::cage_to_bind`). MVC on a cage with quads is QMVC and Green
+    /// is QGC, which have none: those binds run on the CPU.
     pub fn for_cage(method: Method, cage: &Cage) -> Option<Kernel> {
         Self::of_work(method, cage.has_quads())
     }
@@ -37,7 +37,7 @@ impl Kernel {
     /// [`Kernel::for_cage`] from the method and whether the cage keeps patches.
     pub fn of_work(method: Method, patches: bool) -> Option<Kernel> {
         match Self::of(method) {
-            Some(Kernel::Mvc) if patches => None,
+            Some(Kernel::Mvc | Kernel::Green) if patches => None,
             kernel => kernel,
         }
     }

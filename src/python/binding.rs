@@ -146,8 +146,7 @@ fn choose_backend(
 /// integrated in closed form on the CPU), ``grid`` harmonic coordinates' grid (each read only by
 /// its family). A cage's quads are bilinear patches (MVC on them is QMVC);
 /// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
-/// first, as before quads were patches (Green coordinates always bind on
-/// triangles, split along the shorter diagonal unless told otherwise). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
+/// first, as before quads were patches (Green coordinates on patches are QGC). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
 /// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
 /// a GPU kernel bind on the CPU. ``pmvc_kernel`` is PMVC's GPU kernel:
 /// ``"auto"``, ``"tiles"`` or ``"bands"`` (as ``pmvc bind --pmvc-kernel``).
@@ -297,7 +296,7 @@ pub(super) fn bind_points(
     let backend = decision.backend;
     let device = backend.clone();
     let rows = points.len();
-    let columns = options.method.columns(&cage.cage);
+    let columns = options.columns(&cage.cage);
     let size = dtype.size();
     crate::budget::check_memory(
         || format!("the weights ({rows} rows × {columns} columns × {size} bytes)"),

@@ -268,13 +268,23 @@ impl PyWeights {
     /// What each column is, in order: ``("vertex", j)`` for cage vertex j (φ_j
     /// for Green coordinates), then for Green coordinates ``("triangle", k)``
     /// for ``triangles[k]`` (ψ_k, which multiplies that triangle's scaled
-    /// normal).
+    /// normal), then for QGC (Green on quads) ``("quad_corner", 4 q + c)`` for
+    /// corner c of quad q of the metadata's ``quads`` (its scaled corner normal).
     #[getter]
     fn columns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let vertices = self.metadata.cage.vertices;
         let mut entries: Vec<(&str, usize)> = (0..vertices).map(|j| ("vertex", j)).collect();
         if self.method().spec().columns == ColumnLayout::CageVerticesThenTriangles {
-            entries.extend((0..self.metadata.cage.triangles).map(|k| ("triangle", k)));
+            let triangles =
+                (self.metadata.triangles.as_ref()).map_or(self.metadata.cage.triangles, Vec::len);
+            entries.extend((0..triangles).map(|k| ("triangle", k)));
+            // QGC: four per quad, `4 q + corner` for corner normal N of `quads[q]`.
+            let corners = self
+                .metadata
+                .quads
+                .as_ref()
+                .map_or(0, |quads| 4 * quads.len());
+            entries.extend((0..corners).map(|k| ("quad_corner", k)));
         }
         PyList::new(py, entries)
     }

@@ -9,7 +9,7 @@ use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use super::weight_chunks::{
     ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
 };
-use crate::coords::{Method, WeightsId};
+use crate::coords::{BindOptions, Method, QuadSplit, WeightsId};
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
 use glam::DVec3;
@@ -166,6 +166,9 @@ pub struct WeightSlot {
     /// them ([`UNIFORM_DISPLACEMENT_BYTES`], zero past the columns).
     pub uniform_displacements: wgpu::Buffer,
     pub columns: u32,
+    /// How the weights were bound on the cage's quads: Green's columns differ
+    /// with them as patches (QGC) or split.
+    pub quads: QuadSplit,
     /// How the rows' first columns are read as vertex attributes from the one
     /// chunk; `None`: from storage alone.
     pub attributes: Option<AttributeBlend>,
@@ -296,10 +299,16 @@ impl SceneGpu {
         queue.write_buffer(&slot.uniform_displacements, 0, bytemuck::cast_slice(head));
     }
 
-    /// `method`'s column displacements for the current pose, as the shader reads them.
-    pub fn displacements_of(&self, method: Method) -> Vec<[f32; 4]> {
+    /// `method`'s column displacements for the current pose, as the shader reads
+    /// them, for weights bound with the quads as `quads` says.
+    pub fn displacements_of(&self, method: Method, quads: QuadSplit) -> Vec<[f32; 4]> {
+        let options = BindOptions {
+            method,
+            quads,
+            ..BindOptions::default()
+        };
         points_f32(
-            &method.column_displacements(&self.rest_cage, &self.pose),
+            &options.column_displacements(&self.rest_cage, &self.pose),
             0.0,
         )
     }

@@ -19,4 +19,5 @@ mod mec;
 mod mlc;
 mod mlc_smoothing;
 mod origin_offsets;
+mod qgc;
 mod weights_metadata;

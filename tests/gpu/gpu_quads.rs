@@ -1,8 +1,8 @@
 //! The GPU binder on cages with quads: PMVC's kernel takes them as bilinear
 //! patches and agrees with an f64 ray caster (and with the CPU reference once it
 //! takes patches); a quad's corner order does not matter, and splitting quads
-//! does; MVC there is QMVC, bound on the CPU whatever the backend; Green
-//! coordinates keep the triangles. Without an adapter each test says it was not
+//! does; MVC there is QMVC and Green QGC, bound on the CPU whatever the
+//! backend, and both bind their split on the GPU. Without an adapter each test says it was not
 //! run, unless `PMVC_REQUIRE_GPU=1`, which turns a missing adapter into a failure.
 
 use crate::gpu_support;
@@ -434,18 +434,25 @@ fn mvc_on_a_quad_cage_is_qmvc_bound_on_the_cpu_and_said_so() {
 }
 
 #[test]
-fn green_coordinates_on_a_quad_cage_bind_its_triangles_on_the_gpu() {
+fn green_on_a_quad_cage_is_qgc_on_the_cpu_and_its_split_binds_on_the_gpu() {
     let Some(context) = test_context("Green on quads") else {
         return;
     };
     let cage = twisted_box(2.0, 0.6);
     let input = input(&cage, mixed_points(&cage, 200, 4), Method::Green);
     let output = bind_on(&context, &input);
+    assert_eq!(output.stats.gpu_rows, 0, "QGC has no GPU kernel");
+    assert_eq!(output.weights.expect("CPU weights"), cpu(&input));
+    let split = input.with_options(BindOptions {
+        quads: QuadSplit::Shorter,
+        ..input.options
+    });
+    let output = bind_on(&context, &split);
     assert!(output.stats.gpu_rows > 0);
     assert_agree(
-        "Green on quads",
-        &input,
+        "split Green",
+        &split,
         &output.weights.expect("CPU weights"),
-        &cpu(&input),
+        &cpu(&split),
     );
 }

@@ -190,8 +190,8 @@ def test_mvc_on_quads_is_qmvc_and_reproduces_points():
 
 def test_families_say_which_bind_on_the_gpu_on_a_cage_with_quads():
     families = {family["id"]: family for family in pmvc.families()}
-    # QMVC has no GPU kernel; PMVC has one for patches, Green binds on triangles.
+    # QMVC and QGC have no GPU kernel; PMVC has one for patches.
     assert families["mvc"]["gpu_kernel"] and not families["mvc"]["gpu_kernel_quads"]
     assert families["pmvc"]["gpu_kernel"] and families["pmvc"]["gpu_kernel_quads"]
-    assert families["green"]["gpu_kernel_quads"]
+    assert families["green"]["gpu_kernel"] and not families["green"]["gpu_kernel_quads"]
     assert not families["harmonic"]["gpu_kernel_quads"]

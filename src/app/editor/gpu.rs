@@ -66,17 +66,17 @@ impl EditorApp {
             .filter_map(|&id| {
                 document
                     .bound_id(id)
-                    .map(|set| (id, Arc::clone(&set.weights)))
+                    .map(|set| (id, Arc::clone(&set.weights), set.options.quads))
             })
             .collect();
         let uploaded = self.with_renderer(|renderer, device, queue| {
             renderer.set_outside(queue, rest, outside);
-            sets.iter().try_for_each(|(method, weights)| {
+            sets.iter().try_for_each(|(method, weights, quads)| {
                 let on_device = resident
                     .as_ref()
                     .filter(|(bound, _)| Arc::ptr_eq(bound, weights))
                     .map(|(_, buffer)| buffer);
-                renderer.set_weights(device, *method, Some(weights), on_device)
+                renderer.set_weights(device, *method, Some(weights), *quads, on_device)
             })
         });
         if let Some(Err(error)) = uploaded {

@@ -240,10 +240,13 @@ impl Document {
     /// The mesh deformed by `method` with the cage posed as `pose` (one
     /// position per cage vertex), or at rest when the method is not bound.
     pub fn deformed_positions_at(&self, method: Method, pose: &[DVec3]) -> Vec<DVec3> {
-        match self.weights(method) {
-            Some(weights) => {
-                let moves = method.column_displacements(&self.cage, pose);
-                weights.apply_displacements(&self.mesh.positions, &moves)
+        match self.bound(method) {
+            Some(set) => {
+                // On the cage the set was bound on: Green's columns differ with
+                // the quads as patches (QGC) or split.
+                let moves = set.options.column_displacements(&self.cage, pose);
+                set.weights
+                    .apply_displacements(&self.mesh.positions, &moves)
             }
             None => self.mesh.positions.clone(),
         }
@@ -406,7 +409,7 @@ impl Document {
         outside: Arc<[u32]>,
     ) -> bool {
         let fits = set.weights.rows == self.mesh.positions.len()
-            && set.weights.cols == id.method.columns(&self.cage)
+            && set.weights.cols == set.options.columns(&self.cage)
             && id.twin.is_none_or(|twin| twin.matches(&set.options));
         if fits {
             match id.twin {

@@ -151,7 +151,7 @@ fn quads_choice(ui: &mut egui::Ui, cx: &mut PanelContext) {
         })
         .response
         .on_hover_text(format!(
-            "The cage has {quads} quads. As bilinear patches the weights do not depend on how a quad is indexed or split (MVC on them is QMVC); split, they depend on the diagonal. Green coordinates always use the shorter diagonal's triangles."
+            "The cage has {quads} quads. As bilinear patches the weights do not depend on how a quad is indexed or split (MVC on them is QMVC, Green QGC); split, they depend on the diagonal."
         ));
     if chosen != current {
         cx.send(Action::SetQuadSplit(chosen));

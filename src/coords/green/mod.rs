@@ -15,6 +15,8 @@
 //!   triangle (the paper's exterior extension): continuous across that triangle,
 //!   exact at rest, and discontinuous only where the nearest triangle changes.
 
+mod qgc;
+mod quad;
 mod triangle;
 
 #[cfg(test)]
@@ -23,9 +25,19 @@ mod paper;
 use super::{BindProgress, Cancelled, Weights};
 use crate::geometry::{closest_offset_on_triangle, Cage};
 use glam::DVec3;
+pub use qgc::{face_columns, qgc_coordinates, rest_face_vectors, QgcCage};
+pub use quad::{corner_normals, corner_scales, Quadtree, QUADTREE};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use triangle::TriangleFrame;
+
+/// QGC's vectors per ψ column in a pose: [`qgc::face_vectors`].
+pub fn qgc_face_vectors(
+    rest: &Cage,
+    deformed_positions: &[DVec3],
+) -> Result<Vec<DVec3>, GreenError> {
+    qgc::face_vectors(rest, deformed_positions)
+}
 
 /// Points closer than this fraction of the cage diagonal are on the surface (the
 /// tolerance point classification uses).
@@ -44,6 +56,8 @@ pub enum GreenError {
     PhiLength { expected: usize, actual: usize },
     #[error("ψ needs one value per cage triangle ({expected}), the buffer holds {actual}")]
     PsiLength { expected: usize, actual: usize },
+    #[error("ψ needs one value per lone cage triangle and four per quad ({expected}), the buffer holds {actual}")]
+    FaceColumns { expected: usize, actual: usize },
     #[error("point {index} is not finite")]
     NonFinitePoint { index: usize },
     #[error("the cage has {expected} vertices but {actual} deformed positions were given")]

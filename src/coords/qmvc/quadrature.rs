@@ -150,7 +150,7 @@ impl Quadtree<'_> {
 
 /// The fewest nodes per side, from 2 to 8, with `ρ^(−2n) ≤ tau`, where the
 /// kernel's singularity lies `t` half-sizes off the cell: `ρ = t + √(1 + t²)`.
-fn order_for(t: f64, tau: f64) -> usize {
+pub(crate) fn order_for(t: f64, tau: f64) -> usize {
     let rho_squared = (t + (1.0 + t * t).sqrt()).powi(2);
     let mut power = rho_squared * rho_squared;
     let mut order = 2;

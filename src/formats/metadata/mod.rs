@@ -137,7 +137,7 @@ pub struct WeightsMetadata {
     #[serde(default = "no_split")]
     pub quad_split: String,
     /// What the family bound the quads as, in words: "bilinear quads", or the
-    /// diagonal they were split along (Green coordinates always split them).
+    /// diagonal they were split along.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub quads_bound_as: String,
     /// How the matrix is stored: "float32", or "float64" where it was asked for
@@ -156,9 +156,14 @@ pub struct WeightsMetadata {
     /// "cage_vertices", or "cage_vertices_then_triangles" (Green's φ then ψ).
     pub columns_layout: String,
     /// For Green coordinates, the triangle each ψ column refers to: column
-    /// `cage.vertices + k` is `triangles[k]`, corners in the order used.
+    /// `cage.vertices + k` is `triangles[k]`, corners in the order used. For
+    /// QGC (Green on a cage bound with quads), the lone triangles only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub triangles: Option<Vec<[u32; 3]>>,
+    /// For QGC, the quads whose corner normals the last ψ columns multiply:
+    /// after the triangles' columns, four per quad, one per corner in this order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quads: Option<Vec<[u32; 4]>>,
     /// Whether the family promises non-negative weights for inside rows.
     pub positive_inside: bool,
     /// How the family fills rows outside the cage, in one sentence.
@@ -236,10 +241,16 @@ impl WeightsMetadata {
             device: record.device.to_owned(),
             seconds: record.seconds,
             rows: record.points.len(),
-            columns: method.columns(record.cage),
+            columns: method.columns(&bound),
             columns_layout: layout_id(layout).to_owned(),
-            triangles: (layout == ColumnLayout::CageVerticesThenTriangles)
-                .then(|| bound.triangles().to_vec()),
+            triangles: (layout == ColumnLayout::CageVerticesThenTriangles).then(|| {
+                bound
+                    .lone_triangles()
+                    .map(|t| bound.triangles()[t])
+                    .collect()
+            }),
+            quads: (layout == ColumnLayout::CageVerticesThenTriangles && bound.has_quads())
+                .then(|| bound.quads().iter().map(|quad| quad.corners).collect()),
             positive_inside: spec.positive_inside,
             outside_policy: spec.outside_policy.to_owned(),
             classes: ClassesRecord {
@@ -380,6 +391,16 @@ impl WeightsMetadata {
     /// Its own fields agree with each other: the format and version are known,
     /// the family and parameters are valid, and the columns are what the family
     /// gives a cage of the recorded size.
+    /// Green coordinates' ψ columns: one per triangle, or for QGC (the file
+    /// lists `quads`) one per lone triangle and four per quad.
+    pub fn face_columns(&self) -> usize {
+        match &self.quads {
+            // Each quad's two triangles give way to its four corners.
+            Some(quads) => self.cage.triangles + 2 * quads.len(),
+            None => self.cage.triangles,
+        }
+    }
+
     pub fn check_consistent(&self, path: &Path) -> Result<BindOptions, MetadataError> {
         let field = |field: &'static str, reason: String| MetadataError::Field {
             path: path.to_owned(),
@@ -406,7 +427,7 @@ impl WeightsMetadata {
         let layout = options.method.spec().columns;
         let expected = match layout {
             ColumnLayout::CageVertices => self.cage.vertices,
-            ColumnLayout::CageVerticesThenTriangles => self.cage.vertices + self.cage.triangles,
+            ColumnLayout::CageVerticesThenTriangles => self.cage.vertices + self.face_columns(),
         };
         if self.columns != expected || self.columns_layout != layout_id(layout) {
             return Err(field(

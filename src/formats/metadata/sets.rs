@@ -141,7 +141,7 @@ pub fn load_any_weights_set(path: &Path) -> Result<LoadedAnyWeights, MetadataErr
     let (rows, vertices, triangles) = (
         metadata.rows,
         metadata.cage.vertices,
-        metadata.cage.triangles,
+        metadata.face_columns(),
     );
     let npz = options.method.spec().columns == ColumnLayout::CageVerticesThenTriangles;
     let expected = ExpectedArray::cage_vertices(rows, vertices);

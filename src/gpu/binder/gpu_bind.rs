@@ -55,7 +55,7 @@ impl<'a> GpuBind<'a> {
             return Err(failure.into());
         }
         let rows = input.points.len();
-        // The cage the family binds: quads as patches, or split (Green, `--triangulate`).
+        // The cage the family binds: quads as patches, or split (`--triangulate`).
         let cage = input.options.cage_to_bind(&input.cage);
         // A weights row: one column per cage vertex, then for Green coordinates
         // one per cage triangle.

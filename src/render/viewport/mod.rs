@@ -25,7 +25,7 @@ use super::weight_attributes::AttributeBlend;
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 
 mod readbacks;
-use crate::coords::{Method, Weights, WeightsId};
+use crate::coords::{Method, QuadSplit, Weights, WeightsId};
 use crate::geometry::Cage;
 use glam::{DVec3, Vec3};
 
@@ -202,6 +202,7 @@ impl ViewportRenderer {
         device: &wgpu::Device,
         id: WeightsId,
         weights: Option<&Weights>,
+        quads: QuadSplit,
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
         let Some(scene) = self.scene.as_mut() else {
@@ -230,7 +231,7 @@ impl ViewportRenderer {
         let attributes = AttributeBlend::new(&device.limits(), weights.cols as u32, chunks.len())
             .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
         // The columns' displacements, then room for the vertex normals.
-        let mut displacements = scene.displacements_of(id.method);
+        let mut displacements = scene.displacements_of(id.method, quads);
         let uniform_displacements = uniform_displacements_buffer(device, &displacements);
         displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
@@ -249,6 +250,7 @@ impl ViewportRenderer {
                 displacements,
                 uniform_displacements,
                 columns: weights.cols as u32,
+                quads,
                 attributes,
                 normals_pose: None,
             }),
@@ -285,7 +287,7 @@ impl ViewportRenderer {
         let scene_pose = scene.origin.points_to_scene(pose, 1.0);
         queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&scene_pose));
         for (&method, slot) in scene.slots.iter().chain(&scene.twin_slots) {
-            let displacements = scene.displacements_of(method);
+            let displacements = scene.displacements_of(method, slot.quads);
             queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
             SceneGpu::write_uniform_displacements(queue, slot, &displacements);
         }
