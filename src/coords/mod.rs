@@ -23,6 +23,7 @@
 //! policies ([`green`]), which keep the deformation continuous across the cage for
 //! their extra triangle columns, so their rows ignore the point's class.
 
+mod bind_options;
 pub mod cubemap;
 pub mod dtype;
 pub mod exact_pmvc;
@@ -41,7 +42,8 @@ pub mod split_effect;
 mod weights_id;
 
 pub use crate::geometry::QuadSplit;
-use crate::geometry::{Cage, PointClass, PointClasses};
+use crate::geometry::{Cage, PointClass};
+pub use bind_options::BindOptions;
 pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
     FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
@@ -66,173 +68,6 @@ pub fn outside_summary(outside: &[u32], total: usize) -> String {
         100.0 * outside.len() as f64 / total.max(1) as f64,
         first.join(", ")
     )
-}
-
-/// What to bind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BindOptions {
-    pub method: Method,
-    /// Cube-map resolution for PMVC; ignored by the others.
-    pub resolution: u32,
-    /// Grid cells along the cage's longest side for harmonic coordinates; ignored
-    /// by the others.
-    pub grid: u32,
-    /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
-    /// split into triangles along a diagonal first (`--triangulate`). Families that
-    /// only take triangles (Green) split along the shorter one when this is `None`.
-    pub quads: QuadSplit,
-}
-
-impl BindOptions {
-    /// The options for `method` with every parameter at its default.
-    pub fn for_method(method: Method) -> Self {
-        Self {
-            method,
-            ..Self::default()
-        }
-    }
-
-    /// The value of `parameter` in these options.
-    pub fn get(&self, parameter: Parameter) -> u32 {
-        match parameter {
-            Parameter::Resolution => self.resolution,
-            Parameter::Grid => self.grid,
-        }
-    }
-
-    pub fn set(&mut self, parameter: Parameter, value: u32) {
-        match parameter {
-            Parameter::Resolution => self.resolution = value,
-            Parameter::Grid => self.grid = value,
-        }
-    }
-
-    /// The one check of the method's parameter ([`ParameterSpec::validate`]),
-    /// for callers of the library as for the command line and the editor.
-    pub fn validate(&self) -> Result<(), ParameterError> {
-        match self.parameter() {
-            Some((spec, value)) => spec.validate(value.into()).map(|_| ()),
-            None => Ok(()),
-        }
-    }
-
-    /// The parameter of this method and its value, if it has one.
-    pub fn parameter(&self) -> Option<(ParameterSpec, u32)> {
-        let spec = self.method.spec().parameter?;
-        Some((spec, self.get(spec.key)))
-    }
-
-    /// Whether weights bound with `self` are the ones `other` asks for: the same
-    /// method and the same values of the parameters that method reads.
-    pub fn same_weights_as(&self, other: &BindOptions) -> bool {
-        let key =
-            |options: &BindOptions| options.parameter().map(|(spec, value)| (spec.key, value));
-        self.method == other.method && key(self) == key(other) && self.quads == other.quads
-    }
-
-    /// The cage the family binds: `cage` itself, or a copy with its quads split
-    /// into triangles when `--triangulate` asks for it or the family takes only
-    /// triangles. Borrowed when nothing is split.
-    pub fn cage_to_bind<'a>(&self, cage: &'a Cage) -> std::borrow::Cow<'a, Cage> {
-        match self.split_applied(cage) {
-            None => std::borrow::Cow::Borrowed(cage),
-            Some(split) => std::borrow::Cow::Owned(cage.split_quads(split)),
-        }
-    }
-
-    /// Where `points` lie for a bind with these options: classified against the
-    /// cage the family binds ([`Self::cage_to_bind`]), not the cage as given.
-    /// Where quads are split, their triangles decide inside and outside (a
-    /// bilinear patch bulges past one of its two triangles), and a point on the
-    /// surface is on the triangle the bind reads. Binds whose
-    /// [`Self::split_applied`] agree share their classes.
-    pub fn classify(&self, cage: &Cage, points: &[DVec3]) -> PointClasses {
-        crate::geometry::classify_points(&self.cage_to_bind(cage), points)
-    }
-
-    /// Weights columns per point of a bind of `cage` with these options: the
-    /// family's [`Method::columns`] of the cage it binds (Green's differ with
-    /// the quads as patches or split).
-    pub fn columns(&self, cage: &Cage) -> usize {
-        self.method.columns(&self.cage_to_bind(cage))
-    }
-
-    /// [`Method::column_displacements`] on the cage these options bind.
-    pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
-        self.method
-            .column_displacements(&self.cage_to_bind(cage), pose)
-    }
-
-    /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
-    pub fn pmvc_exact(&self) -> bool {
-        self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
-    }
-
-    /// How the cage's quads are split for this bind, if they are. Exact PMVC
-    /// integrates triangles only, so quads are split as for Green coordinates.
-    pub fn split_applied(&self, cage: &Cage) -> Option<QuadSplit> {
-        if !cage.has_quads() {
-            return None;
-        }
-        match (self.quads, self.method.spec().quads) {
-            (QuadSplit::None, QuadSupport::Patches { .. }) if self.pmvc_exact() => {
-                Some(QuadSplit::Shorter)
-            }
-            (QuadSplit::None, QuadSupport::Patches { .. }) => None,
-            (QuadSplit::None, QuadSupport::Triangles) => Some(QuadSplit::Shorter),
-            (split, _) => Some(split),
-        }
-    }
-
-    /// The family's name for this cage: QMVC for MVC on bilinear quads, and
-    /// "(shorter split)" or "(longer split)" after a family whose quads were split.
-    pub fn family_name(&self, cage: &Cage) -> String {
-        let spec = self.method.spec();
-        match (self.split_applied(cage), spec.quads) {
-            (None, QuadSupport::Patches { name }) if cage.has_quads() => name.to_owned(),
-            (Some(split), QuadSupport::Patches { .. }) => {
-                format!("{} ({} split)", spec.name, split.id())
-            }
-            _ => spec.name.to_owned(),
-        }
-    }
-
-    /// What a user should know about the cage's quads in this bind, in one line:
-    /// that they were split, and how, for a family that cannot take patches.
-    pub fn quad_notice(&self, cage: &Cage) -> Option<String> {
-        let split = self.split_applied(cage)?;
-        let count = cage.quads().len();
-        let spec = self.method.spec();
-        if self.pmvc_exact() && self.quads == QuadSplit::None {
-            return Some(format!(
-                "notice: exact PMVC integrate triangles: the cage's {count} quads were split along the shorter diagonal (--triangulate longer for the other one)"
-            ));
-        }
-        Some(match spec.quads {
-            QuadSupport::Triangles => format!(
-                "notice: {} are bound on triangles: the cage's {count} quads were split along the {} diagonal ({})",
-                spec.name,
-                if split == QuadSplit::Longer { "longer" } else { "shorter" },
-                spec.quads_reason
-            ),
-            QuadSupport::Patches { .. } => format!(
-                "notice: the cage's {count} quads were split along the {} diagonal, as asked (--triangulate {})",
-                split.id(),
-                split.id()
-            ),
-        })
-    }
-}
-
-impl Default for BindOptions {
-    fn default() -> Self {
-        Self {
-            method: Method::Pmvc,
-            resolution: DEFAULT_RESOLUTION,
-            grid: harmonic::DEFAULT_GRID,
-            quads: QuadSplit::None,
-        }
-    }
 }
 
 /// Dense weights: one row per mesh vertex, one column per cage vertex (then, for
