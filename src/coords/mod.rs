@@ -261,7 +261,7 @@ pub fn bind_cpu_f64(
 ) -> Result<WeightsF64, BindFailure> {
     options.validate()?;
     if options.method == Method::Harmonic {
-        let columns = options.method.columns(cage) as u64;
+        let columns = options.columns(cage) as u64;
         crate::budget::check_memory(
             || {
                 format!(

@@ -7,7 +7,7 @@ use crate::gpu::GpuError;
 /// Rows the CPU computes, in f64 by the policy of [`coords::weights_at`], through
 /// the same row loop as a CPU bind.
 pub(super) fn cpu_rows(input: &BindInput, rows: &[usize]) -> Vec<f32> {
-    let mut out = vec![0.0f32; rows.len() * input.options.method.columns(&input.cage)];
+    let mut out = vec![0.0f32; rows.len() * input.options.columns(&input.cage)];
     // A batch's own progress: the bind advances once per batch.
     let batch_progress = BindProgress::default();
     let finished = coords::bind_rows(

@@ -40,9 +40,10 @@ class Binding:
         self.linear = self.layout == "cage_vertices"
         m = len(self.rest)
         # Green coordinates: φ for the cage vertices, then ψ for the triangles
-        # (docs/python.md, "Green coordinates' columns"); other layouts go
-        # through the package's deform.
-        self.green = self.layout == "cage_vertices_then_triangles" and weights.triangles is not None
+        # (docs/python.md, "Green coordinates' columns"); other layouts, and
+        # QGC's corner normals of quads, go through the package's deform.
+        self.green = (self.layout == "cage_vertices_then_triangles" and weights.triangles is not None
+                      and not weights.metadata.get("quads"))
         if self.green:
             self.triangles = np.asarray(weights.triangles, dtype=np.int64)
             u, w = self._edges(self.rest)
