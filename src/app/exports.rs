@@ -145,7 +145,11 @@ impl Views {
                 }
             })
             .collect();
-        let comments = Self::colour_comments(colouring, pane, limit, scale);
+        let face = match colouring {
+            Colouring::TriangleWeight(k) => document.face_column(pane.method(), k as usize),
+            _ => None,
+        };
+        let comments = Self::colour_comments(colouring, pane, face, limit, scale);
         let positions = document.deformed_positions(pane.method());
         write_coloured_ply(
             path,
@@ -209,14 +213,21 @@ impl Views {
         }
     }
 
-    fn colour_comments(colouring: Colouring, pane: Pane, limit: f32, scale: Scale) -> Vec<String> {
+    fn colour_comments(
+        colouring: Colouring,
+        pane: Pane,
+        face: Option<crate::coords::green::FaceColumn>,
+        limit: f32,
+        scale: Scale,
+    ) -> Vec<String> {
         let what = match (colouring, pane) {
             (Colouring::CageVertexWeight(vertex), _) => {
                 format!("{} coordinate of cage vertex {vertex}", pane.method())
             }
-            (Colouring::TriangleWeight(triangle), _) => {
-                format!("{} psi of cage triangle {triangle}", pane.method())
-            }
+            (Colouring::TriangleWeight(column), _) => match face {
+                Some(face) => format!("{} psi {column}, of cage {face}", pane.method()),
+                None => format!("{} psi {column}", pane.method()),
+            },
             (Colouring::MostNegativeWeight, _) => {
                 format!("{} most negative weight per vertex", pane.method())
             }

@@ -433,3 +433,39 @@ fn on_the_ogre_qgc_reproduce_similarities_and_differ_from_the_split() {
     assert!(worst < 1e-8, "{worst}");
     assert!(apart > 1e-4, "{apart}");
 }
+
+/// The ψ columns name what they multiply: the house's four lone roof
+/// triangles, then four corner normals for each of its five quads; a cage
+/// of triangles has one per triangle. Views and exports label ψ by this.
+#[test]
+fn each_psi_column_names_its_triangle_or_quad_corner() {
+    use pmvc::coords::green::{face_column, FaceColumn};
+    let cage = house();
+    let lone: Vec<usize> = (0..cage.triangle_count())
+        .filter(|&t| {
+            let corners = cage.triangles()[t];
+            !cage
+                .quads()
+                .iter()
+                .any(|q| corners.iter().all(|c| q.corners.contains(c)))
+        })
+        .collect();
+    assert_eq!(lone.len(), 4, "the roof");
+    assert_eq!(face_columns(&cage), 4 + 4 * 5);
+    for (k, &t) in lone.iter().enumerate() {
+        assert_eq!(face_column(&cage, k), Some(FaceColumn::Triangle(t)));
+    }
+    assert_eq!(
+        face_column(&cage, 4 + 4 * 2 + 3),
+        Some(FaceColumn::QuadCorner { quad: 2, corner: 3 })
+    );
+    assert_eq!(
+        face_column(&cage, 4 + 4 * 2 + 3).unwrap().to_string(),
+        "quad 2, corner 3"
+    );
+    assert_eq!(face_column(&cage, face_columns(&cage)), None);
+    let split = cage.split_quads(pmvc::geometry::QuadSplit::Shorter);
+    assert_eq!(split.triangle_count(), 4 + 2 * 5);
+    assert_eq!(face_column(&split, 13), Some(FaceColumn::Triangle(13)));
+    assert_eq!(face_column(&split, split.triangle_count()), None);
+}

@@ -221,6 +221,21 @@ impl Document {
         }
     }
 
+    /// What ψ column `k` of `method`'s weights multiplies, as bound (a
+    /// triangle's normal, or on QGC a quad's corner normal); `None` for a
+    /// family with no ψ, one not bound, or past the last column.
+    pub fn face_column(
+        &self,
+        method: Method,
+        k: usize,
+    ) -> Option<crate::coords::green::FaceColumn> {
+        let set = self.bound(method)?;
+        if set.options.columns(&self.cage) == method.vertex_columns(&self.cage) {
+            return None;
+        }
+        crate::coords::green::face_column(&set.options.cage_to_bind(&self.cage), k)
+    }
+
     /// `method`'s weights, once bound.
     pub fn weights(&self, method: Method) -> Option<&Arc<Weights>> {
         self.bound(method).map(|set| &set.weights)

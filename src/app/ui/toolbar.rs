@@ -79,20 +79,30 @@ pub fn toolbar(ui: &mut egui::Ui, cx: &mut PanelContext) {
 /// Which coordinate function the heatmap shows: a cage vertex's, or (Green
 /// coordinates) a cage triangle's ψ.
 fn heatmap_controls(ui: &mut egui::Ui, cx: &PanelContext, view: &mut ViewSettings) {
-    let triangles = cx.document().cage().triangle_count();
+    let document = cx.document();
+    // Green's ψ columns as bound: a triangle's each, or on QGC the lone
+    // triangles' then four corner normals per quad.
+    let triangles = document.bound(Method::Green).map_or_else(
+        || document.cage().triangle_count(),
+        |set| set.options.columns(document.cage()) - Method::Green.vertex_columns(document.cage()),
+    );
     let mut of_triangle = view.heat_triangle.is_some();
     let label = ui.label("of");
     egui::ComboBox::from_id_salt("heatmap of")
         .selected_text(if of_triangle {
-            "ψj of triangle"
+            "ψj of face"
         } else {
             "λi of vertex"
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut of_triangle, false, "λi of vertex")
                 .on_hover_text("Every family: the coordinate of cage vertex i (φi for Green)");
-            ui.selectable_value(&mut of_triangle, true, "ψj of triangle")
-                .on_hover_text("Green coordinates only: the function of cage triangle j");
+            ui.selectable_value(&mut of_triangle, true, "ψj of face")
+                .on_hover_text(
+                    "Green coordinates only: ψ column j, the function of cage triangle j; \
+                     on quads (QGC) the lone triangles' columns, then four per quad, \
+                     one per corner normal (the colour bar names which)",
+                );
         })
         .response
         .labelled_by(label.id);
@@ -101,7 +111,10 @@ fn heatmap_controls(ui: &mut egui::Ui, cx: &PanelContext, view: &mut ViewSetting
         let label = ui.label("j =");
         ui.add(egui::DragValue::new(&mut triangle).range(0..=triangles.saturating_sub(1)))
             .labelled_by(label.id)
-            .on_hover_text("Cage triangle, in the order the cage's faces are triangulated");
+            .on_hover_text(
+                "ψ column: a cage triangle in the order the faces are triangulated, or (QGC) \
+                 a quad's corner after the lone triangles",
+            );
         view.heat_triangle = Some(triangle);
     } else {
         view.heat_triangle = None;

@@ -60,7 +60,12 @@ impl Views {
             });
         match (self.settings.colouring(kind), kind) {
             (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
-            (Colouring::TriangleWeight(triangle), _) => format!("ψ{triangle} ({method})"),
+            (Colouring::TriangleWeight(triangle), _) => {
+                match document.face_column(kind.method(), triangle as usize) {
+                    Some(face) => format!("ψ{triangle} of {face} ({method})"),
+                    None => format!("ψ{triangle} ({method})"),
+                }
+            }
             (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
             (Colouring::MethodDistance, Pane::Difference { .. }) => {
                 // The pane's title names the methods; the bar says how it scales.

@@ -25,7 +25,7 @@ mod paper;
 use super::{BindProgress, Cancelled, Weights};
 use crate::geometry::{closest_offset_on_triangle, Cage};
 use glam::DVec3;
-pub use qgc::{face_columns, qgc_coordinates, rest_face_vectors, QgcCage};
+pub use qgc::{face_column, face_columns, qgc_coordinates, rest_face_vectors, FaceColumn, QgcCage};
 pub use quad::{corner_normals, corner_scales, Quadtree, QUADTREE};
 use rayon::prelude::*;
 use std::f64::consts::PI;

@@ -59,6 +59,43 @@ enum Face {
     Quad(usize, f64, f64),
 }
 
+/// What one ψ column of Green coordinates multiplies: a triangle's normal, or
+/// (QGC) one corner normal of a quad.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaceColumn {
+    /// Index into [`Cage::triangles`].
+    Triangle(usize),
+    /// Index into [`Cage::quads`], and the corner (0 to 3) in its order.
+    QuadCorner { quad: usize, corner: usize },
+}
+
+impl std::fmt::Display for FaceColumn {
+    /// "triangle 5" or "quad 2, corner 1" (0-based, as the files and views count).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            FaceColumn::Triangle(triangle) => write!(f, "triangle {triangle}"),
+            FaceColumn::QuadCorner { quad, corner } => write!(f, "quad {quad}, corner {corner}"),
+        }
+    }
+}
+
+/// What ψ column `k` (counted from the first after the vertex columns) of
+/// Green coordinates bound on `cage` multiplies; `None` past the last.
+pub fn face_column(cage: &Cage, k: usize) -> Option<FaceColumn> {
+    if !cage.has_quads() {
+        return (k < cage.triangle_count()).then_some(FaceColumn::Triangle(k));
+    }
+    let lone = cage.lone_triangles().count();
+    if k < lone {
+        return cage.lone_triangles().nth(k).map(FaceColumn::Triangle);
+    }
+    let corner = k - lone;
+    (corner < 4 * cage.quads().len()).then_some(FaceColumn::QuadCorner {
+        quad: corner / 4,
+        corner: corner % 4,
+    })
+}
+
 /// ψ columns of `cage` for Green coordinates: one per triangle on a cage of
 /// triangles; one per lone triangle and four per quad on a cage with quads.
 pub fn face_columns(cage: &Cage) -> usize {
