@@ -249,6 +249,29 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
+    /// Keep no more compared families than the side-by-side layout draws
+    /// beside the difference pane (if shown), the first in [`Method::ALL`]
+    /// order; says what was left out, for the caller to report.
+    pub fn fit_compared(&mut self) -> Option<String> {
+        let room = crate::render::MAX_VIEWS - usize::from(self.difference_pane);
+        if self.compared.len() <= room {
+            return None;
+        }
+        let kept: Vec<Method> = self.compared.iter().take(room).collect();
+        let left: Vec<&str> = self.compared.iter().skip(room).map(Method::name).collect();
+        self.compared = MethodSet::of(&kept);
+        Some(format!(
+            "the viewport shows at most {} views{}; left out {}",
+            crate::render::MAX_VIEWS,
+            if self.difference_pane {
+                ", one of them the difference"
+            } else {
+                ""
+            },
+            left.join(", ")
+        ))
+    }
+
     /// The difference pane of [`Self::difference`].
     pub fn difference_pane_kind(&self) -> Pane {
         let [against, shown] = self.difference;
@@ -469,6 +492,28 @@ pub fn vertex_under_pointer(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn no_more_families_are_compared_than_the_viewport_draws() {
+        let mut view = ViewSettings {
+            layout: Layout::SideBySide,
+            compared: MethodSet::of(&Method::ALL),
+            ..Default::default()
+        };
+        let note = view.fit_compared().expect("six do not fit");
+        assert_eq!(view.compared.len(), crate::render::MAX_VIEWS);
+        assert!(
+            note.starts_with("the viewport shows at most 4 views; left out MEC"),
+            "{note}"
+        );
+        view.difference_pane = true;
+        assert!(view
+            .fit_compared()
+            .unwrap()
+            .contains("one of them the difference"));
+        assert_eq!(view.compared.len(), crate::render::MAX_VIEWS - 1);
+        assert_eq!(view.fit_compared(), None, "what fits stays");
+    }
 
     fn matrix(rows: &[&[f32]]) -> Weights {
         Weights {

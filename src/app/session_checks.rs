@@ -181,6 +181,9 @@ pub fn view_in_range(
         ));
         view.heat_triangle = None;
     }
+    if let Some(note) = view.fit_compared() {
+        notes.push(format!("view.compared: {note}"));
+    }
     view
 }
 

@@ -303,3 +303,38 @@ fn the_edit_menu_offers_undo_by_the_models_label_and_sends_it() {
         "the menu changes nothing itself"
     );
 }
+
+#[test]
+fn side_by_side_offers_no_more_families_than_the_viewport_draws() {
+    use egui::accesskit::Role;
+    use egui_kittest::kittest::NodeT;
+    use pmvc::app::compare::{Layout, MethodSet};
+    use pmvc::coords::Method;
+    let mut shown = Shown::default();
+    shown.view.layout = Layout::SideBySide;
+    let four = [Method::Mvc, Method::Pmvc, Method::Harmonic, Method::Green];
+    shown.view.compared = MethodSet::of(&four);
+    let mut harness = panel_harness(pmvc::app::ui::toolbar::toolbar, shown);
+    harness.get_by_label("Compare…").click();
+    harness.run();
+    let mlc = harness.get_by_role_and_label(Role::CheckBox, "MLC");
+    assert!(
+        mlc.accesskit_node().is_disabled(),
+        "a fifth family is not offered"
+    );
+    let green = harness.get_by_role_and_label(Role::CheckBox, "Green");
+    assert!(
+        !green.accesskit_node().is_disabled(),
+        "a shown one can be cleared"
+    );
+    harness.get_by_role_and_label(Role::CheckBox, "MLC").click();
+    harness.run();
+    assert!(
+        harness.state().actions.is_empty(),
+        "{:?}",
+        harness.state().actions
+    );
+    // Nor a difference pane that would push a family out.
+    let difference = harness.get_by_role_and_label(Role::CheckBox, "+ difference");
+    assert!(difference.accesskit_node().is_disabled());
+}

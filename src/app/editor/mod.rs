@@ -236,6 +236,9 @@ impl EditorApp {
             app.load_pose(pose);
         }
         app.report_heatmap_out_of_range(&options.view);
+        if let Some(note) = app.views.settings.fit_compared() {
+            app.error(format!("--compare: {note}"));
+        }
         if let Some(dir) = options
             .recovery_dir
             .as_deref()

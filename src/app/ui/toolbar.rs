@@ -7,6 +7,7 @@ use crate::app::compare::{Layout, Overlay, ViewSettings, DIFFERENCE_LIMITS};
 use crate::app::ctx::PanelContext;
 use crate::coords::{BindOptions, Method, QuadSplit, Twin, WeightsId};
 use crate::render::colormap::Scale;
+use crate::render::MAX_VIEWS;
 
 /// What the first run shows, in one line.
 pub const FIRST_RUN_LINE: &str = "The middle finger's handles are pulled up. \
@@ -128,17 +129,41 @@ fn heatmap_controls(ui: &mut egui::Ui, cx: &PanelContext, view: &mut ViewSetting
 
 /// Which methods the side-by-side layout shows.
 fn comparison_controls(ui: &mut egui::Ui, view: &mut ViewSettings, later: &mut Vec<Action>) {
+    // The viewport draws at most MAX_VIEWS panes: a family past them is not
+    // offered, rather than left out of the picture without a word.
+    let room = MAX_VIEWS - usize::from(view.difference_pane);
+    let full = format!(
+        "The viewport shows at most {MAX_VIEWS} views{}: clear a family first",
+        if view.difference_pane {
+            ", one of them the difference"
+        } else {
+            ""
+        }
+    );
     if Method::ALL.len() > 2 {
         ui.menu_button("Compare…", |ui| {
             for family in Method::ALL {
                 let mut shown = view.compared.contains(family);
-                if ui.checkbox(&mut shown, family.name()).changed() {
+                let offered = shown || view.compared.len() < room;
+                let checkbox = egui::Checkbox::new(&mut shown, family.name());
+                if ui
+                    .add_enabled(offered, checkbox)
+                    .on_disabled_hover_text(&full)
+                    .changed()
+                {
                     view.compared.set(family, shown);
                 }
             }
         });
     }
-    ui.checkbox(&mut view.difference_pane, "+ difference");
+    let difference_fits = view.difference_pane || view.compared.len() < MAX_VIEWS;
+    ui.add_enabled(
+        difference_fits,
+        egui::Checkbox::new(&mut view.difference_pane, "+ difference"),
+    )
+    .on_disabled_hover_text(format!(
+        "The viewport shows at most {MAX_VIEWS} views: clear a family first"
+    ));
     if view.difference_pane {
         difference_scale_controls(ui, view, later);
     }
