@@ -20,4 +20,5 @@ mod mlc;
 mod mlc_smoothing;
 mod origin_offsets;
 mod qgc;
+mod solver_cost;
 mod weights_metadata;

@@ -444,31 +444,10 @@ fn nearing_a_quad_mec_tends_to_an_interpolation_of_its_corners() {
 fn mec_figures() {
     let mut scenes = cages();
     scenes.push(("sphere of 402 vertices", procedural::uv_sphere(1.0, 21, 20)));
-    for (name, cage) in scenes {
-        let points = procedural::points_inside(&cage, 2000, 21, 1e-3);
-        let mut scratch = mec::MecScratch::default();
-        let mut out = vec![0.0; cage.vertex_count()];
-        let (mut most, mut total) = (0, 0);
-        let start = std::time::Instant::now();
-        for &x in &points {
-            let solve =
-                mec::mec_weights_inside(x, &cage, &mut out, &mut scratch).unwrap_or_else(|e| {
-                    panic!(
-                        "{name} {x}: {e}, distance {}",
-                        procedural::distance_to_surface(&cage, x)
-                    )
-                });
-            most = most.max(solve.iterations);
-            total += solve.iterations;
-        }
-        let micros = start.elapsed().as_secs_f64() * 1e6 / points.len() as f64;
-        println!(
-            "{name} ({} vertices, {} faces): {micros:.1} µs a point on one thread, Newton iterations mean {:.1}, most {most}",
-            cage.vertex_count(),
-            cage.polygons().len(),
-            total as f64 / points.len() as f64
-        );
-    }
+    let mut scratch = mec::MecScratch::default();
+    crate::solver_cost::print_solver_cost(scenes, |x, cage, out| {
+        mec::mec_weights_inside(x, cage, out, &mut scratch).map(|solve| solve.iterations)
+    });
     let cube = procedural::cube_cage(1.0);
     let w = row(&cube, DVec3::ZERO);
     let faces = faces(&cube);
