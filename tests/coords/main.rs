@@ -19,6 +19,7 @@ mod mec;
 mod mlc;
 mod mlc_smoothing;
 mod origin_offsets;
+mod pointwise_family;
 mod qgc;
 mod solver_cost;
 mod weights_metadata;

@@ -5,11 +5,10 @@
 //! 1e-10 of the diagonal, invariance under rotation, scaling and a translation
 //! to 1e7, and interpolation on the cage.
 
-use glam::{DMat3, DQuat, DVec3};
-use pmvc::coords::{
-    bind_cpu, mec, weights_at, BindOptions, BindProgress, Method, PmvcIntegration, RowScratch,
-};
-use pmvc::geometry::procedural_quads::{cage_from_polygons, quad_comb, twisted_box};
+use crate::pointwise_family::{self, minimise_by_bfgs, worst_difference};
+use glam::DVec3;
+use pmvc::coords::{bind_cpu, mec, BindOptions, BindProgress, Method};
+use pmvc::geometry::procedural_quads::{quad_comb, twisted_box};
 use pmvc::geometry::{classify_points, procedural, quads, Cage, PointClass};
 
 fn cages() -> Vec<(&'static str, Cage)> {
@@ -30,17 +29,7 @@ fn cages() -> Vec<(&'static str, Cage)> {
 
 /// MEC of an inside point through the one-row entry every bind uses, in f64.
 fn row(cage: &Cage, x: DVec3) -> Vec<f64> {
-    let mut out = vec![f64::NAN; cage.vertex_count()];
-    weights_at(
-        x,
-        PointClass::Inside,
-        cage,
-        Method::Mec,
-        &PmvcIntegration::of(BindOptions::for_method(Method::Mec)),
-        &mut out,
-        &mut RowScratch::default(),
-    );
-    out
+    pointwise_family::row(Method::Mec, cage, x)
 }
 
 /// The faces as drawn: lone triangles and quads.
@@ -109,58 +98,19 @@ fn log_z(prior: &[f64], offsets: &[DVec3], mu: DVec3) -> (f64, DVec3, Vec<f64>) 
     (z.ln() + shift, gradient, w)
 }
 
-/// BFGS on `log Z` from `μ = 0` with a backtracking line search, to a gradient
-/// of 1e-13 cage diagonals; the weights at the end.
+/// BFGS on `log Z` from `μ = 0`, to a gradient of 1e-13 cage diagonals; the
+/// weights at the minimiser.
 fn reference_mec(cage: &Cage, x: DVec3) -> Vec<f64> {
     let prior = reference_prior(cage, x);
     let offsets: Vec<DVec3> = cage.positions().iter().map(|&v| v - x).collect();
+    let log_z_and_gradient = |mu| {
+        let (value, gradient, _) = log_z(&prior, &offsets, mu);
+        (value, gradient)
+    };
     let tolerance = 1e-13 * cage.diagonal();
-    let mut mu = DVec3::ZERO;
-    let (mut f, mut g, mut w) = log_z(&prior, &offsets, mu);
-    let mut inverse = DMat3::IDENTITY * (1.0 / cage.diagonal().powi(2));
-    for _ in 0..2000 {
-        if g.length() <= tolerance {
-            return w;
-        }
-        let direction = -(inverse * g);
-        let mut t = 1.0;
-        let (next_mu, next_f, next_g, next_w) = loop {
-            let trial = mu + t * direction;
-            let (tf, tg, tw) = log_z(&prior, &offsets, trial);
-            // Past the rounding of log Z, a smaller gradient decides.
-            if tf <= f + 1e-4 * t * g.dot(direction)
-                || (tf <= f + 1e-14 * f.abs().max(1.0) && tg.length() < g.length())
-            {
-                break (trial, tf, tg, tw);
-            }
-            t *= 0.5;
-            assert!(t > 1e-30, "reference line search failed at {x}");
-        };
-        let s = next_mu - mu;
-        let y = next_g - g;
-        let sy = s.dot(y);
-        if sy > 0.0 {
-            let rho = 1.0 / sy;
-            let left = DMat3::IDENTITY - rho * outer(s, y);
-            inverse = left * inverse * left.transpose() + rho * outer(s, s);
-        }
-        (mu, f, g, w) = (next_mu, next_f, next_g, next_w);
-    }
-    panic!(
-        "reference BFGS did not converge at {x}: gradient {}",
-        g.length()
-    );
-}
-
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| (p - q).abs())
-        .fold(0.0, f64::max)
+    let scale = 1.0 / cage.diagonal().powi(2);
+    let mu = minimise_by_bfgs(log_z_and_gradient, DVec3::ZERO, scale, tolerance);
+    log_z(&prior, &offsets, mu).2
 }
 
 #[test]
@@ -200,86 +150,16 @@ fn mec_agrees_with_an_independent_quasi_newton_solver() {
 
 #[test]
 fn mec_is_positive_sums_to_one_and_reproduces_the_point() {
-    for (name, cage) in cages() {
-        let points = procedural::points_inside(&cage, 300, 9, 1e-4);
-        let (mut sum_error, mut position_error, mut min) = (0.0f64, 0.0f64, f64::INFINITY);
-        for &x in &points {
-            let w = row(&cage, x);
-            sum_error = sum_error.max((w.iter().sum::<f64>() - 1.0).abs());
-            let moved: DVec3 = w
-                .iter()
-                .zip(cage.positions())
-                .map(|(w, &v)| *w * (v - x))
-                .sum();
-            position_error = position_error.max(moved.length() / cage.diagonal());
-            min = min.min(w.iter().copied().fold(f64::INFINITY, f64::min));
-        }
-        println!(
-            "{name}: |Σw − 1| {sum_error:e}, linear precision {position_error:e}, min {min:e}"
-        );
-        assert!(
-            sum_error <= 1e-12,
-            "{name}: partition of unity off by {sum_error}"
-        );
-        assert!(
-            position_error <= 1e-10,
-            "{name}: linear precision {position_error}"
-        );
-        assert!(min > 0.0, "{name}: weight {min}");
-    }
+    pointwise_family::check_positive_sums_to_one_and_reproduces_the_point(Method::Mec, cages());
 }
 
-/// A map of the scene, its name, and how far the weights may move under it.
-type SceneMap = (&'static str, Box<dyn Fn(DVec3) -> DVec3>, f64);
-
-/// The same answers after a rotation, a scaling (areas enter the prior in
-/// units of the cage's area) and a translation to 1e7 from the origin.
+/// Areas enter the prior in units of the cage's area, so scaling changes nothing.
 #[test]
 fn mec_is_invariant_under_rotation_scaling_and_a_far_translation() {
-    let turn = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 0.9);
-    let maps: [SceneMap; 3] = [
-        ("rotated", Box::new(move |p| turn * p), 1e-9),
-        ("scaled by 1000", Box::new(|p| 1000.0 * p), 1e-9),
-        // Positions at 1e7 are rounded to 2e-9: the geometry itself moves that much.
-        ("moved to 1e7", Box::new(|p| p + DVec3::splat(1e7)), 1e-7),
-    ];
-    for (name, cage) in cages() {
-        let points = procedural::points_inside(&cage, 30, 13, 1e-2);
-        for (map_name, map, tolerance) in &maps {
-            let moved = cage_mapped(&cage, map);
-            let mut worst = 0.0f64;
-            let mut precision = 0.0f64;
-            for &x in &points {
-                let (w, y) = (row(&cage, x), map(x));
-                let v = row(&moved, y);
-                worst = worst.max(worst_difference(&w, &v));
-                let offset: DVec3 = v
-                    .iter()
-                    .zip(moved.positions())
-                    .map(|(w, &p)| *w * (p - y))
-                    .sum();
-                precision = precision.max(offset.length() / moved.diagonal());
-            }
-            println!(
-                "{name} {map_name}: weights differ by {worst:e}, linear precision {precision:e}"
-            );
-            assert!(worst <= *tolerance, "{name} {map_name}: {worst}");
-            assert!(
-                precision <= 1e-10,
-                "{name} {map_name}: linear precision {precision}"
-            );
-        }
-    }
-}
-
-/// `cage` with every vertex mapped, its faces triangulated again (a quad's
-/// diagonal is chosen from its positions).
-fn cage_mapped(cage: &Cage, map: &dyn Fn(DVec3) -> DVec3) -> Cage {
-    let positions: Vec<DVec3> = cage.positions().iter().map(|&p| map(p)).collect();
-    let (mapped, _) =
-        cage_from_polygons(&positions, &cage.polygons()).expect("a moved cage is valid");
-    assert_eq!(mapped.quads().len(), cage.quads().len());
-    mapped
+    pointwise_family::check_invariance_under_rotation_scaling_and_a_far_translation(
+        Method::Mec,
+        cages(),
+    );
 }
 
 /// Through the bind every front end uses: on a vertex its own weight is one,
@@ -339,28 +219,9 @@ fn mec_interpolates_on_the_cage() {
     }
 }
 
-/// Where MVC go negative in the comb, MEC stay positive, through the f32 bind.
 #[test]
 fn mec_stays_positive_where_mvc_go_negative() {
-    let cage = procedural::extrude(&procedural::comb_outline(5, 1.0, 0.25, 4.0), -0.5, 0.5);
-    let points: Vec<DVec3> = (1..20)
-        .map(|k| DVec3::new(1.75, 1.0 + 0.2 * f64::from(k), 0.0))
-        .collect();
-    let classes = classify_points(&cage, &points);
-    let bind = |method| {
-        bind_cpu(
-            &points,
-            &classes.classes,
-            &cage,
-            BindOptions::for_method(method),
-            &BindProgress::default(),
-        )
-        .unwrap()
-    };
-    let (mvc, mec) = (bind(Method::Mvc), bind(Method::Mec));
-    println!("comb: MVC min {}, MEC min {}", mvc.min(), mec.min());
-    assert!(mvc.min() < -0.01);
-    assert!(mec.min() >= 0.0);
+    pointwise_family::check_positive_where_mvc_go_negative(Method::Mec);
 }
 
 /// A point outside every hull has no MEC: the solver says so, and the bind
@@ -371,17 +232,7 @@ fn outside_the_cage_mec_rows_are_mvc_rows() {
     let x = DVec3::new(1.5, 0.2, -0.1);
     let mut out = vec![0.0; cage.vertex_count()];
     assert!(mec::mec_weights_inside(x, &cage, &mut out, &mut Default::default()).is_err());
-    let classes = classify_points(&cage, &[x]);
-    let bind = |method| {
-        bind_cpu(
-            &[x],
-            &classes.classes,
-            &cage,
-            BindOptions::for_method(method),
-            &BindProgress::default(),
-        )
-        .unwrap()
-    };
+    let bind = |method| pointwise_family::bind(&cage, &[x], method);
     assert_eq!(bind(Method::Mec), bind(Method::Mvc));
 }
 

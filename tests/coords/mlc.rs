@@ -7,11 +7,12 @@
 //! translation to 1e7, and what they do on the cage: interpolation at the
 //! vertices and on faces of the hull, not on faces inside it.
 
-use glam::{DMat3, DQuat, DVec3};
-use pmvc::coords::{
-    bind_cpu, mlc, weights_at, BindOptions, BindProgress, Method, PmvcIntegration, RowScratch,
+use crate::pointwise_family::{
+    self, cage_mapped, linear_precision, minimise_by_bfgs, worst_difference,
 };
-use pmvc::geometry::procedural_quads::{cage_from_polygons, quad_comb, twisted_box};
+use glam::DVec3;
+use pmvc::coords::{mlc, weights_at, BindOptions, Method, PmvcIntegration, RowScratch};
+use pmvc::geometry::procedural_quads::{quad_comb, twisted_box};
 use pmvc::geometry::{classify_points, procedural, quads, Cage, PointClass};
 
 fn cages() -> Vec<(&'static str, Cage)> {
@@ -33,17 +34,7 @@ fn cages() -> Vec<(&'static str, Cage)> {
 
 /// MLC of an inside point through the one-row entry every bind uses, in f64.
 fn row(cage: &Cage, x: DVec3) -> Vec<f64> {
-    let mut out = vec![f64::NAN; cage.vertex_count()];
-    weights_at(
-        x,
-        PointClass::Inside,
-        cage,
-        Method::Mlc,
-        &PmvcIntegration::of(BindOptions::for_method(Method::Mlc)),
-        &mut out,
-        &mut RowScratch::default(),
-    );
-    out
+    pointwise_family::row(Method::Mlc, cage, x)
 }
 
 /// The solver itself: its weights, or why it has none.
@@ -51,16 +42,6 @@ fn solve(cage: &Cage, x: DVec3) -> Result<(Vec<f64>, mlc::MlcSolve), mlc::MlcErr
     let mut out = vec![f64::NAN; cage.vertex_count()];
     let solve = mlc::mlc_weights_inside(x, cage, &mut out, &mut Default::default())?;
     Ok((out, solve))
-}
-
-/// `|Σ wᵢ (vᵢ − x)|` in cage diagonals, measured here from the weights.
-fn linear_precision(cage: &Cage, x: DVec3, w: &[f64]) -> f64 {
-    let moved: DVec3 = w
-        .iter()
-        .zip(cage.positions())
-        .map(|(w, &v)| *w * (v - x))
-        .sum();
-    moved.length() / cage.diagonal()
 }
 
 /// Owen's dual `−Σ log(1 + λ·uᵢ)` and its gradient; infinite outside its domain.
@@ -78,65 +59,23 @@ fn owen_dual(directions: &[DVec3], lambda: DVec3) -> (f64, DVec3) {
     (value, gradient)
 }
 
-/// BFGS on Owen's dual from `λ = 0`, with a backtracking line search that
-/// stays in the domain, to a gradient of 1e-14 per vertex; then the weights of
-/// the definition, `pᵢ / |vᵢ − x|` normalised, `pᵢ = 1 / (n (1 + λ·uᵢ))`.
+/// BFGS on Owen's dual from `λ = 0` (its line search stays in the domain,
+/// where the dual is finite), to a gradient of 1e-14 per vertex; then the
+/// weights of the definition, `pᵢ / |vᵢ − x|` normalised, `pᵢ = 1 / (n (1 + λ·uᵢ))`.
 fn reference_mlc(cage: &Cage, x: DVec3) -> Vec<f64> {
     let offsets: Vec<DVec3> = cage.positions().iter().map(|&v| v - x).collect();
     let directions: Vec<DVec3> = offsets.iter().map(|d| d.normalize()).collect();
     let tolerance = 1e-14 * directions.len() as f64;
-    let mut lambda = DVec3::ZERO;
-    let (mut f, mut g) = owen_dual(&directions, lambda);
-    let mut inverse = DMat3::IDENTITY;
-    for _ in 0..5000 {
-        if g.length() <= tolerance {
-            let n = directions.len() as f64;
-            let q: Vec<f64> = offsets
-                .iter()
-                .zip(&directions)
-                .map(|(d, u)| 1.0 / (n * (1.0 + lambda.dot(*u))) / d.length())
-                .collect();
-            let total: f64 = q.iter().sum();
-            return q.iter().map(|q| q / total).collect();
-        }
-        let direction = -(inverse * g);
-        let mut t = 1.0;
-        let (next_lambda, next_f, next_g) = loop {
-            let trial = lambda + t * direction;
-            let (tf, tg) = owen_dual(&directions, trial);
-            if tf <= f + 1e-4 * t * g.dot(direction)
-                || (tf <= f + 1e-14 * f.abs().max(1.0) && tg.length() < g.length())
-            {
-                break (trial, tf, tg);
-            }
-            t *= 0.5;
-            assert!(t > 1e-30, "reference line search failed at {x}");
-        };
-        let s = next_lambda - lambda;
-        let y = next_g - g;
-        let sy = s.dot(y);
-        if sy > 0.0 {
-            let rho = 1.0 / sy;
-            let left = DMat3::IDENTITY - rho * outer(s, y);
-            inverse = left * inverse * left.transpose() + rho * outer(s, s);
-        }
-        (lambda, f, g) = (next_lambda, next_f, next_g);
-    }
-    panic!(
-        "reference BFGS did not converge at {x}: gradient {}",
-        g.length()
-    );
-}
-
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| (p - q).abs())
-        .fold(0.0, f64::max)
+    let dual = |lambda| owen_dual(&directions, lambda);
+    let lambda = minimise_by_bfgs(dual, DVec3::ZERO, 1.0, tolerance);
+    let n = directions.len() as f64;
+    let q: Vec<f64> = offsets
+        .iter()
+        .zip(&directions)
+        .map(|(d, u)| 1.0 / (n * (1.0 + lambda.dot(*u))) / d.length())
+        .collect();
+    let total: f64 = q.iter().sum();
+    q.iter().map(|q| q / total).collect()
 }
 
 #[test]
@@ -157,77 +96,15 @@ fn mlc_agrees_with_an_independent_quasi_newton_solver() {
 
 #[test]
 fn mlc_is_positive_sums_to_one_and_reproduces_the_point() {
-    for (name, cage) in cages() {
-        let points = procedural::points_inside(&cage, 300, 9, 1e-4);
-        let (mut sum_error, mut position_error, mut min) = (0.0f64, 0.0f64, f64::INFINITY);
-        for &x in &points {
-            let w = row(&cage, x);
-            sum_error = sum_error.max((w.iter().sum::<f64>() - 1.0).abs());
-            position_error = position_error.max(linear_precision(&cage, x, &w));
-            min = min.min(w.iter().copied().fold(f64::INFINITY, f64::min));
-        }
-        println!(
-            "{name}: |Σw − 1| {sum_error:e}, linear precision {position_error:e}, min {min:e}"
-        );
-        assert!(
-            sum_error <= 1e-12,
-            "{name}: partition of unity off by {sum_error}"
-        );
-        assert!(
-            position_error <= 1e-10,
-            "{name}: linear precision {position_error}"
-        );
-        assert!(min > 0.0, "{name}: weight {min}");
-    }
+    pointwise_family::check_positive_sums_to_one_and_reproduces_the_point(Method::Mlc, cages());
 }
 
-/// A map of the scene, its name, and how far the weights may move under it.
-type SceneMap = (&'static str, Box<dyn Fn(DVec3) -> DVec3>, f64);
-
-/// The same answers after a rotation, a scaling and a translation to 1e7.
 #[test]
 fn mlc_is_invariant_under_rotation_scaling_and_a_far_translation() {
-    let turn = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 0.9);
-    let maps: [SceneMap; 3] = [
-        ("rotated", Box::new(move |p| turn * p), 1e-9),
-        ("scaled by 1000", Box::new(|p| 1000.0 * p), 1e-9),
-        // Positions at 1e7 are rounded to 2e-9: the geometry itself moves that much.
-        ("moved to 1e7", Box::new(|p| p + DVec3::splat(1e7)), 1e-7),
-    ];
-    for (name, cage) in cages() {
-        let points = procedural::points_inside(&cage, 30, 13, 1e-2);
-        for (map_name, map, tolerance) in &maps {
-            let moved = cage_mapped(&cage, map);
-            let mut worst = 0.0f64;
-            let mut precision = 0.0f64;
-            let mut min = f64::INFINITY;
-            for &x in &points {
-                let (w, y) = (row(&cage, x), map(x));
-                let v = row(&moved, y);
-                worst = worst.max(worst_difference(&w, &v));
-                precision = precision.max(linear_precision(&moved, y, &v));
-                min = min.min(v.iter().copied().fold(f64::INFINITY, f64::min));
-            }
-            println!(
-                "{name} {map_name}: weights differ by {worst:e}, linear precision {precision:e}"
-            );
-            assert!(worst <= *tolerance, "{name} {map_name}: {worst}");
-            assert!(
-                precision <= 1e-10,
-                "{name} {map_name}: linear precision {precision}"
-            );
-            assert!(min > 0.0, "{name} {map_name}: weight {min}");
-        }
-    }
-}
-
-/// `cage` with every vertex mapped, its faces triangulated again.
-fn cage_mapped(cage: &Cage, map: &dyn Fn(DVec3) -> DVec3) -> Cage {
-    let positions: Vec<DVec3> = cage.positions().iter().map(|&p| map(p)).collect();
-    let (mapped, _) =
-        cage_from_polygons(&positions, &cage.polygons()).expect("a moved cage is valid");
-    assert_eq!(mapped.quads().len(), cage.quads().len());
-    mapped
+    pointwise_family::check_invariance_under_rotation_scaling_and_a_far_translation(
+        Method::Mlc,
+        cages(),
+    );
 }
 
 /// The paper's smoothed form often has no maximiser near the cage
@@ -417,28 +294,9 @@ fn mlc_interpolate_on_hull_faces_and_not_on_faces_inside_the_hull() {
     }
 }
 
-/// Where MVC go negative in the comb, MLC stay positive, through the f32 bind.
 #[test]
 fn mlc_stays_positive_where_mvc_go_negative() {
-    let cage = procedural::extrude(&procedural::comb_outline(5, 1.0, 0.25, 4.0), -0.5, 0.5);
-    let points: Vec<DVec3> = (1..20)
-        .map(|k| DVec3::new(1.75, 1.0 + 0.2 * f64::from(k), 0.0))
-        .collect();
-    let classes = classify_points(&cage, &points);
-    let bind = |method| {
-        bind_cpu(
-            &points,
-            &classes.classes,
-            &cage,
-            BindOptions::for_method(method),
-            &BindProgress::default(),
-        )
-        .unwrap()
-    };
-    let (mvc, mlc) = (bind(Method::Mvc), bind(Method::Mlc));
-    println!("comb: MVC min {}, MLC min {}", mvc.min(), mlc.min());
-    assert!(mvc.min() < -0.01);
-    assert!(mlc.min() >= 0.0);
+    pointwise_family::check_positive_where_mvc_go_negative(Method::Mlc);
 }
 
 /// A point outside every hull has no MLC: the solver says so, and the bind
@@ -451,17 +309,7 @@ fn outside_and_on_the_cage_mlc_rows_follow_the_policies() {
     assert!(solve(&cage, x).is_err());
     let [a, b, c] = cage.triangle(3);
     let points = [x, (a + b + c) / 3.0, cage.positions()[2]];
-    let classes = classify_points(&cage, &points);
-    let bind = |method| {
-        bind_cpu(
-            &points,
-            &classes.classes,
-            &cage,
-            BindOptions::for_method(method),
-            &BindProgress::default(),
-        )
-        .unwrap()
-    };
+    let bind = |method| pointwise_family::bind(&cage, &points, method);
     assert_eq!(bind(Method::Mlc), bind(Method::Mvc));
     let weights = bind(Method::Mlc);
     assert!((f64::from(weights.row(2)[2]) - 1.0).abs() < 1e-6);

@@ -7,6 +7,7 @@
 //! the smoothed directions and its probabilities are mapped back. pmvc's MLC
 //! leave the step out; nothing here is part of the product.
 
+use crate::pointwise_family::linear_precision;
 use glam::{DMat3, DVec3};
 use pmvc::geometry::{classify_points, procedural, Cage, PointClass};
 
@@ -61,16 +62,6 @@ fn mapped_back(combination: &Combination, r: &[f64], p: &[f64]) -> Vec<f64> {
     }
     let total: f64 = q.iter().zip(r).map(|(q, r)| q / r).sum();
     q.iter().zip(r).map(|(q, r)| q / r / total).collect()
-}
-
-/// `|Σ wᵢ (vᵢ − x)|` in cage diagonals.
-fn linear_precision(cage: &Cage, x: DVec3, w: &[f64]) -> f64 {
-    let moved: DVec3 = w
-        .iter()
-        .zip(cage.positions())
-        .map(|(w, &v)| *w * (v - x))
-        .sum();
-    moved.length() / cage.diagonal()
 }
 
 /// How the likelihood step on the smoothed directions ended.
