@@ -157,6 +157,8 @@ pub fn open_pair(
         SceneChange::new(Replacement::framed(document, action)).remembered(RecentEntry::Scene {
             mesh: mesh_path.to_owned(),
             cage: cage_path.to_owned(),
+            mesh_object: objects.mesh.map(Into::into),
+            cage_object: objects.cage.map(Into::into),
         });
     notes.extend(report.messages());
     change.notes = notes;
@@ -197,7 +199,7 @@ pub fn open_file(
         FileRole::Mesh => {
             let mut file = load_mesh_object(path, object).map_err(|error| error.to_string())?;
             if !cage_reaches(current.cage(), &file.mesh) {
-                return mesh_in_box(path, file);
+                return mesh_in_box(path, file, object);
             }
             let notes = object_note(path, file.object_note.take());
             let document = Document::new(
@@ -221,10 +223,11 @@ pub fn open_file(
             (document, notes)
         }
     };
-    let (role_name, entry) = match role {
-        FileRole::Mesh => ("mesh", RecentEntry::Mesh(path.to_owned())),
-        FileRole::Cage => ("cage", RecentEntry::Cage(path.to_owned())),
+    let role_name = match role {
+        FileRole::Mesh => "mesh",
+        FileRole::Cage => "cage",
     };
+    let entry = recent_file(role, path, object);
     let action = format!("open {role_name} {}", file_title(path));
     let mut change = SceneChange::new(Replacement::framed(document, action))
         .remembered(entry)
@@ -233,17 +236,33 @@ pub fn open_file(
     Ok(change)
 }
 
+/// File > Recent's entry for object `object` of `path` (the file's default
+/// where `None`) read as the mesh or the cage.
+fn recent_file(role: FileRole, path: &Path, object: Option<&str>) -> RecentEntry {
+    let path = path.to_owned();
+    match (role, object.map(String::from)) {
+        (FileRole::Mesh, None) => RecentEntry::Mesh(path),
+        (FileRole::Cage, None) => RecentEntry::Cage(path),
+        (FileRole::Mesh, Some(object)) => RecentEntry::MeshObject { path, object },
+        (FileRole::Cage, Some(object)) => RecentEntry::CageObject { path, object },
+    }
+}
+
 /// A mesh with no cage (`pmvc edit MESH`).
 pub fn open_mesh_alone(path: &Path, object: Option<&str>) -> Result<SceneChange, String> {
     let file = load_mesh_object(path, object).map_err(|error| error.to_string())?;
-    let mut change = mesh_in_box(path, file)?;
+    let mut change = mesh_in_box(path, file, object)?;
     change.recent = None;
     Ok(change)
 }
 
-/// `file`, read from `path`, in a loose box cage, with the Generate cage
-/// window offering a real one.
-fn mesh_in_box(path: &Path, mut file: MeshFile) -> Result<SceneChange, String> {
+/// `file`, read from `path` (its object `object` where one was named), in a
+/// loose box cage, with the Generate cage window offering a real one.
+fn mesh_in_box(
+    path: &Path,
+    mut file: MeshFile,
+    object: Option<&str>,
+) -> Result<SceneChange, String> {
     let notes = object_note(path, file.object_note.take());
     let cage = loose_box_cage(&file.mesh).ok_or_else(|| {
         format!(
@@ -255,7 +274,7 @@ fn mesh_in_box(path: &Path, mut file: MeshFile) -> Result<SceneChange, String> {
     let document =
         Document::new(title.clone(), file.mesh.clone(), cage).with_files(Some(file), None);
     let mut change = SceneChange::new(Replacement::framed(document, format!("open {title}")))
-        .remembered(RecentEntry::Mesh(path.to_owned()))
+        .remembered(recent_file(FileRole::Mesh, path, object))
         .done(format!(
             "opened {} in a box cage; generate a cage for it (File > Generate cage…)",
             shown_path(path)

@@ -132,17 +132,7 @@ fn deformed_cage_with_another_vertex_count() {
     let cage = write(dir.path(), "cage.obj", TETRA);
     let pose = write(dir.path(), "pose.obj", &format!("{TETRA}v 2 2 2\n"));
     let out = dir.path().join("out.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&pose),
-        "--out",
-        path_str(&out),
-    ]);
+    let output = deform_with(&mesh, &cage, &pose, &out, &[]);
     assert_clean_failure(&output, path_str(&pose), "has 5 vertices, but the cage");
     assert!(!out.exists());
 }
@@ -271,19 +261,7 @@ fn deform_with_weights(name: &str, bytes: &[u8]) -> (std::process::Output, Strin
     let weights = dir.path().join(name);
     std::fs::write(&weights, bytes).unwrap();
     let out = dir.path().join("out.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&pose),
-        "--weights",
-        path_str(&weights),
-        "--out",
-        path_str(&out),
-    ]);
+    let output = common::deform_with_weights(&mesh, &cage, &pose, &weights, &out);
     (output, weights.display().to_string(), out.exists())
 }
 

@@ -120,17 +120,7 @@ fn deform_keeps_faces_texture_coordinates_and_groups_and_recomputes_normals() {
         .collect();
     let pose = write(dir.path(), "pose.obj", &pose_text);
     let out = dir.path().join("out.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&pose),
-        "--out",
-        path_str(&out),
-    ]);
+    let output = deform_with(&mesh, &cage, &pose, &out, &[]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = std::fs::read_to_string(&out).unwrap();
     for kept in [
@@ -559,17 +549,7 @@ fn deform_writes_normals_that_follow_the_deformation() {
         &common::triangles_obj(&sheared, cube.triangles()),
     );
     let out = dir.path().join("out.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&pose),
-        "--out",
-        path_str(&out),
-    ]);
+    let output = deform_with(&mesh, &cage, &pose, &out, &[]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = std::fs::read_to_string(&out).unwrap();
     let expected = glam::DVec3::new(-1.0, 0.0, 1.0).normalize();

@@ -116,21 +116,8 @@ fn deform_applies_stored_or_fresh_green_coordinates_and_keeps_similarities() {
     assert!(pmvc(&bind_args(&mesh, &cage_path, &weights))
         .status
         .success());
-    let deform = |out: &Path, extra: &[&str]| {
-        let mut args = vec![
-            "deform",
-            "--mesh",
-            path_str(&mesh),
-            "--cage",
-            path_str(&cage_path),
-            "--deformed-cage",
-            path_str(&pose_path),
-            "--out",
-            path_str(out),
-        ];
-        args.extend_from_slice(extra);
-        pmvc(&args)
-    };
+    let deform =
+        |out: &Path, extra: &[&str]| deform_with(&mesh, &cage_path, &pose_path, out, extra);
     let (stored, fresh) = (dir.path().join("a.obj"), dir.path().join("b.obj"));
     let output = deform(&stored, &["--weights", path_str(&weights)]);
     assert!(output.status.success(), "{}", stderr(&output));

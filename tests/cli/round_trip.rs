@@ -22,19 +22,7 @@ fn a_deformed_obj_in_another_folder_names_its_material_library_by_a_path_that_re
     let mesh = write(&models, "tile.obj", TILE);
     write(&models, "tile.mtl", "newmtl stone\nmap_Kd stone.png\n");
     let out = out_dir.join("posed.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&cage),
-        "--backend",
-        "cpu",
-        "--out",
-        path_str(&out),
-    ]);
+    let output = deform_with(&mesh, &cage, &cage, &out, &["--backend", "cpu"]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = std::fs::read_to_string(&out).unwrap();
     let line = text.lines().find(|l| l.starts_with("mtllib")).unwrap();
@@ -52,19 +40,7 @@ fn a_deformed_obj_in_another_folder_names_its_material_library_by_a_path_that_re
 
     // Beside the source, the name stays as written and nothing is said.
     let beside = models.join("posed.obj");
-    let output = pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(&mesh),
-        "--cage",
-        path_str(&cage),
-        "--deformed-cage",
-        path_str(&cage),
-        "--backend",
-        "cpu",
-        "--out",
-        path_str(&beside),
-    ]);
+    let output = deform_with(&mesh, &cage, &cage, &beside, &["--backend", "cpu"]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = std::fs::read_to_string(&beside).unwrap();
     assert!(text.lines().any(|l| l == "mtllib tile.mtl"), "{text}");

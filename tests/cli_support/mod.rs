@@ -105,6 +105,7 @@ pub fn bind(
     bind_on_cpu(mesh, cage, out, &args)
 }
 
+/// `pmvc deform` on the CPU, then `extra`.
 pub fn deform(
     mesh: &Path,
     cage: &Path,
@@ -112,21 +113,9 @@ pub fn deform(
     out: &Path,
     extra: &[&str],
 ) -> std::process::Output {
-    let mut args = vec![
-        "deform",
-        "--mesh",
-        path_str(mesh),
-        "--cage",
-        path_str(cage),
-        "--deformed-cage",
-        path_str(pose),
-        "--backend",
-        "cpu",
-        "--out",
-        path_str(out),
-    ];
+    let mut args = vec!["--backend", "cpu"];
     args.extend_from_slice(extra);
-    pmvc(&args)
+    deform_with(mesh, cage, pose, out, &args)
 }
 
 /// The comb of `comb_scene` with its second tooth's tip moved `shift` along x.

@@ -96,6 +96,24 @@ pub fn bind_with(mesh: &Path, cage: &Path, out: &Path, extra: &[&str]) -> Output
     pmvc(&args)
 }
 
+/// `pmvc deform --mesh mesh --cage cage --deformed-cage pose`, then `extra`,
+/// then `--out out`.
+#[cfg(feature = "editor")]
+pub fn deform_with(mesh: &Path, cage: &Path, pose: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "deform",
+        "--mesh",
+        path_str(mesh),
+        "--cage",
+        path_str(cage),
+        "--deformed-cage",
+        path_str(pose),
+    ];
+    args.extend(extra);
+    args.extend(["--out", path_str(out)]);
+    pmvc(&args)
+}
+
 /// `pmvc deform` of `mesh` in `cage` to `pose` with stored `weights`, into `out`.
 #[cfg(feature = "editor")]
 pub fn deform_with_weights(
@@ -105,19 +123,7 @@ pub fn deform_with_weights(
     weights: &Path,
     out: &Path,
 ) -> Output {
-    pmvc(&[
-        "deform",
-        "--mesh",
-        path_str(mesh),
-        "--cage",
-        path_str(cage),
-        "--deformed-cage",
-        path_str(pose),
-        "--weights",
-        path_str(weights),
-        "--out",
-        path_str(out),
-    ])
+    deform_with(mesh, cage, pose, out, &["--weights", path_str(weights)])
 }
 
 pub fn path_str(path: &Path) -> &str {

@@ -1,6 +1,7 @@
 //! Files of several objects (an OBJ's `o` objects, as Blender exports a
 //! scene): a notice names them, `pmvc edit --mesh-object` picks one, the side
-//! panel offers the others, and a session remembers which was read.
+//! panel offers the others, and a session and File > Recent remember which
+//! was read.
 
 use crate::common;
 
@@ -8,6 +9,7 @@ use common::editor::*;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use glam::DVec3;
+use pmvc::app::recent::RecentEntry;
 use pmvc::app::{EditorApp, EditorOptions};
 
 /// A quad box cage and two triangles, as one OBJ of three objects.
@@ -119,6 +121,24 @@ fn objects_are_chosen_by_name_in_the_side_panel_undone_and_kept_by_sessions() {
     harness.run_steps(2);
     assert_eq!(first_vertex(&harness), DVec3::new(0.6, 0.6, 0.6));
     harness.state_mut().redo();
+    harness.run_steps(2);
+    assert_eq!(first_vertex(&harness), DVec3::new(0.2, 0.2, 0.2));
+
+    // File > Recent names the objects read and reads them again by name.
+    let recent = harness.state().recent_files().entries().to_vec();
+    let labels: Vec<String> = recent.iter().map(RecentEntry::label).collect();
+    assert_eq!(
+        labels[..2],
+        [
+            "mesh scene.obj (First)",
+            "scene.obj (Second) in scene.obj (Cage)"
+        ]
+    );
+    assert!(harness.state_mut().open_recent(&recent[1]));
+    harness.run_steps(2);
+    assert_eq!(first_vertex(&harness), DVec3::new(0.6, 0.6, 0.6));
+    assert_eq!(harness.state().document().cage().quads().len(), 6);
+    assert!(harness.state_mut().open_recent(&recent[0]));
     harness.run_steps(2);
     assert_eq!(first_vertex(&harness), DVec3::new(0.2, 0.2, 0.2));
 

@@ -333,6 +333,8 @@ fn options_beside_a_session_win_and_a_vanished_recent_file_leaves_the_list() {
     let entry = RecentEntry::Scene {
         mesh: mesh.clone(),
         cage: cage.clone(),
+        mesh_object: None,
+        cage_object: None,
     };
     assert!(app.open_recent(&entry));
     assert_eq!(app.recent_files().entries().first(), Some(&entry));

@@ -226,11 +226,26 @@ impl EditorApp {
     pub(super) fn open_recent_now(&mut self, entry: &RecentEntry) -> bool {
         let opened = match entry {
             RecentEntry::Session(path) => self.open_session_now(path),
-            RecentEntry::Scene { mesh, cage } => {
-                self.open_pair_now(mesh, cage, files::ObjectNames::default())
+            RecentEntry::Scene {
+                mesh,
+                cage,
+                mesh_object,
+                cage_object,
+            } => {
+                let objects = files::ObjectNames {
+                    mesh: mesh_object.as_deref(),
+                    cage: cage_object.as_deref(),
+                };
+                self.open_pair_now(mesh, cage, objects)
             }
             RecentEntry::Mesh(path) => self.open_file_now(FileRole::Mesh, path),
             RecentEntry::Cage(path) => self.open_file_now(FileRole::Cage, path),
+            RecentEntry::MeshObject { path, object } => {
+                self.open_object_now(FileRole::Mesh, path, Some(object))
+            }
+            RecentEntry::CageObject { path, object } => {
+                self.open_object_now(FileRole::Cage, path, Some(object))
+            }
         };
         if !opened {
             self.files.recent.forget(entry);
