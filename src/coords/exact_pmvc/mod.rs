@@ -218,11 +218,12 @@ pub struct ExactPmvcStats {
     pub splits: usize,
     /// Visible convex pieces integrated.
     pub fragments: usize,
-    /// Quads x sees from their inner side with no fold: candidates of four
-    /// sides, integrated by quadrature.
+    /// Patches x sees from their inner side with no fold (quads, and the
+    /// sub-patches of folded ones): candidates of four sides, integrated by
+    /// quadrature.
     pub quads: usize,
-    /// Quads x sees folded (a silhouette inside the patch): taken as the
-    /// cage's two triangles of each at this point.
+    /// Quads x sees folded (a silhouette inside the patch): cut into a grid
+    /// of sub-patches at this point.
     pub folded: usize,
     /// Rays cast on patches by the quadrature.
     pub nodes: usize,
@@ -252,6 +253,11 @@ pub struct ExactPmvcScratch {
     sides: Vec<f64>,
     /// How x sees each quad of the cage.
     quad_views: Vec<QuadView>,
+    /// The points of folded quads' grids, vertices after the cage's: their
+    /// quad and (u, v) on it.
+    grid_points: Vec<(u32, f64, f64)>,
+    /// Unnormalised weights of the cage's vertices and the grid points.
+    sums: Vec<f64>,
     stats: ExactPmvcStats,
 }
 
@@ -385,6 +391,8 @@ pub fn exact_pmvc_weights_inside(
     out.fill(0.0);
     scratch.stats = ExactPmvcStats::default();
     set_up(x, cage, scratch)?;
+    scratch.sums.clear();
+    scratch.sums.resize(scratch.relative.len(), 0.0);
     let count = scratch.candidates.len();
     scratch.stats.candidates = count;
     scratch.stats.thin = scratch.candidates.iter().filter(|c| c.thin).count();
@@ -419,7 +427,7 @@ pub fn exact_pmvc_weights_inside(
                 solid_angle += omega;
                 for (&v, weight) in target.vertices.iter().zip(weights) {
                     let weight = weight.max(0.0);
-                    out[v as usize] += weight;
+                    scratch.sums[v as usize] += weight;
                     total_weight += weight;
                 }
             }
@@ -434,7 +442,7 @@ pub fn exact_pmvc_weights_inside(
             for k in 0..3 {
                 // Non-negative in exact arithmetic: clamp the rounding.
                 let weight = target.weight_normals[k].dot(mean).max(0.0);
-                out[target.vertices[k] as usize] += weight;
+                scratch.sums[target.vertices[k] as usize] += weight;
                 total_weight += weight;
             }
         }
@@ -449,8 +457,17 @@ pub fn exact_pmvc_weights_inside(
         return Err(ExactPmvcFailure::NotEnclosed);
     }
     let inverse = 1.0 / total_weight;
-    for value in out.iter_mut() {
-        *value *= inverse;
+    let vertices = out.len();
+    for (value, sum) in out.iter_mut().zip(&scratch.sums) {
+        *value = sum * inverse;
+    }
+    // A grid point's weight goes to its quad's corners by the quad's basis.
+    for (&(q, u, v), sum) in scratch.grid_points.iter().zip(&scratch.sums[vertices..]) {
+        let corners = cage.quads()[q as usize].corners;
+        let basis = crate::geometry::quads::bilinear_basis(u, v);
+        for (corner, psi) in corners.iter().zip(basis) {
+            out[*corner as usize] += sum * inverse * psi;
+        }
     }
     Ok(())
 }

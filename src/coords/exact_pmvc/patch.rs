@@ -135,7 +135,7 @@ const DEEPEST: u32 = 10;
 
 /// `∫_R ψₖ / |y − x| dσ` over the convex spherical polygon `piece` of the
 /// patch's image, for its four corners: each triangle of a fan is
-/// integrated by two Gauss–Legendre rules (4² and 8² nodes on the square
+/// integrated by two Gauss–Legendre rules (6² and 8² nodes on the square
 /// collapsed onto it), and split in four until the two differ by at most
 /// `tolerance_per_steradian` times its solid angle (summed over the four
 /// corners), the finer one kept. Returns the weights and the solid angle.
@@ -176,7 +176,7 @@ fn adapt(
     depth: u32,
     count: &mut QuadratureCount,
 ) -> [f64; 4] {
-    let coarse = rule(a, b, c, patch, &GAUSS_4, count);
+    let coarse = rule(a, b, c, patch, &GAUSS_6, count);
     let fine = rule(a, b, c, patch, &super::polygon::GAUSS, count);
     let error: f64 = coarse.iter().zip(&fine).map(|(c, f)| (c - f).abs()).sum();
     if error <= tolerance {
@@ -198,12 +198,14 @@ fn adapt(
     sum
 }
 
-/// 4-point Gauss–Legendre on [0, 1]: nodes and weights.
-const GAUSS_4: [(f64, f64); 4] = [
-    (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
-    (0.330_009_478_207_571_87, 0.326_072_577_431_273_07),
-    (0.669_990_521_792_428_1, 0.326_072_577_431_273_07),
-    (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
+/// 6-point Gauss–Legendre on [0, 1]: nodes and weights.
+const GAUSS_6: [(f64, f64); 6] = [
+    (0.033_765_242_898_423_99, 0.085_662_246_189_585_17),
+    (0.169_395_306_766_867_74, 0.180_380_786_524_069_3),
+    (0.380_690_406_958_401_55, 0.233_956_967_286_345_5),
+    (0.619_309_593_041_598_5, 0.233_956_967_286_345_5),
+    (0.830_604_693_233_132_3, 0.180_380_786_524_069_3),
+    (0.966_234_757_101_576, 0.085_662_246_189_585_17),
 ];
 
 /// The tensor rule `nodes` on the spherical triangle (a, b, c): the flat

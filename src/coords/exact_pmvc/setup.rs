@@ -34,12 +34,10 @@ pub(super) fn set_up(
         let corners = quad.corners.map(|v| scratch.relative[v as usize]);
         scratch.quad_views.push(patch::view(quad.corners, corners));
     }
+    scratch.grid_points.clear();
     for (t, &vertices) in cage.triangles().iter().enumerate() {
-        // A quad's triangles stand in for it only where x sees it folded.
-        if let Some(q) = cage.quad_of_triangle(t) {
-            if scratch.quad_views[q] != QuadView::Folded {
-                continue;
-            }
+        if cage.quad_of_triangle(t).is_some() {
+            continue;
         }
         if let Some((candidate, cone)) = triangle_candidate(vertices, scratch) {
             scratch.candidates.push(candidate);
@@ -47,10 +45,14 @@ pub(super) fn set_up(
         }
     }
     for (q, quad) in cage.quads().iter().enumerate() {
-        if scratch.quad_views[q] == QuadView::Inner {
-            let (candidate, cone) = quad_candidate(q as u32, quad.corners, scratch);
-            scratch.candidates.push(candidate);
-            scratch.cones.push(cone);
+        match scratch.quad_views[q] {
+            QuadView::Inner => {
+                let (candidate, cone) = quad_candidate(q as u32, quad.corners, scratch);
+                scratch.candidates.push(candidate);
+                scratch.cones.push(cone);
+            }
+            QuadView::Outer => {}
+            QuadView::Folded => folded_quad(q as u32, quad.corners, scratch),
         }
     }
     // Both lists in the order of the candidates' distances.
@@ -75,6 +77,69 @@ pub(super) fn set_up(
     std::mem::swap(&mut scratch.candidates, &mut scratch.sorted);
     std::mem::swap(&mut scratch.cones, &mut scratch.sorted_cones);
     Ok(())
+}
+
+/// Cells along each side of the grid of sub-patches a folded quad is cut
+/// into ([`folded_quad`]).
+pub(super) const FOLD_GRID: usize = 4;
+
+/// A quad x sees folded, as a grid of [`FOLD_GRID`]² sub-patches (each the
+/// bilinear patch of its corners, whose basis composed with the quad's is
+/// the quad's basis): those x sees whole from inside are candidates, those
+/// seen from outside are skipped, and those still folded are taken as two
+/// triangles. The grid's points are extra vertices after the cage's, which
+/// hand their weights on to the quad's corners by its bilinear basis
+/// ([`ExactPmvcScratch::grid_points`]).
+fn folded_quad(q: u32, corners: [u32; 4], scratch: &mut ExactPmvcScratch) {
+    let n = FOLD_GRID;
+    let q_relative = corners.map(|v| scratch.relative[v as usize]);
+    let mut ids = [[0u32; FOLD_GRID + 1]; FOLD_GRID + 1];
+    for (i, row) in ids.iter_mut().enumerate() {
+        for (j, id) in row.iter_mut().enumerate() {
+            *id = match (i, j) {
+                (0, 0) => corners[0],
+                (i, 0) if i == n => corners[1],
+                (i, j) if i == n && j == n => corners[2],
+                (0, j) if j == n => corners[3],
+                _ => {
+                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                    let p = crate::geometry::quads::bilinear_point(&q_relative, u, v);
+                    let distance = p.length();
+                    scratch.relative.push(p);
+                    scratch.distances.push(distance);
+                    scratch.directions.push(p / distance);
+                    scratch.grid_points.push((q, u, v));
+                    (scratch.relative.len() - 1) as u32
+                }
+            };
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            let cell = [ids[i][j], ids[i + 1][j], ids[i + 1][j + 1], ids[i][j + 1]];
+            let p = cell.map(|v| scratch.relative[v as usize]);
+            // x on a grid point: the coverage check refuses the point.
+            if p.iter().any(|p| p.length() == 0.0 || p.is_nan()) {
+                continue;
+            }
+            match patch::view(cell, p) {
+                QuadView::Inner => {
+                    let (candidate, cone) = quad_candidate(q, cell, scratch);
+                    scratch.candidates.push(candidate);
+                    scratch.cones.push(cone);
+                }
+                QuadView::Outer => {}
+                QuadView::Folded => {
+                    for triangle in [[cell[0], cell[1], cell[2]], [cell[0], cell[2], cell[3]]] {
+                        if let Some((candidate, cone)) = triangle_candidate(triangle, scratch) {
+                            scratch.candidates.push(candidate);
+                            scratch.cones.push(cone);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The triangle as a candidate at x, if x sees it from its inner side.
