@@ -467,7 +467,7 @@ fn bench_shared_data(
                     .map(move |&split| (method, value, split))
             })
             .collect();
-        // Exact PMVC split a cage's quads themselves: one row.
+        // Exact PMVC, quads as patches: one row.
         configurations.push((Method::Pmvc, EXACT_RESOLUTION, QuadSplit::None));
         rows.extend(bench_scene_split(
             name,

@@ -70,9 +70,9 @@ pub fn shared_scene(data: &std::path::Path, name: &str) -> Result<Scene> {
     })
 }
 
-/// Every row of the table for `scene`. Exact PMVC integrate triangles, so a
-/// cage's quads are split along their shorter diagonal for every family here,
-/// and the comparison is on one cage.
+/// Every row of the table for `scene`. A cage's quads are split along their
+/// shorter diagonal for every family here, so that the comparison is on one
+/// cage and its figures are those of docs/coordinates.md.
 pub fn measure(scene: &Scene) -> Result<Vec<ExactErrorRow>> {
     let split = if scene.cage.has_quads() {
         QuadSplit::Shorter

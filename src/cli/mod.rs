@@ -126,7 +126,7 @@ pub struct MethodChoice {
     /// Coordinates to compute.
     #[arg(long, value_enum, default_value_t = crate::coords::Method::Pmvc)]
     pub method: crate::coords::Method,
-    /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated in closed form, on the CPU, on triangles (quads are split along their shorter diagonal unless --triangulate says otherwise).
+    /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated with no cube map, on the CPU (triangles in closed form, quads as bilinear patches by adaptive quadrature).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
     /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).

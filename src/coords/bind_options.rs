@@ -108,16 +108,13 @@ impl BindOptions {
         self.method == Method::Pmvc && self.resolution == EXACT_RESOLUTION
     }
 
-    /// How the cage's quads are split for this bind, if they are. Exact PMVC
-    /// integrates triangles only, so quads are split as for Green coordinates.
+    /// How the cage's quads are split for this bind, if they are (exact PMVC,
+    /// like the cube map, takes them as bilinear patches).
     pub fn split_applied(&self, cage: &Cage) -> Option<QuadSplit> {
         if !cage.has_quads() {
             return None;
         }
         match (self.quads, self.method.spec().quads) {
-            (QuadSplit::None, QuadSupport::Patches { .. }) if self.pmvc_exact() => {
-                Some(QuadSplit::Shorter)
-            }
             (QuadSplit::None, QuadSupport::Patches { .. }) => None,
             (QuadSplit::None, QuadSupport::Triangles) => Some(QuadSplit::Shorter),
             (split, _) => Some(split),
@@ -143,11 +140,6 @@ impl BindOptions {
         let split = self.split_applied(cage)?;
         let count = cage.quads().len();
         let spec = self.method.spec();
-        if self.pmvc_exact() && self.quads == QuadSplit::None {
-            return Some(format!(
-                "notice: exact PMVC integrate triangles: the cage's {count} quads were split along the shorter diagonal (--triangulate longer for the other one)"
-            ));
-        }
         Some(match spec.quads {
             QuadSupport::Triangles => format!(
                 "notice: {} are bound on triangles: the cage's {count} quads were split along the {} diagonal ({})",

@@ -231,7 +231,7 @@ fn difference_controls(
                     }
                     Twin::Reference => {
                         "The shown family at its reference setting (PMVC: exact, no cube map): \
-                         how far the approximation moves the mesh (exact PMVC splits quads)"
+                         how far the approximation moves the mesh"
                     }
                 };
                 ui.selectable_value(&mut against, (family, Some(twin)), twin_label(twin))

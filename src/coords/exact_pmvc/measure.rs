@@ -120,6 +120,13 @@ struct Figures {
     fragments_max: usize,
     cube_micros: [f64; 2],
     cube_error: [f64; 2],
+    /// Per point: quads seen whole, quads seen folded, rays cast on patches,
+    /// quadrature triangles left above tolerance, rays that missed.
+    quads: [f64; 5],
+    /// Points that saw at least one quad folded.
+    points_folded: usize,
+    /// Largest `|Σ wᵢ vᵢ − x|` over the cage diagonal.
+    linear: f64,
 }
 
 fn measure(cage: &Cage, points: &[DVec3]) -> Figures {
@@ -152,6 +159,27 @@ fn measure(cage: &Cage, points: &[DVec3]) -> Figures {
         cube_error[k] = error;
     }
     let mut mean = [0.0; 10];
+    let mut quads = [0.0; 5];
+    for s in &stats {
+        let values = [s.quads, s.folded, s.nodes, s.unresolved, s.missed];
+        for (sum, value) in quads.iter_mut().zip(values) {
+            *sum += value as f64 / stats.len() as f64;
+        }
+    }
+    let linear = points
+        .iter()
+        .zip(&exact_weights)
+        .zip(&kept)
+        .filter(|(_, &kept)| kept)
+        .map(|((&x, w), _)| {
+            let p: DVec3 = w
+                .iter()
+                .zip(cage.positions())
+                .map(|(&w, &v)| w * (v - x))
+                .sum();
+            p.length() / cage.diagonal()
+        })
+        .fold(0.0, f64::max);
     for s in &stats {
         let values = [
             s.candidates,
@@ -177,6 +205,9 @@ fn measure(cage: &Cage, points: &[DVec3]) -> Figures {
         fragments_max: stats.iter().map(|s| s.fragments).max().unwrap_or(0),
         cube_micros,
         cube_error,
+        quads,
+        points_folded: stats.iter().filter(|s| s.folded > 0).count(),
+        linear,
     }
 }
 
@@ -200,6 +231,18 @@ fn report(name: &str, cage: &Cage, f: &Figures) {
         f.cube_micros[1],
         f.cube_error[1],
     );
+    if cage.has_quads() {
+        let [quads, folded, nodes, unresolved, missed] = f.quads;
+        println!(
+            "  {} quads as patches: per point {quads:.1} seen whole, {folded:.2} folded \
+             ({} points saw a fold), {nodes:.0} rays cast by the quadrature ({unresolved:.2} \
+             triangles above tolerance, {missed:.2} rays missed); largest |Σ wᵢ vᵢ − x| / \
+             diagonal {:.1e}",
+            cage.quads().len(),
+            f.points_folded,
+            f.linear,
+        );
+    }
 }
 
 #[test]
@@ -215,11 +258,22 @@ fn speed_and_fragments() {
     let sphere = procedural::icosphere(1.0, 3);
     let points = procedural::points_inside(&sphere, 500, 41, 1e-3);
     report("icosphere", &sphere, &measure(&sphere, &points));
+    for (model, patches, inside) in shared_models() {
+        let cage = patches.split_quads(QuadSplit::Shorter);
+        report(&model, &cage, &measure(&cage, &inside));
+    }
+}
+
+/// The artist cages of `../shared/data/qmvc` (read at test time, never
+/// copied), each with about 2000 of its mesh's vertices inside its split
+/// cage; "not run" when they are missing.
+fn shared_models() -> Vec<(String, Cage, Vec<DVec3>)> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/qmvc");
     if !data.is_dir() {
         println!("not run: {} is not present", data.display());
-        return;
+        return Vec::new();
     }
+    let mut models = Vec::new();
     for model in ["Beast", "Ogre", "FireHydrant", "ManHead", "Bench"] {
         let (Some(cage_mesh), Some(mesh)) = (
             read_obj(&data.join(format!("{model}_Cage.obj"))),
@@ -228,8 +282,8 @@ fn speed_and_fragments() {
             println!("not run: {model} is not readable");
             continue;
         };
-        let (cage, _) = Cage::new(cage_mesh).expect("a valid cage");
-        let cage = cage.split_quads(QuadSplit::Shorter);
+        let (patches, _) = Cage::new(cage_mesh).expect("a valid cage");
+        let cage = patches.split_quads(QuadSplit::Shorter);
         let step = (mesh.positions.len() / 2000).max(1);
         let sample: Vec<DVec3> = mesh.positions.iter().step_by(step).copied().collect();
         let classes = classify_points(&cage, &sample).classes;
@@ -239,7 +293,42 @@ fn speed_and_fragments() {
             .filter(|(_, class)| matches!(class, PointClass::Inside))
             .map(|(&x, _)| x)
             .collect();
-        report(model, &cage, &measure(&cage, &inside));
+        models.push((model.to_owned(), patches, inside));
+    }
+    models
+}
+
+/// Exact PMVC on the artist cages' quads as bilinear patches, beside the
+/// same points on the split cages: time, pieces, folds and the quadrature's
+/// rays per point (the figures of docs/coordinates.md).
+#[test]
+#[ignore = "a measurement: run in release with --ignored --nocapture"]
+fn quads_as_patches() {
+    let comb = crate::geometry::procedural_quads::quad_comb(3, 1.0, 0.5, 2.0, 1.0, 0.3);
+    let points = procedural::points_inside(&comb, 500, 43, 1e-3);
+    report("bent quad comb", &comb, &measure(&comb, &points));
+    // PMVC_MEASURE_STEP=k measures every k-th point only.
+    let step = std::env::var("PMVC_MEASURE_STEP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    for (model, patches, inside) in shared_models() {
+        let inside: Vec<DVec3> = inside.into_iter().step_by(step).collect();
+        let cage = patches.split_quads(QuadSplit::Shorter);
+        report(&format!("{model} (split)"), &cage, &measure(&cage, &inside));
+        // The same points that are inside the patches too.
+        let classes = classify_points(&patches, &inside).classes;
+        let inside: Vec<DVec3> = inside
+            .iter()
+            .zip(&classes)
+            .filter(|(_, class)| matches!(class, PointClass::Inside))
+            .map(|(&x, _)| x)
+            .collect();
+        report(
+            &format!("{model} (patches)"),
+            &patches,
+            &measure(&patches, &inside),
+        );
     }
 }
 
@@ -293,7 +382,7 @@ fn thin_threshold() {
             4.0 * PI * scratch.distances.len() as f64 / scratch.distances.iter().sum::<f64>();
         for t in 0..scratch.candidates.len() {
             let c = scratch.candidates[t];
-            let [a, b, d] = c.directions;
+            let [a, b, d, _] = c.directions;
             let perimeter = (a - b).length() + (b - d).length() + (d - a).length();
             let ratio = a.dot(b.cross(d)) / (perimeter * perimeter);
             visible_pieces(t, scratch);

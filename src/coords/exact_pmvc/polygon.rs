@@ -235,7 +235,7 @@ const LONGEST_CHORD: f64 = 0.6;
 const DEEPEST_SPLIT: u32 = 12;
 
 /// 8-point Gauss–Legendre on [0, 1]: nodes and weights.
-const GAUSS: [(f64, f64); 8] = [
+pub(super) const GAUSS: [(f64, f64); 8] = [
     (0.019_855_071_751_231_856, 0.050_614_268_145_188_09),
     (0.101_666_761_293_186_58, 0.111_190_517_226_687_23),
     (0.237_233_795_041_835_5, 0.156_853_322_938_943_7),

@@ -6,7 +6,6 @@ use super::polygon::{clip, mean_vector, mean_vector_by_quadrature, side_of, Corn
 use super::*;
 use crate::coords::mvc::{mvc_weights, MvcScratch};
 use crate::geometry::procedural::{self, SplitMix64};
-use crate::geometry::QuadSplit;
 use glam::{DQuat, DVec2};
 
 pub(super) fn exact(x: DVec3, cage: &Cage) -> Vec<f64> {
@@ -345,18 +344,4 @@ fn points_not_strictly_inside_are_refused() {
         let result = exact_pmvc_weights_inside(x, &cage, &mut out, scratch);
         assert_eq!(result, Err(ExactPmvcFailure::NotEnclosed), "{x}");
     }
-}
-
-#[test]
-fn quads_are_refused_and_their_split_is_bound() {
-    let cage = crate::geometry::procedural_quads::twisted_box(2.0, 0.6);
-    assert!(cage.has_quads());
-    let x = DVec3::new(0.1, -0.2, 1.0);
-    let mut out = vec![0.0; cage.vertex_count()];
-    let scratch = &mut ExactPmvcScratch::default();
-    let refused = exact_pmvc_weights_inside(x, &cage, &mut out, scratch);
-    assert_eq!(refused, Err(ExactPmvcFailure::Quads));
-    let split = cage.split_quads(QuadSplit::Shorter);
-    let w = exact(x, &split);
-    assert!(linear_error(&w, &split, x) < 1e-13);
 }

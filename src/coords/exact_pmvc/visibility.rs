@@ -55,25 +55,57 @@ enum Order {
     Probe,
 }
 
+/// Where b lies against a's plane (a quad's slab, which holds its patch):
+/// `Some(true)` wholly beyond it seen from x, `Some(false)` wholly on x's
+/// side, `None` across it.
+fn against(a: &Candidate, b: &Candidate, relative: &[DVec3]) -> Option<bool> {
+    if a.quad.is_none() {
+        let sides = || {
+            b.vertices()
+                .iter()
+                .map(|&v| a.plane_side(v, relative[v as usize]))
+        };
+        if sides().all(|d| d >= 0.0) {
+            return Some(true);
+        }
+        if sides().all(|d| d <= 0.0) {
+            return Some(false);
+        }
+        return None;
+    }
+    // x must be on the near side of the whole slab for a ray's order to follow.
+    if a.offset.is_nan() || a.offset <= 0.0 {
+        return None;
+    }
+    let along = || {
+        b.vertices()
+            .iter()
+            .map(|&v| a.normal.dot(relative[v as usize]))
+    };
+    if along().all(|d| d >= a.far_offset) {
+        return Some(true);
+    }
+    if along().all(|d| d <= a.offset) {
+        return Some(false);
+    }
+    None
+}
+
 /// Whether s is in front of t where both are seen, as far as the sides of
 /// their planes tell: s wholly beyond t's plane (seen from x) is behind it,
 /// wholly on x's side of it in front, and the same for t against s's plane.
+/// A quad's plane is the slab between its corners across its diagonals'
+/// normal, which holds its patch.
 fn order(t: &Candidate, s: &Candidate, relative: &[DVec3]) -> Order {
-    let s_sides = s.vertices.map(|v| t.plane_side(v, relative[v as usize]));
-    if s_sides.iter().all(|&d| d >= 0.0) {
-        return Order::Behind;
+    match against(t, s, relative) {
+        Some(true) => Order::Behind,
+        Some(false) => Order::Front,
+        None => match against(s, t, relative) {
+            Some(true) => Order::Front,
+            Some(false) => Order::Behind,
+            None => Order::Probe,
+        },
     }
-    if s_sides.iter().all(|&d| d <= 0.0) {
-        return Order::Front;
-    }
-    let t_sides = t.vertices.map(|v| s.plane_side(v, relative[v as usize]));
-    if t_sides.iter().all(|&d| d >= 0.0) {
-        return Order::Front;
-    }
-    if t_sides.iter().all(|&d| d <= 0.0) {
-        return Order::Behind;
-    }
-    Order::Probe
 }
 
 /// Fills `scratch.pieces` with the part of candidate t that x sees first:
@@ -95,7 +127,8 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
     let target = &candidates[t];
     let target_cone = &cones[t];
     pieces.clear();
-    pieces.push(&target.corners());
+    let corners = target.corners();
+    pieces.push(&corners[..target.count]);
     for (s, cone) in cones.iter().enumerate() {
         if cone.nearest >= target.farthest {
             // This one and all after it are wholly farther than t.
@@ -119,7 +152,7 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
         }
         if matches!(order, Order::Probe) {
             stats.probed += 1;
-            if !probe_in_front(target, occluder, directions, work, cut, sides) {
+            if !probe_in_front(target, occluder, directions, relative, work, cut, sides) {
                 continue;
             }
         }
@@ -138,18 +171,20 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
 }
 
 /// Whether s is in front of t over the overlap of their cones, by one ray
-/// through it; false when they do not overlap.
+/// through it; false when they do not overlap. With a quad, the order is
+/// taken to hold over the whole overlap, as it does for planar faces.
 fn probe_in_front(
     t: &Candidate,
     s: &Candidate,
     directions: &[DVec3],
+    relative: &[DVec3],
     work: &mut Vec<Corner>,
     cut: &mut Vec<Corner>,
     sides: &mut Vec<f64>,
 ) -> bool {
     work.clear();
-    work.extend_from_slice(&t.corners());
-    for plane in &s.sides {
+    work.extend_from_slice(&t.corners()[..t.count]);
+    for plane in s.sides() {
         sides.clear();
         sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
         cut.clear();
@@ -159,8 +194,11 @@ fn probe_in_front(
         std::mem::swap(work, cut);
     }
     let d: DVec3 = work.iter().map(|c| c.direction).sum();
-    // t_s < t_t, with t = offset / (N·d) and both N·d > 0 inside both cones.
-    s.offset * d.dot(t.normal) < t.offset * d.dot(s.normal)
+    if t.quad.is_none() && s.quad.is_none() {
+        // t_s < t_t, with t = offset / (N·d) and both N·d > 0 inside both cones.
+        return s.offset * d.dot(t.normal) < t.offset * d.dot(s.normal);
+    }
+    s.distance(d, relative) < t.distance(d, relative)
 }
 
 /// Appends to `out` the parts of `piece` outside the cone of `occluder`, cut
@@ -181,7 +219,7 @@ fn subtract(
     }
     work.clear();
     work.extend_from_slice(piece);
-    for plane in &occluder.sides {
+    for plane in occluder.sides() {
         sides.clear();
         sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
         if sides.iter().all(|&d| d >= 0.0) {
@@ -211,31 +249,31 @@ fn subtract(
     true
 }
 
-/// Whether a side of either triangle has the other wholly on its outer side:
+/// Whether a side of either face has the other wholly on its outer side:
 /// then their cones do not overlap.
 fn triangles_separated(t: &Candidate, s: &Candidate, directions: &[DVec3]) -> bool {
-    if !t.vertices.iter().any(|v| s.holds(*v)) {
+    if !t.vertices().iter().any(|v| s.holds(*v)) {
         // No corner in common: no side is exactly 0 by its label.
-        let outside = |plane: &EdgePlane, corners: &[DVec3; 3]| {
+        let outside = |plane: &EdgePlane, corners: &[DVec3]| {
             corners
                 .iter()
                 .all(|&d| plane.normal.dot(d) <= plane.tolerance)
         };
-        return t.sides.iter().any(|plane| outside(plane, &s.directions))
-            || s.sides.iter().any(|plane| outside(plane, &t.directions));
+        return t.sides().iter().any(|plane| outside(plane, s.directions()))
+            || s.sides().iter().any(|plane| outside(plane, t.directions()));
     }
-    let outside = |plane: &EdgePlane, corners: &[u32; 3]| {
+    let outside = |plane: &EdgePlane, corners: &[u32]| {
         corners
             .iter()
             .all(|&v| side_of(directions[v as usize], Label::Vertex(v), plane) <= 0.0)
     };
-    t.sides.iter().any(|plane| outside(plane, &s.vertices))
-        || s.sides.iter().any(|plane| outside(plane, &t.vertices))
+    t.sides().iter().any(|plane| outside(plane, s.vertices()))
+        || s.sides().iter().any(|plane| outside(plane, t.vertices()))
 }
 
 /// Whether a side of either polygon has the other wholly on its outer side.
 fn separated(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bool {
-    let by_occluder = occluder.sides.iter().any(|plane| {
+    let by_occluder = occluder.sides().iter().any(|plane| {
         piece
             .iter()
             .all(|c| side_of(c.direction, c.label, plane) <= 0.0)
@@ -243,7 +281,7 @@ fn separated(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bo
     by_occluder
         || piece.iter().any(|corner| {
             occluder
-                .vertices
+                .vertices()
                 .iter()
                 .all(|&v| side_of(directions[v as usize], Label::Vertex(v), &corner.side) <= 0.0)
         })

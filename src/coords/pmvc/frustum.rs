@@ -105,13 +105,13 @@ fn index_range(low: f64, high: f64, table: &TexelTable) -> Range<usize> {
 
 /// A cube face as axis swizzles: exact, and cheaper than dot products with unit axes.
 #[derive(Debug, PartialEq)]
-pub(super) struct FaceFrame {
-    pub(super) axes: [(usize, f64); 3],
+pub(crate) struct FaceFrame {
+    pub(crate) axes: [(usize, f64); 3],
 }
 
 /// [`CUBE_FACES`] as swizzles (checked by a test), constant so that loops over the
 /// faces compile to fixed swizzles.
-pub(super) const FACE_FRAMES: [FaceFrame; 6] = [
+pub(crate) const FACE_FRAMES: [FaceFrame; 6] = [
     FaceFrame {
         axes: [(1, 1.0), (2, 1.0), (0, 1.0)],
     },
@@ -157,7 +157,7 @@ impl FaceFrame {
 
     /// `(p·right, p·up, p·normal)`.
     #[inline(always)]
-    pub(super) fn local(&self, p: DVec3) -> DVec3 {
+    pub(crate) fn local(&self, p: DVec3) -> DVec3 {
         let [(r, rs), (u, us), (n, ns)] = self.axes;
         DVec3::new(p[r] * rs, p[u] * us, p[n] * ns)
     }

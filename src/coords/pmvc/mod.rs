@@ -34,11 +34,11 @@
 //! all four corners, which bound the whole patch (see [`PatchSetup::corner_sides`]).
 //! A cage of triangles only takes the triangle code alone, unchanged.
 
-mod frustum;
+pub(crate) mod frustum;
 mod integration;
 mod lanes;
 mod missed;
-mod patch;
+pub(crate) mod patch;
 #[cfg(test)]
 mod quad_tests;
 mod raster;

@@ -25,18 +25,18 @@ use std::ops::Range;
 
 /// One patch at one cage vertex x.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct PatchSetup {
+pub(crate) struct PatchSetup {
     /// Cage vertices q0..q3.
-    pub(super) vertices: [u32; 4],
+    pub(crate) vertices: [u32; 4],
     /// Corners relative to x, times `scale`.
-    pub(super) corners: [DVec3; 4],
+    pub(crate) corners: [DVec3; 4],
     /// A power of two near the inverse size of `corners` (exact to apply): the solve
     /// forms products of up to eleven corner coordinates, kept in range this way.
-    pub(super) scale: f64,
+    pub(crate) scale: f64,
 }
 
 impl PatchSetup {
-    pub(super) fn new(vertices: [u32; 4], relative: [DVec3; 4]) -> Self {
+    pub(crate) fn new(vertices: [u32; 4], relative: [DVec3; 4]) -> Self {
         let size = relative
             .iter()
             .map(|p| p.abs().max_element())
@@ -53,13 +53,13 @@ impl PatchSetup {
     /// `det[q_k, q_k+1, q_k−1]` per corner k: the side of x of the patch's tangent
     /// plane there (negative outside). The patch's `(P − x)·n(u, v)` is bilinear in
     /// (u, v) (n is linear in them), so these four bound its sign everywhere.
-    pub(super) fn corner_sides(&self) -> [f64; 4] {
+    pub(crate) fn corner_sides(&self) -> [f64; 4] {
         let q = &self.corners;
         std::array::from_fn(|k| q[k].dot(q[(k + 1) % 4].cross(q[(k + 3) % 4])))
     }
 
     /// The patch's functions in the coordinates of one cube face.
-    pub(super) fn on_face(&self, frame: &FaceFrame, code_mask: usize, code: u64) -> FacePatch {
+    pub(crate) fn on_face(&self, frame: &FaceFrame, code_mask: usize, code: u64) -> FacePatch {
         let [q0, q1, q2, q3] = self.corners.map(|p| frame.local(p));
         FacePatch {
             along_u: [q0.cross(q3), q0.cross(q2) + q1.cross(q3), q1.cross(q2)],
@@ -77,7 +77,7 @@ impl PatchSetup {
 
 /// A patch's solve on one cube face, for a texel ray `d = (s, r, 1)`.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct FacePatch {
+pub(crate) struct FacePatch {
     /// Bernstein coefficients of g(u) (u = 0, middle, u = 1) as `x·s + y·r + z`.
     along_u: [DVec3; 3],
     /// The same for v: `d·(q0×q1)`, `d·(q0×q2 + q3×q1)`, `d·(q3×q2)`.
@@ -471,7 +471,7 @@ impl FacePatch {
 
     /// A missed texel's ray `(s, r, 1)` cast again with `slack` in u and v: `1/t`, u
     /// and the weights `(1 − v)/t`, `v/t`, or `None`.
-    pub(super) fn hit_with_slack(&self, s: f64, r: f64, slack: f64) -> Option<[f64; 4]> {
+    pub(crate) fn hit_with_slack(&self, s: f64, r: f64, slack: f64) -> Option<[f64; 4]> {
         let eval = |edge: DVec3| s.mul_add(edge.x, r.mul_add(edge.y, edge.z));
         let [gl, gm, gr] = self.along_u.map(eval);
         let alpha = (gl + gr) - gm;
