@@ -185,6 +185,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         (Method::Mlc, 0),
         (Method::Harmonic, 64),
         (Method::Harmonic, 128),
+        (Method::Bbw, crate::coords::bbw::DEFAULT_GRID),
     ];
     for name in procedural::table1_scene_names() {
         if let Some(scene) = procedural::table1_scene(name).filter(|_| wanted(name)) {

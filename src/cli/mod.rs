@@ -129,9 +129,9 @@ pub struct MethodChoice {
     /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated with no cube map, on the CPU (triangles in closed form, quads as bilinear patches by adaptive quadrature).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
-    /// Harmonic coordinates: grid cells along the cage's longest side (4–2048).
-    #[arg(long, default_value_t = crate::coords::harmonic::DEFAULT_GRID, value_parser = parse_grid)]
-    pub grid: u32,
+    /// Harmonic coordinates and BBW: grid cells along the cage's longest side (4–2048; default 64 for harmonic coordinates, 32 for BBW).
+    #[arg(long, value_parser = parse_grid)]
+    pub grid: Option<u32>,
     /// Split the cage's quads into triangles along their shorter or longer diagonal
     /// before binding, as before quads were bilinear patches, to reproduce earlier
     /// results or see how much the split moves the mesh. Without it, quads stay
@@ -166,7 +166,9 @@ impl MethodChoice {
         crate::coords::BindOptions {
             method: self.method,
             resolution: self.resolution,
-            grid: self.grid,
+            grid: self
+                .grid
+                .unwrap_or(crate::coords::BindOptions::for_method(self.method).grid),
             quads: self
                 .triangulate
                 .map_or(crate::coords::QuadSplit::None, TriangulateArg::split),

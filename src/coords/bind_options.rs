@@ -24,12 +24,17 @@ pub struct BindOptions {
 }
 
 impl BindOptions {
-    /// The options for `method` with every parameter at its default.
+    /// The options for `method` with every parameter at its default (the
+    /// family's own default for its parameter, e.g. BBW's grid).
     pub fn for_method(method: Method) -> Self {
-        Self {
+        let mut options = Self {
             method,
             ..Self::default()
+        };
+        if let Some(spec) = method.spec().parameter {
+            options.set(spec.key, spec.default);
         }
+        options
     }
 
     /// The value of `parameter` in these options.

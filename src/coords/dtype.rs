@@ -26,6 +26,11 @@ pub enum DtypeError {
          error (about 1e-3 at grid 64) is far above float32's rounding; bind them as float32"
     )]
     Harmonic,
+    #[error(
+        "dtype float64: {family} weights are sampled in float32 from their grid, whose \
+         error is far above float32's rounding; bind them as float32"
+    )]
+    SampledFromGrid { family: &'static str },
     #[error("dtype float64: weights are computed on the CPU (GPU kernels compute in float32)")]
     NotOnGpu,
 }
@@ -70,6 +75,11 @@ impl Dtype {
     pub fn check_family(self, method: Method) -> Result<(), DtypeError> {
         match (self, method) {
             (Dtype::Float64, Method::Harmonic) => Err(DtypeError::Harmonic),
+            (Dtype::Float64, method) if !method.spec().rows_independent => {
+                Err(DtypeError::SampledFromGrid {
+                    family: method.name(),
+                })
+            }
             _ => Ok(()),
         }
     }

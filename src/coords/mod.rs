@@ -1,7 +1,8 @@
 //! Barycentric coordinates of mesh vertices with respect to a cage: mean value
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
 //! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
-//! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), and the
+//! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), bounded
+//! biharmonic weights ([`bbw`]), and the
 //! dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
@@ -23,6 +24,7 @@
 //! policies ([`green`]), which keep the deformation continuous across the cage for
 //! their extra triangle columns, so their rows ignore the point's class.
 
+pub mod bbw;
 mod bind_options;
 pub mod cubemap;
 pub mod dtype;
@@ -199,7 +201,8 @@ const ROWS_PER_TASK: usize = 32;
 /// `classes` comes from [`BindOptions::classify`] for the same points, cage and
 /// options; it decides the inside/outside/surface policy described in the module doc.
 /// Families with a closed form or per-point integral go row by row
-/// ([`bind_rows`]); harmonic coordinates solve over the whole cage first.
+/// ([`bind_rows`]); the grid families (harmonic coordinates, BBW: those whose
+/// rows are not independent) solve over the whole cage first.
 pub fn bind_cpu(
     points: &[DVec3],
     classes: &[PointClass],
@@ -209,16 +212,28 @@ pub fn bind_cpu(
 ) -> Result<Weights, BindFailure> {
     options.validate()?;
     let cage = &*options.cage_to_bind(cage);
-    if options.method == Method::Harmonic {
-        let (weights, _stats) =
-            harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?;
-        return Ok(weights);
+    if !options.method.spec().rows_independent {
+        return bind_on_grid(points, classes, cage, options, progress);
     }
     let (cols, values) = every_row(points, classes, cage, options, progress)?;
     Ok(Weights {
         rows: points.len(),
         cols,
         values,
+    })
+}
+
+/// A whole-scene solve on the harmonic solve's grid.
+fn bind_on_grid(
+    points: &[DVec3],
+    classes: &[PointClass],
+    cage: &Cage,
+    options: BindOptions,
+    progress: &BindProgress,
+) -> Result<Weights, BindFailure> {
+    Ok(match options.method {
+        Method::Bbw => bbw::bind_bbw(points, classes, cage, options.grid, progress)?.0,
+        _ => harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?.0,
     })
 }
 
@@ -249,9 +264,9 @@ fn every_row<T: WeightValue>(
 }
 
 /// [`bind_cpu`] into float64 weights: every row as computed, without the
-/// rounding to float32. Harmonic coordinates, solved in float32 on their grid,
-/// come widened (front ends refuse `Dtype::Float64` for them:
-/// [`Dtype::check_family`]).
+/// rounding to float32. The grid families (harmonic coordinates, BBW), sampled
+/// in float32 from their grid, come widened (front ends refuse
+/// `Dtype::Float64` for them: [`Dtype::check_family`]).
 pub fn bind_cpu_f64(
     points: &[DVec3],
     classes: &[PointClass],
@@ -260,7 +275,7 @@ pub fn bind_cpu_f64(
     progress: &BindProgress,
 ) -> Result<WeightsF64, BindFailure> {
     options.validate()?;
-    if options.method == Method::Harmonic {
+    if !options.method.spec().rows_independent {
         let columns = options.columns(cage) as u64;
         crate::budget::check_memory(
             || {
@@ -414,9 +429,9 @@ pub fn weights_at(
         }
         PointClass::Outside => mvc::mvc_weights(x, cage, out, mvc_scratch),
         PointClass::Inside => match method {
-            // Harmonic coordinates have no per-point form; bind_cpu solves them
+            // Grid families have no per-point form; bind_cpu solves them
             // whole. Asked for one row, MVC is the outside policy's answer.
-            Method::Mvc | Method::Harmonic | Method::Green => {
+            Method::Mvc | Method::Harmonic | Method::Bbw | Method::Green => {
                 mvc::mvc_weights(x, cage, out, mvc_scratch)
             }
             Method::Pmvc => {

@@ -1,4 +1,4 @@
-//! Coordinates: MVC, PMVC, harmonic, Green, maximum entropy and maximum likelihood coordinates against references and
+//! Coordinates: MVC, PMVC, harmonic, Green, maximum entropy and maximum likelihood coordinates, bounded biharmonic weights against references and
 //! their properties, far-field exactness, origin offsets, weights metadata and
 //! the figures the docs quote. Builds without features
 //! (`cargo test --no-default-features --test coords`); the parts that run the
@@ -7,6 +7,8 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod bbw;
+mod bbw_reference;
 mod coords_properties;
 mod coords_reference;
 mod doc_figures;

@@ -127,13 +127,15 @@ def test_a_npy_point_set_loads_as_points_without_faces(tmp_path, test_points):
 
 def test_families_lists_every_family_with_its_parameters_and_promise():
     families = {family["id"]: family for family in pmvc.families()}
-    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec", "mlc"]
+    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec", "mlc", "bbw"]
     assert families["pmvc"]["positive_inside"] and not families["mvc"]["positive_inside"]
     for positive_on_the_cpu in ("mec", "mlc"):
         family = families[positive_on_the_cpu]
         assert family["positive_inside"] and not family["gpu_kernel"]
     assert [p["id"] for p in families["pmvc"]["parameters"]] == ["resolution"]
     assert families["harmonic"]["parameters"][0]["default"] == 64
+    assert families["bbw"]["parameters"][0]["default"] == 32
+    assert families["bbw"]["parameters"][0]["id"] == "grid"
     assert families["green"]["columns_layout"] == "cage_vertices_then_triangles"
     assert "Green's exterior extension" in families["green"]["outside_policy"]
 

@@ -18,32 +18,36 @@ use crate::geometry::Cage;
 use glam::{DVec2, DVec3};
 
 /// No unknown here: the node is outside the cage, or the arm is cut.
-pub(super) const NONE: u32 = u32::MAX;
+pub(in crate::coords) const NONE: u32 = u32::MAX;
 /// Arms shorter than this share of a cell are lengthened to it, bounding the
 /// diagonal; the boundary then moves by at most this share of a cell.
-pub(super) const THETA_MIN: f64 = 1e-3;
+pub(in crate::coords) const THETA_MIN: f64 = 1e-3;
 
 /// Where a grid line crosses the cage: `s` along the line in cells from its first
 /// node, and the boundary data there.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Crossing {
+pub(in crate::coords) struct Crossing {
     pub s: f64,
     pub value: BoundaryValue,
 }
 
-/// A cut arm: the unknown it belongs to, its coefficient `1/θ`, and the values at
-/// the crossing.
+/// A cut arm: the unknown it belongs to, which of its arms it is (−x, +x, −y,
+/// +y, −z, +z), its coefficient `1/θ`, the values at the crossing, and their
+/// surface gradients' components along the arm's axis, in cells⁻¹ (what
+/// bounded biharmonic weights' boundary rows read).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct CutArm {
+pub(in crate::coords) struct CutArm {
     pub unknown: u32,
+    pub arm: u8,
     pub coefficient: f32,
     pub corners: [u32; 4],
     pub values: [f32; 4],
+    pub slopes: [f32; 4],
 }
 
 /// The grid's placement, shared by all levels (a level doubles `h`).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Frame {
+pub(in crate::coords) struct Frame {
     pub origin: DVec3,
     pub h: f64,
     pub dims: [usize; 3],
@@ -79,7 +83,7 @@ impl Frame {
 }
 
 /// One level: the inside nodes (the unknowns) and their stencils.
-pub(super) struct Level {
+pub(in crate::coords) struct Level {
     pub frame: Frame,
     /// Per grid node: its unknown, or [`NONE`] outside the cage.
     pub unknown_of: Vec<u32>,
@@ -124,7 +128,7 @@ fn line_crossings(cage: &Cage, frame: &Frame, axis: usize) -> Vec<Vec<Crossing>>
                 let s = weights[0] * q[0][axis] + weights[1] * q[1][axis] + weights[2] * q[2][axis];
                 lines[jb + nb * jc].push(Crossing {
                     s,
-                    value: BoundaryValue::triangle(corners, weights),
+                    value: BoundaryValue::triangle(corners, weights).with_triangle_gradients(q),
                 });
             }
         }
@@ -137,7 +141,8 @@ fn line_crossings(cage: &Cage, frame: &Frame, axis: usize) -> Vec<Vec<Crossing>>
                 for [s, u, v] in patch_line_crossings(&q, axis, point).into_iter().flatten() {
                     lines[jb + nb * jc].push(Crossing {
                         s,
-                        value: BoundaryValue::quad(quad.corners, u, v),
+                        value: BoundaryValue::quad(quad.corners, u, v)
+                            .with_patch_gradients(&q, u, v),
                     });
                 }
             }
@@ -166,7 +171,10 @@ fn line_of(frame: &Frame, axis: usize, node: [usize; 3]) -> (usize, usize) {
 }
 
 /// Which grid nodes are inside the cage: odd crossings before them along x.
-pub(super) fn inside_nodes(cage: &Cage, frame: &Frame) -> (Vec<bool>, [Vec<Vec<Crossing>>; 3]) {
+pub(in crate::coords) fn inside_nodes(
+    cage: &Cage,
+    frame: &Frame,
+) -> (Vec<bool>, [Vec<Vec<Crossing>>; 3]) {
     let lines = [0, 1, 2].map(|axis| line_crossings(cage, frame, axis));
     let mut inside = vec![false; frame.node_count()];
     for (index, flag) in inside.iter_mut().enumerate() {
@@ -231,9 +239,11 @@ impl Level {
                         if with_cut_arms {
                             cut_arms.push(CutArm {
                                 unknown: unknown as u32,
+                                arm: arm as u8,
                                 coefficient,
                                 corners: crossing.value.corners,
                                 values: crossing.value.values.map(|w| w as f32),
+                                slopes: crossing.value.gradients.map(|g| g[axis] as f32),
                             });
                         }
                     }

@@ -17,9 +17,9 @@
 //! Vertices on the cage get the barycentrics of their triangle and vertices outside
 //! get MVC, as for the other families (see [`super`]).
 
-mod grid;
+pub(super) mod grid;
 mod patches;
-mod sample;
+pub(super) mod sample;
 mod solve;
 
 use super::{BindProgress, Cancelled, Weights};
@@ -41,24 +41,35 @@ const EXPECTED_ITERATIONS: usize = 12;
 /// Cage vertices solved together: bounds memory while one sweep serves many.
 const COLUMNS_PER_BLOCK: usize = 32;
 /// Share of the available memory a bind may plan to use.
-const MEMORY_SHARE: f64 = 0.8;
+pub(super) const MEMORY_SHARE: f64 = 0.8;
 
-/// Why a harmonic bind could not be done.
+/// Why a bind on the harmonic solve's grid (harmonic coordinates, and the
+/// families that share the grid: [`super::bbw`]) could not be done.
 #[derive(Debug, thiserror::Error)]
 pub enum HarmonicError {
-    #[error("the harmonic grid needs at least {MIN_GRID} cells along the cage's longest side, not {grid}")]
+    #[error("the grid needs at least {MIN_GRID} cells along the cage's longest side, not {grid}")]
     GridTooSmall { grid: u32 },
-    #[error("a harmonic grid of {grid} cells has {nodes} nodes, more than this tool supports; use a smaller --grid")]
+    #[error("a grid of {grid} cells has {nodes} nodes, more than this tool supports; use a smaller --grid")]
     GridTooLarge { grid: u32, nodes: u128 },
     #[error(
-        "a harmonic bind at grid {grid} needs about {needed_mib} MiB, but only {available_mib} MiB of memory is available; use a smaller --grid (grid {suggested} needs about {suggested_mib} MiB)"
+        "a {family} bind at grid {grid} needs about {needed_mib} MiB, but only {available_mib} MiB of memory is available; use a smaller --grid (grid {suggested} needs about {suggested_mib} MiB)"
     )]
     NotEnoughMemory {
+        /// The family's display name ("HC", "BBW").
+        family: &'static str,
         grid: u32,
         needed_mib: u64,
         available_mib: u64,
         suggested: u32,
         suggested_mib: u64,
+    },
+    /// The sparse factorisation of a grid family's system failed (out of
+    /// memory while factorising, or a matrix that is not positive definite).
+    #[error("the {family} solve at grid {grid} failed: {reason}")]
+    Solver {
+        family: &'static str,
+        grid: u32,
+        reason: String,
     },
     #[error(transparent)]
     Cancelled(#[from] Cancelled),
@@ -95,7 +106,7 @@ pub struct SolveStats {
 }
 
 /// The finest frame for `grid` and the number of multigrid levels.
-fn frame_for(cage: &Cage, grid: u32) -> Result<(Frame, usize), HarmonicError> {
+pub(super) fn frame_for(cage: &Cage, grid: u32) -> Result<(Frame, usize), HarmonicError> {
     if grid < MIN_GRID {
         return Err(HarmonicError::GridTooSmall { grid });
     }
@@ -177,6 +188,7 @@ fn check_memory(cage: &Cage, plan: &HarmonicPlan, points: usize) -> Result<(), H
         suggested_bytes = smaller.predicted_bytes;
     }
     Err(HarmonicError::NotEnoughMemory {
+        family: "HC",
         grid: plan.grid,
         needed_mib: plan.predicted_bytes >> 20,
         available_mib: available >> 20,
@@ -282,7 +294,7 @@ fn right_hand_sides(level: &Level, first: usize, width: usize) -> Vec<f32> {
 
 /// Rows of points on the cage (their triangle's barycentrics) and outside it (MVC):
 /// the policy every family shares, from [`super::weights_at`].
-fn fill_boundary_and_outside(
+pub(super) fn fill_boundary_and_outside(
     points: &[DVec3],
     classes: &[PointClass],
     cage: &Cage,
@@ -316,7 +328,7 @@ fn fill_boundary_and_outside(
 }
 
 /// Maps the solve's work units onto the caller's rows, never going back.
-struct RowsProgress<'a> {
+pub(super) struct RowsProgress<'a> {
     progress: &'a BindProgress,
     rows: usize,
     units: usize,
@@ -324,7 +336,7 @@ struct RowsProgress<'a> {
 }
 
 impl<'a> RowsProgress<'a> {
-    fn new(progress: &'a BindProgress, rows: usize, units: usize) -> Self {
+    pub(super) fn new(progress: &'a BindProgress, rows: usize, units: usize) -> Self {
         Self {
             progress,
             rows,
@@ -334,7 +346,7 @@ impl<'a> RowsProgress<'a> {
     }
 
     /// `done` of the units are done.
-    fn reach(&self, done: usize) {
+    pub(super) fn reach(&self, done: usize) {
         let rows = (done.min(self.units) * self.rows) / self.units;
         let before = self
             .reported
@@ -344,7 +356,7 @@ impl<'a> RowsProgress<'a> {
         }
     }
 
-    fn finish(&self) {
+    pub(super) fn finish(&self) {
         self.reach(self.units);
     }
 }

@@ -14,10 +14,14 @@ use glam::{DVec2, DVec3};
 
 /// The boundary data at a cage point: up to four cage vertices and the value of
 /// each one's function there. On a triangle the fourth value is zero.
+/// `gradients` are the functions' surface gradients there, in the units of the
+/// points the face was given in, where known (crossings of grid lines; zero at
+/// closest points, where nothing reads them).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct BoundaryValue {
+pub(in crate::coords) struct BoundaryValue {
     pub corners: [u32; 4],
     pub values: [f64; 4],
+    pub gradients: [DVec3; 4],
 }
 
 impl BoundaryValue {
@@ -25,6 +29,7 @@ impl BoundaryValue {
         BoundaryValue {
             corners: [a, b, c, c],
             values: [wa, wb, wc, 0.0],
+            gradients: [DVec3::ZERO; 4],
         }
     }
 
@@ -32,7 +37,51 @@ impl BoundaryValue {
         BoundaryValue {
             corners,
             values: bilinear_basis(u, v),
+            gradients: [DVec3::ZERO; 4],
         }
+    }
+
+    /// With the hat functions' gradients on the triangle `q` (constant on it):
+    /// `∇φₖ = n̂ × eₖ / 2A`, eₖ the edge opposite corner k.
+    pub fn with_triangle_gradients(mut self, q: [DVec3; 3]) -> BoundaryValue {
+        let normal = (q[1] - q[0]).cross(q[2] - q[0]);
+        let twice_area = normal.length();
+        if twice_area > 0.0 {
+            let unit = normal / twice_area;
+            for k in 0..3 {
+                let edge = q[(k + 2) % 3] - q[(k + 1) % 3];
+                self.gradients[k] = unit.cross(edge) / twice_area;
+            }
+        }
+        self
+    }
+
+    /// With the bilinear basis functions' surface gradients on the patch `q`
+    /// at `(u, v)`: `[P_u P_v] G⁻¹ (∂φ/∂u, ∂φ/∂v)`, G the metric.
+    pub fn with_patch_gradients(mut self, q: &[DVec3; 4], u: f64, v: f64) -> BoundaryValue {
+        let along_u = (1.0 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
+        let along_v = (1.0 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
+        let (guu, guv, gvv) = (
+            along_u.dot(along_u),
+            along_u.dot(along_v),
+            along_v.dot(along_v),
+        );
+        let det = guu * gvv - guv * guv;
+        if det <= 0.0 {
+            return self;
+        }
+        let partials = [
+            (-(1.0 - v), -(1.0 - u)),
+            (1.0 - v, -u),
+            (v, u),
+            (-v, 1.0 - u),
+        ];
+        for (gradient, (du, dv)) in self.gradients.iter_mut().zip(partials) {
+            let a = (gvv * du - guv * dv) / det;
+            let b = (guu * dv - guv * du) / det;
+            *gradient = a * along_u + b * along_v;
+        }
+        self
     }
 }
 

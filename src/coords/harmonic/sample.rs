@@ -25,7 +25,7 @@ enum Corner {
 }
 
 /// Per inside point, its eight corners and their trilinear weights.
-pub(super) struct Sampler {
+pub(in crate::coords) struct Sampler {
     rows: Vec<(usize, [(Corner, f32); 8])>,
     /// Cage vertices and their boundary values, per outside corner used.
     hats: Vec<([u32; 4], [f32; 4])>,
