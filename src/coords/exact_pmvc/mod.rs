@@ -333,20 +333,28 @@ struct Cone {
 }
 
 impl Candidate {
-    fn vertices(&self) -> &[u32] {
-        &self.vertices[..self.count]
+    // The accessors below take the corner count as a constant, N = `count`
+    // (3, or 4 for a patch): the scan of visibility.rs is written once per
+    // pair of counts, so that on cages of triangles its loops are over 3,
+    // fully unrolled, with no test of the face's kind inside them.
+
+    fn vertices<const N: usize>(&self) -> &[u32; N] {
+        debug_assert_eq!(N, self.count);
+        self.vertices[..N].try_into().expect("N ≤ 4")
     }
 
-    fn sides(&self) -> &[EdgePlane] {
-        &self.sides[..self.count]
+    fn sides<const N: usize>(&self) -> &[EdgePlane; N] {
+        debug_assert_eq!(N, self.count);
+        self.sides[..N].try_into().expect("N ≤ 4")
     }
 
-    fn directions(&self) -> &[DVec3] {
-        &self.directions[..self.count]
+    fn directions<const N: usize>(&self) -> &[DVec3; N] {
+        debug_assert_eq!(N, self.count);
+        self.directions[..N].try_into().expect("N ≤ 4")
     }
 
-    fn holds(&self, v: u32) -> bool {
-        self.vertices().contains(&v)
+    fn holds<const N: usize>(&self, v: u32) -> bool {
+        self.vertices::<N>().contains(&v)
     }
 
     /// The distance from x to the face along the unit direction `d`, inside
@@ -368,15 +376,15 @@ impl Candidate {
     /// plane: positive beyond it, as seen from x; 0 for its own corners.
     /// Triangles only.
     fn plane_side(&self, v: u32, p: DVec3) -> f64 {
-        if self.holds(v) {
+        if self.holds::<3>(v) {
             0.0
         } else {
             self.normal.dot(p) - self.offset
         }
     }
 
-    /// The corners of its cone (the first `count`).
-    fn corners(&self) -> [Corner; 4] {
+    /// The corners of its cone (N = `count`).
+    fn corners<const N: usize>(&self) -> [Corner; N] {
         std::array::from_fn(|k| Corner {
             direction: self.directions[k],
             label: Label::Vertex(self.vertices[k]),

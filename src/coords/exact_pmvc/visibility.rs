@@ -2,7 +2,7 @@
 //! candidates in front of it, as convex pieces.
 
 use super::polygon::{clip, side_of, Corner, EdgePlane, Label};
-use super::{Candidate, Cone, ExactPmvcScratch};
+use super::{Candidate, Cone, ExactPmvcScratch, ExactPmvcStats};
 use glam::DVec3;
 
 #[derive(Debug, Default)]
@@ -55,20 +55,22 @@ enum Order {
     Probe,
 }
 
-/// Where b lies against a's plane (a quad's slab, which holds its patch):
-/// `Some(true)` wholly beyond it seen from x, `Some(false)` wholly on x's
-/// side, `None` across it.
-fn against(a: &Candidate, b: &Candidate, relative: &[DVec3]) -> Option<bool> {
-    if a.quad.is_none() {
-        let sides = || {
-            b.vertices()
-                .iter()
-                .map(|&v| a.plane_side(v, relative[v as usize]))
-        };
-        if sides().all(|d| d >= 0.0) {
+/// Where b (B corners) lies against a's plane (A corners; a quad's slab,
+/// which holds its patch): `Some(true)` wholly beyond it seen from x,
+/// `Some(false)` wholly on x's side, `None` across it.
+#[inline]
+fn against<const A: usize, const B: usize>(
+    a: &Candidate,
+    b: &Candidate,
+    relative: &[DVec3],
+) -> Option<bool> {
+    let vertices = b.vertices::<B>();
+    if A == 3 {
+        let sides = vertices.map(|v| a.plane_side(v, relative[v as usize]));
+        if sides.iter().all(|&d| d >= 0.0) {
             return Some(true);
         }
-        if sides().all(|d| d <= 0.0) {
+        if sides.iter().all(|&d| d <= 0.0) {
             return Some(false);
         }
         return None;
@@ -77,15 +79,11 @@ fn against(a: &Candidate, b: &Candidate, relative: &[DVec3]) -> Option<bool> {
     if a.offset.is_nan() || a.offset <= 0.0 {
         return None;
     }
-    let along = || {
-        b.vertices()
-            .iter()
-            .map(|&v| a.normal.dot(relative[v as usize]))
-    };
-    if along().all(|d| d >= a.far_offset) {
+    let along = vertices.map(|v| a.normal.dot(relative[v as usize]));
+    if along.iter().all(|&d| d >= a.far_offset) {
         return Some(true);
     }
-    if along().all(|d| d <= a.offset) {
+    if along.iter().all(|&d| d <= a.offset) {
         return Some(false);
     }
     None
@@ -95,12 +93,17 @@ fn against(a: &Candidate, b: &Candidate, relative: &[DVec3]) -> Option<bool> {
 /// their planes tell: s wholly beyond t's plane (seen from x) is behind it,
 /// wholly on x's side of it in front, and the same for t against s's plane.
 /// A quad's plane is the slab between its corners across its diagonals'
-/// normal, which holds its patch.
-fn order(t: &Candidate, s: &Candidate, relative: &[DVec3]) -> Order {
-    match against(t, s, relative) {
+/// normal, which holds its patch. T and S are their corner counts.
+#[inline]
+fn order<const T: usize, const S: usize>(
+    t: &Candidate,
+    s: &Candidate,
+    relative: &[DVec3],
+) -> Order {
+    match against::<T, S>(t, s, relative) {
         Some(true) => Order::Behind,
         Some(false) => Order::Front,
-        None => match against(s, t, relative) {
+        None => match against::<S, T>(s, t, relative) {
             Some(true) => Order::Front,
             Some(false) => Order::Behind,
             None => Order::Probe,
@@ -111,6 +114,17 @@ fn order(t: &Candidate, s: &Candidate, relative: &[DVec3]) -> Order {
 /// Fills `scratch.pieces` with the part of candidate t that x sees first:
 /// its cone less those of the candidates in front of it.
 pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
+    // One scan per corner count of t, and one test per count of the other
+    // face: the loops over corners have a constant length.
+    if scratch.candidates[t].count == 3 {
+        scan::<3>(t, scratch);
+    } else {
+        scan::<4>(t, scratch);
+    }
+}
+
+/// [`visible_pieces`] for a candidate t of T corners.
+fn scan<const T: usize>(t: usize, scratch: &mut ExactPmvcScratch) {
     let ExactPmvcScratch {
         relative,
         directions,
@@ -127,8 +141,7 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
     let target = &candidates[t];
     let target_cone = &cones[t];
     pieces.clear();
-    let corners = target.corners();
-    pieces.push(&corners[..target.count]);
+    pieces.push(&target.corners::<T>());
     for (s, cone) in cones.iter().enumerate() {
         if cone.nearest >= target.farthest {
             // This one and all after it are wholly farther than t.
@@ -140,26 +153,24 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
         }
         stats.cones_overlapping += 1;
         let occluder = &candidates[s];
-        // The cheaper tests first: depth by planes, then overlap.
-        let order = order(target, occluder, relative);
-        if matches!(order, Order::Behind) {
-            stats.behind += 1;
+        let buffers = (&mut *work, &mut *cut, &mut *sides);
+        let occludes = if occluder.count == 3 {
+            occludes::<T, 3>(target, occluder, directions, relative, buffers, stats)
+        } else {
+            occludes::<T, 4>(target, occluder, directions, relative, buffers, stats)
+        };
+        if !occludes {
             continue;
-        }
-        if triangles_separated(target, occluder, directions) {
-            stats.separated += 1;
-            continue;
-        }
-        if matches!(order, Order::Probe) {
-            stats.probed += 1;
-            if !probe_in_front(target, occluder, directions, relative, work, cut, sides) {
-                continue;
-            }
         }
         next.clear();
         stats.occluding += 1;
         for piece in pieces.iter() {
-            if subtract(piece, occluder, directions, next, work, cut, sides) {
+            let overlapped = if occluder.count == 3 {
+                subtract::<3>(piece, occluder, directions, next, work, cut, sides)
+            } else {
+                subtract::<4>(piece, occluder, directions, next, work, cut, sides)
+            };
+            if overlapped {
                 stats.splits += 1;
             }
         }
@@ -170,10 +181,37 @@ pub(super) fn visible_pieces(t: usize, scratch: &mut ExactPmvcScratch) {
     }
 }
 
+/// Whether s (S corners) is in front of t (T corners) somewhere both are
+/// seen: the cheaper tests first, depth by planes, then overlap, then a ray.
+#[inline]
+fn occludes<const T: usize, const S: usize>(
+    target: &Candidate,
+    occluder: &Candidate,
+    directions: &[DVec3],
+    relative: &[DVec3],
+    (work, cut, sides): (&mut Vec<Corner>, &mut Vec<Corner>, &mut Vec<f64>),
+    stats: &mut ExactPmvcStats,
+) -> bool {
+    let order = order::<T, S>(target, occluder, relative);
+    if matches!(order, Order::Behind) {
+        stats.behind += 1;
+        return false;
+    }
+    if faces_separated::<T, S>(target, occluder, directions) {
+        stats.separated += 1;
+        return false;
+    }
+    if matches!(order, Order::Probe) {
+        stats.probed += 1;
+        return probe_in_front::<T, S>(target, occluder, directions, relative, work, cut, sides);
+    }
+    true
+}
+
 /// Whether s is in front of t over the overlap of their cones, by one ray
 /// through it; false when they do not overlap. With a quad, the order is
 /// taken to hold over the whole overlap, as it does for planar faces.
-fn probe_in_front(
+fn probe_in_front<const T: usize, const S: usize>(
     t: &Candidate,
     s: &Candidate,
     directions: &[DVec3],
@@ -183,8 +221,8 @@ fn probe_in_front(
     sides: &mut Vec<f64>,
 ) -> bool {
     work.clear();
-    work.extend_from_slice(&t.corners()[..t.count]);
-    for plane in s.sides() {
+    work.extend_from_slice(&t.corners::<T>());
+    for plane in s.sides::<S>() {
         sides.clear();
         sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
         cut.clear();
@@ -194,7 +232,7 @@ fn probe_in_front(
         std::mem::swap(work, cut);
     }
     let d: DVec3 = work.iter().map(|c| c.direction).sum();
-    if t.quad.is_none() && s.quad.is_none() {
+    if T == 3 && S == 3 {
         // t_s < t_t, with t = offset / (N·d) and both N·d > 0 inside both cones.
         return s.offset * d.dot(t.normal) < t.offset * d.dot(s.normal);
     }
@@ -204,7 +242,7 @@ fn probe_in_front(
 /// Appends to `out` the parts of `piece` outside the cone of `occluder`, cut
 /// along its sides in turn. Returns whether the two overlapped (the piece was
 /// cut or hidden).
-fn subtract(
+fn subtract<const S: usize>(
     piece: &[Corner],
     occluder: &Candidate,
     directions: &[DVec3],
@@ -213,13 +251,13 @@ fn subtract(
     cut: &mut Vec<Corner>,
     sides: &mut Vec<f64>,
 ) -> bool {
-    if separated(piece, occluder, directions) {
+    if separated::<S>(piece, occluder, directions) {
         out.push(piece);
         return false;
     }
     work.clear();
     work.extend_from_slice(piece);
-    for plane in occluder.sides() {
+    for plane in occluder.sides::<S>() {
         sides.clear();
         sides.extend(work.iter().map(|c| side_of(c.direction, c.label, plane)));
         if sides.iter().all(|&d| d >= 0.0) {
@@ -249,31 +287,37 @@ fn subtract(
     true
 }
 
-/// Whether a side of either face has the other wholly on its outer side:
-/// then their cones do not overlap.
-fn triangles_separated(t: &Candidate, s: &Candidate, directions: &[DVec3]) -> bool {
-    if !t.vertices().iter().any(|v| s.holds(*v)) {
+/// Whether a side of either face (t of T corners, s of S) has the other
+/// wholly on its outer side: then their cones do not overlap.
+#[inline]
+fn faces_separated<const T: usize, const S: usize>(
+    t: &Candidate,
+    s: &Candidate,
+    directions: &[DVec3],
+) -> bool {
+    if !t.vertices::<T>().iter().any(|&v| s.holds::<S>(v)) {
         // No corner in common: no side is exactly 0 by its label.
         let outside = |plane: &EdgePlane, corners: &[DVec3]| {
             corners
                 .iter()
                 .all(|&d| plane.normal.dot(d) <= plane.tolerance)
         };
-        return t.sides().iter().any(|plane| outside(plane, s.directions()))
-            || s.sides().iter().any(|plane| outside(plane, t.directions()));
+        return (t.sides::<T>().iter()).any(|plane| outside(plane, s.directions::<S>()))
+            || (s.sides::<S>().iter()).any(|plane| outside(plane, t.directions::<T>()));
     }
     let outside = |plane: &EdgePlane, corners: &[u32]| {
         corners
             .iter()
             .all(|&v| side_of(directions[v as usize], Label::Vertex(v), plane) <= 0.0)
     };
-    t.sides().iter().any(|plane| outside(plane, s.vertices()))
-        || s.sides().iter().any(|plane| outside(plane, t.vertices()))
+    (t.sides::<T>().iter()).any(|plane| outside(plane, s.vertices::<S>()))
+        || (s.sides::<S>().iter()).any(|plane| outside(plane, t.vertices::<T>()))
 }
 
-/// Whether a side of either polygon has the other wholly on its outer side.
-fn separated(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bool {
-    let by_occluder = occluder.sides().iter().any(|plane| {
+/// Whether a side of either polygon has the other (of S corners) wholly on
+/// its outer side.
+fn separated<const S: usize>(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bool {
+    let by_occluder = occluder.sides::<S>().iter().any(|plane| {
         piece
             .iter()
             .all(|c| side_of(c.direction, c.label, plane) <= 0.0)
@@ -281,7 +325,7 @@ fn separated(piece: &[Corner], occluder: &Candidate, directions: &[DVec3]) -> bo
     by_occluder
         || piece.iter().any(|corner| {
             occluder
-                .vertices()
+                .vertices::<S>()
                 .iter()
                 .all(|&v| side_of(directions[v as usize], Label::Vertex(v), &corner.side) <= 0.0)
         })
