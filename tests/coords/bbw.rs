@@ -220,3 +220,22 @@ fn a_cancelled_bind_stops() {
     let error = bind_bbw(&points, &classes.classes, &cage, 16, &progress).unwrap_err();
     assert!(matches!(error, HarmonicError::Cancelled(_)), "{error}");
 }
+
+/// Time and memory of BBW at its default grid on the shared models (what
+/// `pmvc bench` rows measure), for the docs; long, so not run by default.
+#[test]
+#[ignore]
+fn cost_on_the_shared_models() {
+    for name in procedural::table1_scene_names() {
+        let scene = procedural::table1_scene(name).unwrap();
+        let planned = plan(&scene.cage, 32, scene.points.len()).unwrap();
+        let start = std::time::Instant::now();
+        let _ = bind(&scene.cage, &scene.points, 32);
+        println!(
+            "{name}: {} cage vertices, {} points, {planned:?}, {:.1} s",
+            scene.cage.vertex_count(),
+            scene.points.len(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+}
