@@ -66,7 +66,9 @@ fn options(method: Method) -> BindOptions {
     BindOptions {
         method,
         resolution: 32,
-        grid: 32,
+        // BBW's factor on a box-shaped cage grows as the grid's fourth power:
+        // a coarse grid keeps this test about the offsets, not the solve.
+        grid: if method == Method::Bbw { 12 } else { 32 },
         quads: pmvc::coords::QuadSplit::None,
     }
 }
