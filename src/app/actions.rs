@@ -93,6 +93,8 @@ pub enum Action {
     NextMethod,
     /// A family parameter, checked by its spec.
     SetParameter(Parameter, u32),
+    /// One family's parameter, shown or not (the side panel's controls).
+    SetFamilyParameter(Method, u32),
     /// Bind quads as bilinear patches, or split along a diagonal (`--triangulate`).
     SetQuadSplit(crate::coords::QuadSplit),
     /// Bind the methods the views show, replacing a running bind.

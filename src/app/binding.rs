@@ -7,17 +7,28 @@ use super::bind_queue::BindQueue;
 use super::compare::ViewSettings;
 use super::document::Document;
 use crate::coords::{BindOptions, Method, Parameter, QuadSplit, QuadSupport};
+use std::collections::BTreeMap;
 
-/// `options` with the parameters `pmvc edit` was given put over them, each
-/// checked by its spec; a refused value leaves the option as it was and is
-/// returned as a message.
+/// Whether another family has a parameter of the same kind as `method`'s.
+fn shares_parameter_kind(method: Method) -> bool {
+    let Some(spec) = method.spec().parameter else {
+        return false;
+    };
+    Method::ALL
+        .iter()
+        .any(|&other| other != method && other.spec().parameter.is_some_and(|p| p.key == spec.key))
+}
+
+/// The parameters `pmvc edit` was given put over `binding`'s, each checked by
+/// its spec and given to every family that reads it; a refused value leaves the
+/// parameter as it was and is returned as a message.
 pub(super) fn with_asked_parameters(
-    options: &mut crate::coords::BindOptions,
+    binding: &mut Binding,
     asked: &super::options::EditorOptions,
 ) -> Vec<String> {
     let mut refused = Vec::new();
     if let Some(split) = asked.triangulate {
-        options.quads = split;
+        binding.options.quads = split;
     }
     for (parameter, value) in [
         (Parameter::Resolution, asked.resolution),
@@ -25,7 +36,7 @@ pub(super) fn with_asked_parameters(
     ] {
         if let Some(value) = value {
             match parameter.validate(value.into()) {
-                Ok(value) => options.set(parameter, value),
+                Ok(value) => binding.ask_for_every_family(parameter, value),
                 Err(error) => refused.push(error.to_string()),
             }
         }
@@ -51,8 +62,14 @@ pub fn wanted_methods(active: Method, view: &ViewSettings) -> Vec<Method> {
 /// The bind queue and what it binds with.
 pub struct Binding {
     pub queue: BindQueue,
-    /// The method a single view shows (`options.method`) and every family's parameters.
+    /// The method a single view shows (`options.method`), its parameter, and
+    /// the parameters of the families that share none with it.
     pub options: BindOptions,
+    /// The parameter each family not shown was last bound with, where it
+    /// shares its kind with another family (harmonic coordinates' and BBW's
+    /// grids): each keeps its own value, so BBW does not take harmonic
+    /// coordinates' grid of 64. A family not here has its default.
+    shared_kind_values: BTreeMap<Method, u32>,
     /// After a cancel, views stop asking for binds until the user binds again.
     pub paused: bool,
 }
@@ -62,8 +79,28 @@ impl Binding {
         Self {
             queue,
             options,
+            shared_kind_values: BTreeMap::new(),
             paused: false,
         }
+    }
+
+    /// `pmvc edit --grid N` and the like: the value for every family that
+    /// reads `parameter`, shown or not.
+    pub fn ask_for_every_family(&mut self, parameter: Parameter, value: u32) {
+        self.options.set(parameter, value);
+        for method in Method::ALL {
+            let reads_it = method.spec().parameter.is_some_and(|p| p.key == parameter);
+            if reads_it && shares_parameter_kind(method) {
+                self.shared_kind_values.insert(method, value);
+            }
+        }
+    }
+
+    /// Options put in place as a whole (a session, an undo step): the
+    /// families not shown take their defaults again.
+    pub fn replace_options(&mut self, options: BindOptions) {
+        self.options = options;
+        self.shared_kind_values.clear();
     }
 
     /// The method a single view shows.
@@ -80,11 +117,18 @@ impl Binding {
             QuadSupport::Patches { .. } => self.options.quads,
             QuadSupport::Triangles => QuadSplit::None,
         };
-        BindOptions {
+        let mut options = BindOptions {
             method,
             quads,
             ..self.options
+        };
+        if method != self.options.method && shares_parameter_kind(method) {
+            if let Some(spec) = method.spec().parameter {
+                let value = self.shared_kind_values.get(&method);
+                options.set(spec.key, value.copied().unwrap_or(spec.default));
+            }
         }
+        options
     }
 
     /// Bind the cage's quads as bilinear patches or split along a diagonal;
@@ -162,28 +206,77 @@ impl Binding {
         if method == self.options.method {
             return false;
         }
+        let shown = self.options.method;
+        if shares_parameter_kind(shown) {
+            if let Some(spec) = shown.spec().parameter {
+                let value = self.options.get(spec.key);
+                self.shared_kind_values.insert(shown, value);
+            }
+        }
+        let parameter = self.options_for(method).parameter();
         self.options.method = method;
+        if let Some((spec, value)) = parameter {
+            self.options.set(spec.key, value);
+        }
         true
     }
 
-    /// Set a family parameter (PMVC's resolution, …) checked by its spec; the
-    /// families that read it are bound again, the others keep their weights.
-    /// False when it was already set.
+    /// Set a parameter (PMVC's resolution, …) checked by its spec: the shown
+    /// family's where it reads it, else every family's that does. The
+    /// families whose value changed are bound again, the others keep their
+    /// weights. False when it was already set.
     pub fn set_parameter(&mut self, parameter: Parameter, value: u32) -> Result<bool, String> {
         let value = parameter
             .validate(value.into())
             .map_err(|error| error.to_string())?;
-        if self.options.get(parameter) == value {
-            return Ok(false);
+        let shown_reads_it = self
+            .options
+            .method
+            .spec()
+            .parameter
+            .is_some_and(|p| p.key == parameter);
+        let before: Vec<BindOptions> = Method::ALL.map(|m| self.options_for(m)).to_vec();
+        if shown_reads_it {
+            self.options.set(parameter, value);
+        } else {
+            self.ask_for_every_family(parameter, value);
         }
-        self.options.set(parameter, value);
-        for method in Method::ALL {
-            if method.spec().parameter.is_some_and(|p| p.key == parameter) {
+        self.drop_changed(&before)
+    }
+
+    /// Set `family`'s parameter, checked by its spec, whether it is shown or
+    /// not (the side panel's controls); only the families whose value changed
+    /// are bound again. False when it was already set.
+    pub fn set_family_parameter(&mut self, family: Method, value: u32) -> Result<bool, String> {
+        let Some(spec) = family.spec().parameter else {
+            return Ok(false);
+        };
+        if family == self.options.method || !shares_parameter_kind(family) {
+            let before: Vec<BindOptions> = Method::ALL.map(|m| self.options_for(m)).to_vec();
+            let value = spec.validate(value.into()).map_err(|e| e.to_string())?;
+            self.options.set(spec.key, value);
+            return self.drop_changed(&before);
+        }
+        let value = spec.validate(value.into()).map_err(|e| e.to_string())?;
+        let before: Vec<BindOptions> = Method::ALL.map(|m| self.options_for(m)).to_vec();
+        self.shared_kind_values.insert(family, value);
+        self.drop_changed(&before)
+    }
+
+    /// Forget the weights of the families whose options differ from `before`
+    /// (one per [`Method::ALL`]); whether any did.
+    fn drop_changed(&mut self, before: &[BindOptions]) -> Result<bool, String> {
+        let mut changed = false;
+        for (method, before) in Method::ALL.into_iter().zip(before) {
+            if !self.options_for(method).same_weights_as(before) {
                 self.queue.drop_method(method);
+                changed = true;
             }
         }
-        self.paused = false;
-        Ok(true)
+        if changed {
+            self.paused = false;
+        }
+        Ok(changed)
     }
 
     /// Cancel the running bind and those queued after it. The controls go back to

@@ -13,8 +13,11 @@ use crate::coords::{BindOptions, Method};
 /// What the panels show besides the document, gathered by the editor each frame.
 #[derive(Clone, Debug, Default)]
 pub struct Shown {
-    /// The method a single view shows and every family's parameters.
+    /// The method a single view shows and its parameters.
     pub bind_options: BindOptions,
+    /// Each family's parameter value, as it binds (harmonic coordinates and
+    /// BBW each have a grid of their own).
+    pub family_parameters: Vec<(Method, u32)>,
     pub view: ViewSettings,
     pub highlight_outside: bool,
     /// The running bind, for the progress bar.

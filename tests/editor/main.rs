@@ -38,6 +38,8 @@ mod editor_offscreen;
 #[cfg(feature = "ui-tests")]
 mod editor_panels;
 #[cfg(feature = "ui-tests")]
+mod editor_parameters;
+#[cfg(feature = "ui-tests")]
 mod editor_pose_tools;
 #[cfg(feature = "ui-tests")]
 mod editor_quads;

@@ -14,6 +14,7 @@ use crate::app::model::Model;
 use crate::app::shortcuts::{pressed, Scope, Shortcut};
 use crate::app::ui::{generate_cage, menu, side_panel, toolbar};
 use crate::app::views::{ViewportContext, ViewportFacts, Views};
+use crate::coords::Method;
 
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
@@ -161,6 +162,10 @@ impl EditorApp {
     fn shown(&self) -> Shown {
         Shown {
             bind_options: self.binding.options,
+            family_parameters: Method::ALL
+                .into_iter()
+                .filter_map(|m| Some((m, self.binding.options_for(m).parameter()?.1)))
+                .collect(),
             view: self.views.settings,
             highlight_outside: self.views.highlight_outside,
             bind_status: self.binding.queue.status(),

@@ -176,16 +176,17 @@ impl EditorApp {
         let wake_ctx = cc.egui_ctx.clone();
         // The comb is generated, so it cannot fail to load.
         let (mesh, cage) = (scenes::comb_mesh(), scenes::comb_cage());
-        let mut bind_options = BindOptions::for_method(options.method.unwrap_or(Method::Pmvc));
-        let refused_parameters = binding::with_asked_parameters(&mut bind_options, &options);
+        let bind_options = BindOptions::for_method(options.method.unwrap_or(Method::Pmvc));
         let queue = BindQueue::new(backend, request, move || wake_ctx.request_repaint());
+        let mut binding = Binding::new(queue, bind_options);
+        let refused_parameters = binding::with_asked_parameters(&mut binding, &options);
         let mut app = Self {
             gpu,
             model: Model::new(
                 Document::new(BundledScene::Comb.title(), mesh, cage)
                     .bundled_as(BundledScene::Comb),
             ),
-            binding: Binding::new(queue, bind_options),
+            binding,
             views: Views::new(options.view),
             panels: Panels {
                 cage_window: CageGeneration::new(cc.egui_ctx.clone()),
@@ -288,9 +289,9 @@ impl EditorApp {
         self.views.settings =
             super::session::view_with_overrides(self.views.settings, options.view);
         if let Some(method) = options.method {
-            self.binding.options.method = method;
+            self.binding.set_active_method(method);
         }
-        for refused in binding::with_asked_parameters(&mut self.binding.options, options) {
+        for refused in binding::with_asked_parameters(&mut self.binding, options) {
             self.error(refused);
         }
     }
@@ -427,7 +428,7 @@ impl EditorApp {
             Cameras::Session(cameras) => self.views.viewport.set_first_cameras(&cameras),
         }
         if let Some((bind_options, view)) = settings {
-            self.binding.options = bind_options;
+            self.binding.replace_options(bind_options);
             self.views.settings = view;
             // A session's pose is on disk: quitting keeps it.
             self.apply(Command::MarkSessionSaved);
@@ -486,7 +487,7 @@ impl EditorApp {
     fn reinstate_document(&mut self, swapped: &Swapped) {
         self.document_swapped(!swapped.same_mesh);
         if let Some(view) = swapped.view {
-            self.binding.options = view.bind_options;
+            self.binding.replace_options(view.bind_options);
             self.views.settings = view.view;
             self.views.viewport.set_cameras(view.cameras);
         }

@@ -133,6 +133,13 @@ impl EditorApp {
                     Err(error) => self.error(error),
                 }
             }
+            Action::SetFamilyParameter(family, value) => {
+                match self.binding.set_family_parameter(family, value) {
+                    Ok(true) => self.request_wanted_binds(),
+                    Ok(false) => {}
+                    Err(error) => self.error(error),
+                }
+            }
             Action::SetQuadSplit(split) => {
                 if self.binding.set_quad_split(split) {
                     self.request_wanted_binds();

@@ -11,7 +11,7 @@ use crate::app::ui::pose_panel::PosePanel;
 use crate::app::ui::quality_table::quality_table;
 use crate::app::ui::statistics::StatisticsPanel;
 use crate::app::ui::timeline::TimelinePanel;
-use crate::coords::{Method, QuadSplit};
+use crate::coords::QuadSplit;
 use std::time::Duration;
 
 /// The panels the side panel shows below its own sections.
@@ -55,13 +55,13 @@ pub fn side_panel(ui: &mut egui::Ui, cx: &mut PanelContext, sections: Sections) 
 }
 
 fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context) {
-    let bind_options = cx.shown().bind_options;
+    let family_parameters = cx.shown().family_parameters.clone();
     ui.label("Binding");
-    for family in Method::ALL {
+    for (family, bound_value) in family_parameters {
         let Some(spec) = family.spec().parameter else {
             continue;
         };
-        let mut value = bind_options.get(spec.key);
+        let mut value = bound_value;
         egui::ComboBox::from_label(spec.label)
             .selected_text((spec.format)(value))
             .show_ui(ui, |ui| {
@@ -69,8 +69,8 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
                     ui.selectable_value(&mut value, choice, (spec.format)(choice));
                 }
             });
-        if value != bind_options.get(spec.key) {
-            cx.send(Action::SetParameter(spec.key, value));
+        if value != bound_value {
+            cx.send(Action::SetFamilyParameter(family, value));
         }
     }
     quads_choice(ui, cx);
@@ -119,7 +119,7 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
             cx.send(Action::StartBind);
         }
     }
-    if let Some(set) = cx.document().bound(bind_options.method) {
+    if let Some(set) = cx.document().bound(cx.shown().bind_options.method) {
         ui.label(format!("Bound on {}", set.device));
     }
     if cx.document().bound_methods().next().is_some() {
