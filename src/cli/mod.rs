@@ -129,7 +129,7 @@ pub struct MethodChoice {
     /// PMVC cube-map resolution: texels along one face edge (1–1024), or `exact`: the visible cage integrated with no cube map, on the CPU (triangles in closed form, quads as bilinear patches by adaptive quadrature).
     #[arg(long, default_value_t = crate::coords::DEFAULT_RESOLUTION, value_parser = parse_resolution)]
     pub resolution: u32,
-    /// Harmonic coordinates and BBW: grid cells along the cage's longest side (4–2048; default 64 for harmonic coordinates, 32 for BBW).
+    /// Harmonic coordinates and BBW: grid cells along the cage's longest side (4–2048); default 64 for harmonic coordinates, 32 for BBW.
     #[arg(long, value_parser = parse_grid)]
     pub grid: Option<u32>,
     /// Split the cage's quads into triangles along their shorter or longer diagonal
@@ -272,7 +272,7 @@ pub struct EditArgs {
     /// PMVC cube-map resolution (1–1024), or `exact` (no cube map).
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<u32>,
-    /// Harmonic grid: cells along the cage's longest side (4–2048).
+    /// Harmonic coordinates and BBW: grid cells along the cage's longest side (4–2048), for both; without it 64 and 32.
     #[arg(long, value_parser = parse_grid)]
     pub grid: Option<u32>,
     /// Bind the cage's quads split along their shorter or longer diagonal
