@@ -33,8 +33,18 @@ def parameter_specs():
 
 
 def parameters_for(method, values):
-    """The parameters ``method`` reads, from ``values`` (a dict of every one)."""
-    return {p["id"]: int(values[p["id"]]) for p in family(method)["parameters"] if p["id"] in values}
+    """The parameters ``method`` reads, from ``values`` (a dict of every one).
+
+    Families share a setting by its id (harmonic coordinates' and BBW's grid);
+    left at the setting's default, each family takes its own default (BBW's
+    grid is 32, not harmonic coordinates' 64)."""
+    shared = parameter_specs()
+    chosen = {}
+    for p in family(method)["parameters"]:
+        if p["id"] in values:
+            value = int(values[p["id"]])
+            chosen[p["id"]] = p["default"] if value == shared[p["id"]]["default"] else value
+    return chosen
 
 
 def mesh_and_cage(context):
