@@ -8,6 +8,8 @@ use super::actions::FileRole;
 use super::cage_generation::{cage_reaches, loose_box_cage, Proposal};
 use super::compare::ViewSettings;
 use super::document::Document;
+pub use super::file_objects::ObjectNames;
+use super::file_objects::{object_note, recent_file};
 use super::recent::RecentEntry;
 use super::scenes::BundledScene;
 use super::session::{self, SessionSettings};
@@ -165,27 +167,6 @@ pub fn open_pair(
     Ok(change)
 }
 
-/// Which object of the mesh file and of the cage file to read (`pmvc edit
-/// --mesh-object`, the side panel's choice); `None`: the file's default.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ObjectNames<'a> {
-    pub mesh: Option<&'a str>,
-    pub cage: Option<&'a str>,
-}
-
-/// A file's note of which of its objects was read, as a notice naming it,
-/// with where to choose another.
-fn object_note(path: &Path, note: Option<String>) -> Vec<String> {
-    note.map(|note| {
-        format!(
-            "{}: {note}; choose another in the side panel",
-            shown_path(path)
-        )
-    })
-    .into_iter()
-    .collect()
-}
-
 /// The mesh replaced (the cage kept) or the cage replaced (the mesh kept),
 /// by object `object` of the file (its default where `None`). A mesh the
 /// current cage holds none of sits in a loose box instead.
@@ -234,18 +215,6 @@ pub fn open_file(
         .done(format!("opened {}", shown_path(path)));
     change.notes = notes;
     Ok(change)
-}
-
-/// File > Recent's entry for object `object` of `path` (the file's default
-/// where `None`) read as the mesh or the cage.
-fn recent_file(role: FileRole, path: &Path, object: Option<&str>) -> RecentEntry {
-    let path = path.to_owned();
-    match (role, object.map(String::from)) {
-        (FileRole::Mesh, None) => RecentEntry::Mesh(path),
-        (FileRole::Cage, None) => RecentEntry::Cage(path),
-        (FileRole::Mesh, Some(object)) => RecentEntry::MeshObject { path, object },
-        (FileRole::Cage, Some(object)) => RecentEntry::CageObject { path, object },
-    }
 }
 
 /// A mesh with no cage (`pmvc edit MESH`).

@@ -34,6 +34,7 @@ pub mod compare;
 pub mod ctx;
 pub mod editor;
 mod exports;
+mod file_objects;
 mod files;
 mod focus;
 pub mod model;
