@@ -186,6 +186,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         (Method::Harmonic, 64),
         (Method::Harmonic, 128),
         (Method::Bbw, crate::coords::bbw::DEFAULT_GRID),
+        (Method::Lbc, crate::coords::lbc::DEFAULT_GRID),
     ];
     for name in procedural::table1_scene_names() {
         if let Some(scene) = procedural::table1_scene(name).filter(|_| wanted(name)) {

@@ -35,6 +35,10 @@ pub enum Method {
     /// bound-constrained quadratic programme per cage vertex on the harmonic
     /// solve's grid.
     Bbw,
+    /// Local barycentric coordinates (Zhang, Deng, Hormann, Zheng 2014), by a
+    /// total-variation minimisation of every cage vertex's weight together,
+    /// subject to the barycentric constraints, on the harmonic solve's grid.
+    Lbc,
 }
 
 /// A family's one integer parameter (a resolution, a grid size).
@@ -301,6 +305,16 @@ const BBW_GRID: ParameterSpec = ParameterSpec {
     ..GRID
 };
 
+/// Local barycentric coordinates' grid: the `--grid` of harmonic coordinates,
+/// with a smaller default, since every cage vertex's weights are solved
+/// together (memory grows with the grid's cube times the cage's vertices).
+const LBC_GRID: ParameterSpec = ParameterSpec {
+    label: "LBC grid",
+    choices: &[16, 32, 48],
+    default: super::lbc::DEFAULT_GRID,
+    ..GRID
+};
+
 const PMVC: FamilySpec = FamilySpec {
     id: "pmvc",
     name: "PMVC",
@@ -381,9 +395,23 @@ const BBW: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const LBC: FamilySpec = FamilySpec {
+    id: "lbc",
+    name: "LBC",
+    summary:
+        "local barycentric coordinates: a grid solve of least total variation, positive and local",
+    parameter: Some(LBC_GRID),
+    columns: ColumnLayout::CageVertices,
+    positive_inside: true,
+    outside_policy: OUTSIDE_BY_MVC,
+    rows_independent: false,
+    quads: QuadSupport::Patches { name: "LBC" },
+    quads_reason: "",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
@@ -391,6 +419,7 @@ impl Method {
         Method::Mec,
         Method::Mlc,
         Method::Bbw,
+        Method::Lbc,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -402,6 +431,7 @@ impl Method {
             Method::Mec => &MEC,
             Method::Mlc => &MLC,
             Method::Bbw => &BBW,
+            Method::Lbc => &LBC,
         }
     }
 

@@ -2,7 +2,7 @@
 //! coordinates in closed form ([`mvc`]), the CPU reference for positive mean value
 //! coordinates ([`pmvc`]), harmonic coordinates ([`harmonic`]), maximum entropy
 //! coordinates ([`mec`]), maximum likelihood coordinates ([`mlc`]), bounded
-//! biharmonic weights ([`bbw`]), and the
+//! biharmonic weights ([`bbw`]), local barycentric coordinates ([`lbc`]), and the
 //! dense weights matrix they fill. Nothing here touches the GPU or the UI.
 //!
 //! Policy for vertices that are not strictly inside the cage:
@@ -32,6 +32,7 @@ pub mod exact_pmvc;
 pub mod family;
 pub mod green;
 pub mod harmonic;
+pub mod lbc;
 pub mod mec;
 pub mod mlc;
 pub mod mvc;
@@ -231,8 +232,21 @@ fn bind_on_grid(
     options: BindOptions,
     progress: &BindProgress,
 ) -> Result<Weights, BindFailure> {
+    if !classes
+        .iter()
+        .any(|class| matches!(class, PointClass::Inside))
+    {
+        // Nothing is sampled from the grid: every row is the boundary's or
+        // the outside policy's. The grid is still checked, as a solve would.
+        harmonic::frame_for(cage, options.grid)?;
+        let mut weights = Weights::zeros(points.len(), cage.vertex_count());
+        harmonic::fill_boundary_and_outside(points, classes, cage, &mut weights);
+        progress.advance(points.len());
+        return Ok(weights);
+    }
     Ok(match options.method {
         Method::Bbw => bbw::bind_bbw(points, classes, cage, options.grid, progress)?.0,
+        Method::Lbc => lbc::bind_lbc(points, classes, cage, options.grid, progress)?.0,
         _ => harmonic::bind_harmonic(points, classes, cage, options.grid, progress)?.0,
     })
 }
@@ -431,7 +445,7 @@ pub fn weights_at(
         PointClass::Inside => match method {
             // Grid families have no per-point form; bind_cpu solves them
             // whole. Asked for one row, MVC is the outside policy's answer.
-            Method::Mvc | Method::Harmonic | Method::Bbw | Method::Green => {
+            Method::Mvc | Method::Harmonic | Method::Bbw | Method::Lbc | Method::Green => {
                 mvc::mvc_weights(x, cage, out, mvc_scratch)
             }
             Method::Pmvc => {

@@ -87,7 +87,13 @@ fn families_without_a_kernel_always_bind_on_the_cpu() {
         .into_iter()
         .filter(|&method| Kernel::of(method).is_none())
         .collect();
-    for family in [Method::Harmonic, Method::Mec, Method::Mlc, Method::Bbw] {
+    for family in [
+        Method::Harmonic,
+        Method::Mec,
+        Method::Mlc,
+        Method::Bbw,
+        Method::Lbc,
+    ] {
         assert!(cpu_only.contains(&family), "{family}");
     }
     for method in cpu_only {

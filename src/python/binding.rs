@@ -143,8 +143,9 @@ fn choose_backend(
 ///
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
 /// cube-map resolution (or ``"exact"``: no cube map, the visible cage
-/// integrated in closed form on the CPU), ``grid`` harmonic coordinates' grid (each read only by
-/// its family). A cage's quads are bilinear patches (MVC on them is QMVC);
+/// integrated in closed form on the CPU), ``grid`` the grid of harmonic
+/// coordinates, BBW and LBC (each read only by its family; ``None``: the
+/// family's default, 64 for harmonic coordinates, 32 for BBW and LBC). A cage's quads are bilinear patches (MVC on them is QMVC);
 /// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
 /// first, as before quads were patches (Green coordinates on patches are QGC). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
 /// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
@@ -158,7 +159,7 @@ fn choose_backend(
 #[pyfunction]
 #[pyo3(
     signature = (points, cage, method=None, resolution=None, grid=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None, dtype=None),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=64, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False, dtype='float32')"
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=None, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False, dtype='float32')"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(

@@ -12,7 +12,7 @@ use pmvc::geometry::{procedural, Cage};
 use std::collections::HashMap;
 
 /// The hat function of every cage vertex at `p` on the box face `axis = side`.
-fn hats_on_face(cage: &Cage, p: DVec3, axis: usize, side: f64) -> Vec<f64> {
+pub(crate) fn hats_on_face(cage: &Cage, p: DVec3, axis: usize, side: f64) -> Vec<f64> {
     let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
     let mut out = vec![0.0; cage.vertex_count()];
     for t in cage.triangles() {

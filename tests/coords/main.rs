@@ -1,4 +1,4 @@
-//! Coordinates: MVC, PMVC, harmonic, Green, maximum entropy and maximum likelihood coordinates, bounded biharmonic weights against references and
+//! Coordinates: MVC, PMVC, harmonic, Green, maximum entropy and maximum likelihood coordinates, bounded biharmonic weights, local barycentric coordinates against references and
 //! their properties, far-field exactness, origin offsets, weights metadata and
 //! the figures the docs quote. Builds without features
 //! (`cargo test --no-default-features --test coords`); the parts that run the
@@ -17,6 +17,8 @@ mod green;
 mod green_family;
 mod green_gallery;
 mod harmonic;
+mod lbc;
+mod lbc_reference;
 mod mec;
 mod mlc;
 mod mlc_smoothing;

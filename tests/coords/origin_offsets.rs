@@ -66,9 +66,13 @@ fn options(method: Method) -> BindOptions {
     BindOptions {
         method,
         resolution: 32,
-        // BBW's factor on a box-shaped cage grows as the grid's fourth power:
-        // a coarse grid keeps this test about the offsets, not the solve.
-        grid: if method == Method::Bbw { 12 } else { 32 },
+        // BBW's factor grows as the grid's fourth power and LBC's iterations
+        // with its size: a coarse grid keeps this test about the offsets.
+        grid: if matches!(method, Method::Bbw | Method::Lbc) {
+            12
+        } else {
+            32
+        },
         quads: pmvc::coords::QuadSplit::None,
     }
 }
@@ -399,10 +403,9 @@ mod command_line {
         }
     }
 
-    /// BBW's factor grows as the grid's fourth power: a coarse grid keeps
-    /// these runs about the offsets, not the solve (as [`options`] does).
+    /// BBW and LBC bind at a coarse grid, as [`options`] says why.
     fn cli_grid(method: Method) -> &'static str {
-        if method == Method::Bbw {
+        if matches!(method, Method::Bbw | Method::Lbc) {
             "12"
         } else {
             "32"

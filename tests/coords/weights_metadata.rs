@@ -60,8 +60,8 @@ fn bind_and_save(dir: &Path, method: Method) -> (std::path::PathBuf, Cage, Vec<D
     let (cage, points) = scene();
     let classes = classify_points(&cage, &points).classes;
     let mut options = BindOptions::for_method(method);
-    if method == Method::Bbw {
-        // The metadata is what is tested: a coarse grid keeps BBW's solve short.
+    if matches!(method, Method::Bbw | Method::Lbc) {
+        // The metadata is what is tested: a coarse grid keeps the solve short.
         options.grid = 12;
     }
     let weights = bind_cpu(&points, &classes, &cage, options, &BindProgress::default()).unwrap();

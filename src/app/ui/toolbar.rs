@@ -216,8 +216,11 @@ fn difference_controls(
         Some(twin) => twin_label(twin),
         None => against.0.name().to_owned(),
     };
+    // Tall enough for every family and twin: a list that scrolls hides entries.
+    let list_height = ui.ctx().content_rect().height();
     egui::ComboBox::from_label("vs")
         .selected_text(selected)
+        .height(list_height)
         .show_ui(ui, |ui| {
             for family in Method::ALL {
                 ui.selectable_value(&mut against, (family, None), family.name());
@@ -247,6 +250,7 @@ fn difference_controls(
     let mut chosen = shown;
     egui::ComboBox::from_label("shown")
         .selected_text(chosen.name())
+        .height(list_height)
         .show_ui(ui, |ui| {
             for family in Method::ALL {
                 ui.selectable_value(&mut chosen, family, family.name());

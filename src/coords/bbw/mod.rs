@@ -112,6 +112,14 @@ fn prepare(
     let (frame, _) = harmonic::frame_for(cage, grid)?;
     let columns = cage.vertex_count() as u64;
     let output = points as u64 * columns * 4 + (64 << 20);
+    // Classifying the nodes alone takes this much: refuse before it.
+    check_memory(
+        cage,
+        grid,
+        points,
+        frame.node_count() as u64 * 8 + output,
+        settings,
+    )?;
     let (inside, _) = inside_nodes(cage, &frame);
     let inside = inside.iter().filter(|&&inside| inside).count() as u64;
     let before_factor =
@@ -159,7 +167,7 @@ fn prepare(
 }
 
 /// Refuse `needed` bytes at `grid` if they would not fit, naming a grid that
-/// would (by planning smaller grids, each a quarter or less of the memory).
+/// would.
 fn check_memory(
     cage: &Cage,
     grid: u32,
@@ -167,36 +175,10 @@ fn check_memory(
     needed: u64,
     settings: &AdmmSettings,
 ) -> Result<(), HarmonicError> {
-    let Some(available) = crate::budget::available_memory() else {
-        return Ok(());
-    };
-    let budget = (available as f64 * harmonic::MEMORY_SHARE) as u64;
-    if needed <= budget {
-        return Ok(());
-    }
-    let mut suggested = grid / 2;
-    let mut suggested_bytes = needed / 8;
-    while suggested >= harmonic::MIN_GRID {
-        match prepare(cage, suggested, points, settings) {
-            Ok(smaller) if smaller.plan.predicted_bytes <= budget => {
-                suggested_bytes = smaller.plan.predicted_bytes;
-                break;
-            }
-            Ok(smaller) => suggested_bytes = smaller.plan.predicted_bytes,
-            Err(HarmonicError::NotEnoughMemory { needed_mib, .. }) => {
-                suggested_bytes = needed_mib << 20
-            }
-            Err(other) => return Err(other),
-        }
-        suggested /= 2;
-    }
-    Err(HarmonicError::NotEnoughMemory {
-        family: FAMILY,
-        grid,
-        needed_mib: needed >> 20,
-        available_mib: available >> 20,
-        suggested: suggested.max(harmonic::MIN_GRID),
-        suggested_mib: suggested_bytes >> 20,
+    harmonic::refuse_unless_it_fits(FAMILY, grid, needed, &|smaller| {
+        Ok(prepare(cage, smaller, points, settings)?
+            .plan
+            .predicted_bytes)
     })
 }
 

@@ -197,6 +197,48 @@ fn check_memory(cage: &Cage, plan: &HarmonicPlan, points: usize) -> Result<(), H
     })
 }
 
+/// Refuse `needed` bytes for `family` at `grid` if they would not fit, naming
+/// a grid that would: `predict` gives the bytes of a smaller grid (each
+/// halving a quarter or less of the memory), tried until one fits.
+pub(super) fn refuse_unless_it_fits(
+    family: &'static str,
+    grid: u32,
+    needed: u64,
+    predict: &dyn Fn(u32) -> Result<u64, HarmonicError>,
+) -> Result<(), HarmonicError> {
+    let Some(available) = crate::budget::available_memory() else {
+        return Ok(());
+    };
+    let budget = (available as f64 * MEMORY_SHARE) as u64;
+    if needed <= budget {
+        return Ok(());
+    }
+    let mut suggested = grid / 2;
+    let mut suggested_bytes = needed / 8;
+    while suggested >= MIN_GRID {
+        match predict(suggested) {
+            Ok(bytes) if bytes <= budget => {
+                suggested_bytes = bytes;
+                break;
+            }
+            Ok(bytes) => suggested_bytes = bytes,
+            Err(HarmonicError::NotEnoughMemory { needed_mib, .. }) => {
+                suggested_bytes = needed_mib << 20
+            }
+            Err(other) => return Err(other),
+        }
+        suggested /= 2;
+    }
+    Err(HarmonicError::NotEnoughMemory {
+        family,
+        grid,
+        needed_mib: needed >> 20,
+        available_mib: available >> 20,
+        suggested: suggested.max(MIN_GRID),
+        suggested_mib: suggested_bytes >> 20,
+    })
+}
+
 /// Harmonic coordinates of `points` (classified by
 /// [`crate::geometry::classify_points`]) at `grid` cells along the cage's longest
 /// side. `progress` counts rows: it is advanced in proportion to the solve.

@@ -158,7 +158,7 @@ def bind(
     cage: CageLike,
     method: str = "pmvc",
     resolution: Union[int, str] = 32,
-    grid: int = 64,
+    grid: int | None = None,
     backend: str = "auto",
     progress: Optional[Progress] = None,
     triangulate: Optional[str] = None,
@@ -168,8 +168,9 @@ def bind(
 ) -> Weights:
     """Bind ``points`` (n, 3) to ``cage`` with one family (see ``families()``).
 
-    ``resolution`` is PMVC's cube-map resolution (or ``"exact"``), ``grid`` harmonic
-    coordinates' grid; each is read only by its family and checked against its
+    ``resolution`` is PMVC's cube-map resolution (or ``"exact"``), ``grid`` the
+    grid of harmonic coordinates, BBW and LBC (``None``: the family's default,
+    64, 32 and 32); each is read only by its family and checked against its
     range. Quads are bilinear patches (MVC on them is QMVC) unless
     ``triangulate`` is "shorter" or "longer", which splits them along that
     diagonal first; Green coordinates always bind on triangles. ``backend``: "auto" (the CPU, or a hardware GPU where it is

@@ -35,7 +35,7 @@ def parameter_specs():
 def parameters_for(method, values):
     """The parameters ``method`` reads, from ``values`` (a dict of every one).
 
-    Families share a setting by its id (harmonic coordinates' and BBW's grid);
+    Families share a setting by its id (the grid of harmonic coordinates, BBW and LBC);
     left at the setting's default, each family takes its own default (BBW's
     grid is 32, not harmonic coordinates' 64)."""
     shared = parameter_specs()
