@@ -41,6 +41,7 @@ pub mod pmvc;
 mod progress;
 pub mod qmvc;
 pub mod quality;
+pub mod somigliana;
 pub mod split_effect;
 mod weights_id;
 
