@@ -456,10 +456,12 @@ fn bench_shared_data(
         } else {
             &[QuadSplit::None]
         };
-        // Every family at its default parameter, so that a new family gets rows;
+        // Every family quick to bind at its default parameter, so that a new
+        // family gets rows;
         // a family that binds triangles only splits quads itself: one row.
         let mut configurations: Vec<_> = Method::ALL
             .into_iter()
+            .filter(|method| method.spec().quick_to_bind)
             .flat_map(|method| {
                 let value = method.spec().parameter.map_or(0, |p| p.default);
                 let patches = matches!(method.spec().quads, QuadSupport::Patches { .. });

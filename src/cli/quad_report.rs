@@ -32,7 +32,7 @@ pub(super) fn report_split_effect(args: &CheckArgs, cage: &Cage, points: &[DVec3
     );
     let percent =
         |spread: Spread| format!("{:.3}% / {:.3}%", 100.0 * spread.mean, 100.0 * spread.max);
-    for method in Method::ALL {
+    for method in Method::ALL.into_iter().filter(|m| m.spec().quick_to_bind) {
         let options = BindOptions {
             resolution: args.resolution,
             grid: args.grid,

@@ -231,6 +231,11 @@ pub struct FamilySpec {
     /// bind can be computed and written in blocks of rows. False for a family
     /// that solves once for the whole cage (harmonic coordinates' grid).
     pub rows_independent: bool,
+    /// Whether a bind at the default parameter takes seconds, not minutes, on
+    /// a cage of a few hundred vertices: the families `pmvc check`'s split
+    /// report and `pmvc bench`'s shared-data rows bind unasked (LBC's
+    /// iterations take minutes there).
+    pub quick_to_bind: bool,
     pub quads: QuadSupport,
     /// Why a family of [`QuadSupport::Triangles`] cannot take quads, for its notice.
     pub quads_reason: &'static str,
@@ -255,6 +260,7 @@ const MVC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: false,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: true,
     quads: QuadSupport::Patches { name: "QMVC" },
     quads_reason: "",
@@ -323,6 +329,7 @@ const PMVC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: true,
     quads: QuadSupport::Patches { name: "PMVC" },
     quads_reason: "",
@@ -336,6 +343,7 @@ const HARMONIC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: false,
     quads: QuadSupport::Patches { name: "HC" },
     quads_reason: "",
@@ -350,6 +358,7 @@ const GREEN: FamilySpec = FamilySpec {
     positive_inside: false,
     outside_policy: "vertices outside the cage get Green's exterior extension: the inside \
          coordinates continued through the nearest cage triangle, exact at rest and continuous across it",
+    quick_to_bind: true,
     rows_independent: true,
     quads: QuadSupport::Patches { name: "QGC" },
     quads_reason: "",
@@ -363,6 +372,7 @@ const MEC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: true,
     quads: QuadSupport::Patches { name: "MEC" },
     quads_reason: "",
@@ -376,6 +386,7 @@ const MLC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: true,
     // Inside only vertex positions count: splitting a quad would change nothing.
     quads: QuadSupport::Patches { name: "MLC" },
@@ -390,6 +401,7 @@ const BBW: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: true,
     rows_independent: false,
     quads: QuadSupport::Patches { name: "BBW" },
     quads_reason: "",
@@ -404,6 +416,7 @@ const LBC: FamilySpec = FamilySpec {
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
+    quick_to_bind: false,
     rows_independent: false,
     quads: QuadSupport::Patches { name: "LBC" },
     quads_reason: "",
