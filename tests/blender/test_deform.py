@@ -5,13 +5,13 @@ import bpy
 import numpy as np
 import pytest
 
-from conftest import (FAMILIES, TOLERANCE, cage_faces, cli_deform, comb, coordinates, evaluated,
+from conftest import (FAMILIES, TEST_PARAMETERS, TOLERANCE, cage_faces, cli_deform, comb, coordinates, evaluated,
                       evaluated_cage, expected, middle_tip, quad_scene, relative_error, select)
 
 
 def bind(mesh_obj, cage_obj, method):
     select(mesh_obj, cage_obj)
-    assert bpy.ops.pmvc.bind(method=method.upper()) == {"FINISHED"}
+    assert bpy.ops.pmvc.bind(method=method.upper(), **TEST_PARAMETERS.get(method, {})) == {"FINISHED"}
 
 
 @pytest.mark.parametrize("method", FAMILIES)
