@@ -17,6 +17,9 @@ pub struct BindOptions {
     /// Grid cells along the cage's longest side for harmonic coordinates; ignored
     /// by the others.
     pub grid: u32,
+    /// Somigliana coordinates' Poisson ratio in thousandths ([`Self::poisson_ratio`]);
+    /// ignored by the others.
+    pub poisson_ratio: u32,
     /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
     /// split into triangles along a diagonal first (`--triangulate`). Families that
     /// only take triangles (Green) split along the shorter one when this is `None`.
@@ -42,6 +45,7 @@ impl BindOptions {
         match parameter {
             Parameter::Resolution => self.resolution,
             Parameter::Grid => self.grid,
+            Parameter::PoissonRatio => self.poisson_ratio,
         }
     }
 
@@ -49,6 +53,7 @@ impl BindOptions {
         match parameter {
             Parameter::Resolution => self.resolution = value,
             Parameter::Grid => self.grid = value,
+            Parameter::PoissonRatio => self.poisson_ratio = value,
         }
     }
 
@@ -106,6 +111,11 @@ impl BindOptions {
     pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
         self.method
             .column_displacements(&self.cage_to_bind(cage), pose)
+    }
+
+    /// The Poisson ratio ν Somigliana coordinates bind with.
+    pub fn poisson_ratio(&self) -> f64 {
+        f64::from(self.poisson_ratio) / f64::from(Parameter::PoissonRatio.spec().scale)
     }
 
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
@@ -167,6 +177,7 @@ impl Default for BindOptions {
             method: Method::Pmvc,
             resolution: DEFAULT_RESOLUTION,
             grid: harmonic::DEFAULT_GRID,
+            poisson_ratio: Parameter::PoissonRatio.spec().default,
             quads: QuadSplit::None,
         }
     }

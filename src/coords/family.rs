@@ -35,9 +35,14 @@ pub enum Method {
     /// bound-constrained quadratic programme per cage vertex on the harmonic
     /// solve's grid.
     Bbw,
+    /// Somigliana coordinates (Chen, de Goes, Desbrun 2023), the global variant:
+    /// a 3×3 block per cage vertex and per triangle, by boundary integrals of the
+    /// elastic kernels ([`super::somigliana`]).
+    Somigliana,
 }
 
-/// A family's one integer parameter (a resolution, a grid size).
+/// A family's one parameter (a resolution, a grid size, a Poisson ratio), held
+/// as a whole number of `1/scale` units.
 #[derive(Clone, Copy, Debug)]
 pub struct ParameterSpec {
     /// Which field of [`super::BindOptions`] holds it.
@@ -57,6 +62,9 @@ pub struct ParameterSpec {
     pub named: &'static [NamedValue],
     /// How a value reads in titles, e.g. "32²" or "exact".
     pub format: fn(u32) -> String,
+    /// Units per one: 1 for whole numbers, 1000 for a value in thousandths
+    /// (read and written as a decimal, "0.3").
+    pub scale: u32,
 }
 
 /// A parameter value with a name, written and read as that name.
@@ -69,7 +77,10 @@ pub struct NamedValue {
 /// A parameter value outside its family's range.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "{id} {value} is out of range: the {label} must be {min} to {max}{}",
+    "{id} {} is out of range: the {label} must be {} to {}{}",
+    decimal(*.value, *.scale),
+    decimal(u64::from(*.min), *.scale),
+    decimal(u64::from(*.max), *.scale),
     or_named(named)
 )]
 pub struct ParameterError {
@@ -80,6 +91,21 @@ pub struct ParameterError {
     pub min: u32,
     pub max: u32,
     pub named: &'static [NamedValue],
+    pub scale: u32,
+}
+
+/// `value` units of `1/scale` as a decimal: "0.3" for 300 thousandths.
+pub fn decimal(value: u64, scale: u32) -> String {
+    if scale <= 1 {
+        return value.to_string();
+    }
+    let digits = scale.ilog10() as usize;
+    let text = format!(
+        "{}.{:0digits$}",
+        value / u64::from(scale),
+        value % u64::from(scale)
+    );
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 /// `, or "exact"` after a range, for a parameter with named values.
@@ -110,6 +136,7 @@ impl ParameterSpec {
             min: self.min,
             max: self.max,
             named: self.named,
+            scale: self.scale,
         }
     }
 
@@ -124,6 +151,9 @@ impl ParameterSpec {
         {
             return Ok(named.value);
         }
+        if self.scale > 1 {
+            return self.parse_decimal(text);
+        }
         let value: u64 = text.parse().map_err(|_| {
             format!(
                 "'{text}' is not a whole number{}",
@@ -131,6 +161,33 @@ impl ParameterSpec {
             )
         })?;
         self.validate_number(value)
+            .map_err(|error| error.to_string())
+    }
+
+    /// A decimal (`scale` > 1) in units of `1/scale`: "0.3" is 300 thousandths.
+    fn parse_decimal(&self, text: &str) -> Result<u32, String> {
+        let number: f64 = match text.parse() {
+            Ok(number) if f64::is_finite(number) => number,
+            _ => return Err(format!("'{text}' is not a number")),
+        };
+        self.validate_decimal(number)
+            .map_err(|error| error.to_string())
+    }
+
+    /// A decimal value checked as [`Self::validate_number`], in `1/scale`
+    /// units, rounded to the nearest; below zero it is out of range.
+    pub fn validate_decimal(&self, number: f64) -> Result<u32, String> {
+        let units = (number * f64::from(self.scale)).round();
+        if !(units >= 0.0 && units <= f64::from(u32::MAX)) {
+            return Err(format!(
+                "{} {number} is out of range: the {} must be {} to {}",
+                self.key.id(),
+                self.label,
+                decimal(self.min.into(), self.scale),
+                decimal(self.max.into(), self.scale)
+            ));
+        }
+        self.validate_number(units as u64)
             .map_err(|error| error.to_string())
     }
 
@@ -159,16 +216,23 @@ pub enum Parameter {
     Resolution,
     /// Grid cells along the cage's longest side (harmonic coordinates, BBW).
     Grid,
+    /// The material's Poisson ratio in thousandths (Somigliana coordinates).
+    PoissonRatio,
 }
 
 impl Parameter {
-    pub const ALL: [Parameter; 2] = [Parameter::Resolution, Parameter::Grid];
+    pub const ALL: [Parameter; 3] = [
+        Parameter::Resolution,
+        Parameter::Grid,
+        Parameter::PoissonRatio,
+    ];
 
     /// The name saved files give it.
     pub fn id(self) -> &'static str {
         match self {
             Parameter::Resolution => "resolution",
             Parameter::Grid => "grid",
+            Parameter::PoissonRatio => "poisson_ratio",
         }
     }
 
@@ -177,6 +241,7 @@ impl Parameter {
         match self {
             Parameter::Resolution => &RESOLUTION,
             Parameter::Grid => &GRID,
+            Parameter::PoissonRatio => &super::somigliana::POISSON_RATIO_SETTING,
         }
     }
 
@@ -196,6 +261,10 @@ pub enum ColumnLayout {
     /// lone triangle ([`Cage::lone_triangles`]), then four per quad, one per
     /// corner in the quad's order ([`super::green::face_columns`]).
     CageVerticesThenTriangles,
+    /// A 3×3 block per cage vertex, then per cage triangle in [`Cage::triangles`]
+    /// order, each as 9 columns, row-major (Somigliana coordinates:
+    /// [`super::somigliana`]).
+    BlocksPerVertexThenTriangle,
 }
 
 /// What a family does with a cage's quads.
@@ -274,6 +343,7 @@ const RESOLUTION: ParameterSpec = ParameterSpec {
         EXACT_RESOLUTION => "exact".to_owned(),
         side => format!("{side}²"),
     },
+    scale: 1,
 };
 
 /// Harmonic coordinates' grid: fewer than `MIN_GRID` cells cannot resolve a
@@ -288,6 +358,7 @@ const GRID: ParameterSpec = ParameterSpec {
     max: 2048,
     named: &[],
     format: |value| format!("grid {value}"),
+    scale: 1,
 };
 
 /// Bounded biharmonic weights' grid: the `--grid` of harmonic coordinates, with
@@ -381,9 +452,23 @@ const BBW: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const SOMIGLIANA: FamilySpec = FamilySpec {
+    id: "somigliana",
+    name: "Somigliana",
+    summary: "Somigliana coordinates: elasticity-based, a 3×3 block per cage vertex and triangle; not positive",
+    parameter: Some(super::somigliana::POISSON_RATIO_SETTING),
+    columns: ColumnLayout::BlocksPerVertexThenTriangle,
+    positive_inside: false,
+    outside_policy: "vertices outside the cage (or on it) get MVC weights (the triangle's barycentrics \
+         on it) as identity blocks with no face term, so they follow MVC's deformation of the cage",
+    rows_independent: true,
+    quads: QuadSupport::Triangles,
+    quads_reason: "the tractions are constant per triangle",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
@@ -391,6 +476,7 @@ impl Method {
         Method::Mec,
         Method::Mlc,
         Method::Bbw,
+        Method::Somigliana,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -402,6 +488,7 @@ impl Method {
             Method::Mec => &MEC,
             Method::Mlc => &MLC,
             Method::Bbw => &BBW,
+            Method::Somigliana => &SOMIGLIANA,
         }
     }
 
@@ -433,6 +520,7 @@ impl Method {
             ColumnLayout::CageVerticesThenTriangles => {
                 cage.vertex_count() + super::green::face_columns(cage)
             }
+            ColumnLayout::BlocksPerVertexThenTriangle => super::somigliana::column_count(cage),
         }
     }
 
@@ -441,6 +529,9 @@ impl Method {
     /// quads, QGC: each lone triangle's, then each quad's four corner normals
     /// `Nₖ`). A row reproduces its point when Σₖ wₖ cₖ equals it (linear precision).
     pub fn rest_columns(self, rest: &Cage) -> Vec<DVec3> {
+        if self.spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            return super::somigliana::rest_columns(rest);
+        }
         let mut columns = rest.positions().to_vec();
         if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
             columns.extend(super::green::rest_face_vectors(rest));
@@ -455,6 +546,9 @@ impl Method {
     /// the rest normal, and for a quad corner's (QGC) `σₖ Nₖ' − Nₖ`. A pose of the
     /// wrong length moves nothing.
     pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+        if self.spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            return super::somigliana::column_displacements(rest, pose);
+        }
         let mut moves: Vec<DVec3> = pose
             .iter()
             .zip(rest.positions())
@@ -477,7 +571,12 @@ impl Method {
     /// Columns that belong to cage vertices: where partition of unity and
     /// positivity are measured (Green coordinates' ψ columns are neither).
     pub fn vertex_columns(self, cage: &Cage) -> usize {
-        cage.vertex_count()
+        match self.spec().columns {
+            ColumnLayout::BlocksPerVertexThenTriangle => {
+                super::somigliana::BLOCK_COLUMNS * cage.vertex_count()
+            }
+            _ => cage.vertex_count(),
+        }
     }
 }
 
@@ -509,84 +608,5 @@ impl std::fmt::Display for Method {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_outside_policy_names_the_far_field_distance_in_use() {
-        let distance = format!(
-            "beyond {} cage diagonals",
-            crate::coords::mvc::FAR_FIELD_DIAGONALS
-        );
-        assert!(OUTSIDE_BY_MVC.contains(&distance), "{OUTSIDE_BY_MVC}");
-    }
-
-    #[test]
-    fn identifiers_are_unique_and_round_trip() {
-        for method in Method::ALL {
-            assert_eq!(Method::from_id(method.id()), Some(method));
-            assert_eq!(
-                Method::ALL.iter().filter(|m| m.id() == method.id()).count(),
-                1
-            );
-        }
-        assert_eq!(Method::from_id("PMVC"), Some(Method::Pmvc));
-        assert_eq!(Method::from_id("nope"), None);
-    }
-
-    #[test]
-    fn a_parameter_outside_its_range_is_refused_with_its_name_value_and_range() {
-        let error = Parameter::Grid.validate(4_294_967_295).unwrap_err();
-        assert_eq!(
-            error.to_string(),
-            "grid 4294967295 is out of range: the harmonic grid must be 4 to 2048"
-        );
-        let error = Parameter::Resolution.validate(1 << 40).unwrap_err();
-        assert!(error.to_string().contains("1099511627776"), "{error}");
-        // 0 is exact PMVC's code: stored options hold it, a user names it.
-        assert_eq!(Parameter::Resolution.validate(0), Ok(EXACT_RESOLUTION));
-        let spec = Parameter::Resolution.spec();
-        assert!(spec.validate_number(0).is_err());
-        assert_eq!(spec.parse(" Exact "), Ok(EXACT_RESOLUTION));
-        assert_eq!(spec.parse("64"), Ok(64));
-        let refused = spec.parse("0").unwrap_err();
-        assert!(
-            refused.ends_with("must be 1 to 1024, or \"exact\""),
-            "{refused}"
-        );
-        assert!(Parameter::Grid.spec().parse("exact").is_err());
-        assert!(Parameter::Grid.validate(3).is_err());
-        assert_eq!(Parameter::Resolution.validate(1024), Ok(1024));
-        assert_eq!(Parameter::Grid.validate(4), Ok(4));
-    }
-
-    #[test]
-    fn every_family_parameter_is_its_parameters_spec_and_offers_valid_choices() {
-        for method in Method::ALL {
-            let Some(spec) = method.spec().parameter else {
-                continue;
-            };
-            // A family may offer its own label, choices and default for a
-            // parameter it shares (BBW's grid), not its own range or flag.
-            let shared = spec.key.spec();
-            assert_eq!(
-                (spec.flag, spec.min, spec.max),
-                (shared.flag, shared.min, shared.max)
-            );
-            for &value in spec.choices.iter().chain([&spec.default]) {
-                assert_eq!(spec.validate(value.into()), Ok(value), "{}", spec.label);
-            }
-        }
-    }
-
-    #[test]
-    fn next_visits_every_family_once_per_cycle() {
-        let mut seen = vec![Method::ALL[0]];
-        for _ in 1..Method::ALL.len() {
-            seen.push(seen.last().unwrap().next());
-        }
-        seen.sort();
-        assert_eq!(seen, Method::ALL.to_vec());
-        assert_eq!(Method::ALL.last().unwrap().next(), Method::ALL[0]);
-    }
-}
+#[path = "family_tests.rs"]
+mod tests;

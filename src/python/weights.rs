@@ -235,12 +235,15 @@ impl PyWeights {
         let parameters = PyDict::new(py);
         for (name, &value) in &self.metadata.parameters {
             // A named value ("exact") as its name, as W.json writes it.
-            let named = crate::coords::Parameter::ALL
-                .into_iter()
+            let spec = (crate::coords::Parameter::ALL.into_iter())
                 .find(|p| p.id() == name)
-                .and_then(|p| p.spec().name_of(value));
-            match named {
-                Some(named) => parameters.set_item(name, named)?,
+                .map(|p| p.spec());
+            match spec {
+                Some(spec) => match spec.name_of(value) {
+                    Some(named) => parameters.set_item(name, named)?,
+                    None => parameters
+                        .set_item(name, super::families::parameter_number(py, spec, value))?,
+                },
                 None => parameters.set_item(name, value)?,
             }
         }

@@ -296,6 +296,7 @@ fn the_library_refuses_a_parameter_outside_its_range() {
     let classes = classify_points(&cage, &points);
     for (method, resolution, grid) in [(Method::Pmvc, 100_000, 64), (Method::Harmonic, 32, 0)] {
         let options = BindOptions {
+            poisson_ratio: 0,
             method,
             resolution,
             grid,

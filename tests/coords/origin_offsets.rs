@@ -64,6 +64,7 @@ fn comb_and_points() -> (Cage, Vec<DVec3>) {
 
 fn options(method: Method) -> BindOptions {
     BindOptions {
+        poisson_ratio: 0,
         method,
         resolution: 32,
         // BBW's factor on a box-shaped cage grows as the grid's fourth power:

@@ -1,8 +1,8 @@
 //! Somigliana coordinates (Chen, de Goes, Desbrun, "Somigliana Coordinates: an
 //! elasticity-derived approach for cage deformation", SIGGRAPH 2023), the CPU
 //! core: 3×3 blocks per point and cage vertex or triangle, in f64, and the
-//! paper's global deformation. Not yet a [`super::Method`]: its columns are 3×3
-//! blocks, which the weights layout does not have.
+//! paper's global deformation; as the family [`super::Method::Somigliana`], each
+//! block expanded into 9 scalar columns (`columns.rs`).
 //!
 //! # Formulation
 //!
@@ -60,6 +60,7 @@
 //! the blocks are the identity's exterior value (Σ Bᵥ = 0), with no exterior
 //! extension.
 
+mod columns;
 mod fit;
 mod near;
 mod quadrature;
@@ -70,9 +71,15 @@ mod reference;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_family;
+#[cfg(test)]
 mod tests_schemes;
 
 use crate::geometry::Cage;
+pub use columns::{
+    column_count, column_displacements, identity_blocks, rest_columns, SomiglianaCage,
+    BLOCK_COLUMNS,
+};
 pub use fit::SimilarityFit;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -83,6 +90,23 @@ pub const DEFAULT_POISSON_RATIO: f64 = 0.0;
 /// The open range of Poisson ratios accepted: at −1 the face term vanishes, at ½
 /// it diverges (incompressible material).
 pub const POISSON_RATIO_RANGE: (f64, f64) = (-1.0, 0.5);
+
+/// The family's Poisson ratio setting ν, in thousandths: 0 to 0.499 (at ½ the
+/// face term diverges). Negative (auxetic) ratios, which the library's
+/// [`somigliana_blocks`] takes, do not fit this unsigned
+/// setting.
+pub const POISSON_RATIO_SETTING: super::ParameterSpec = super::ParameterSpec {
+    key: super::Parameter::PoissonRatio,
+    label: "Poisson ratio",
+    flag: "--poisson-ratio",
+    choices: &[0, 250, 300, 400, 450],
+    default: (DEFAULT_POISSON_RATIO * 1000.0) as u32,
+    min: 0,
+    max: 499,
+    named: &[],
+    format: |value| format!("ν {}", super::family::decimal(value.into(), 1000)),
+    scale: 1000,
+};
 
 /// What can go wrong computing or applying Somigliana blocks.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
