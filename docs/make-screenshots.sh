@@ -29,6 +29,7 @@ shoot compare-difference --pose "$finger" --view difference
 shoot compare-three-families --pose "$finger" --compare mvc,pmvc,harmonic
 shoot compare-three-heatmap --pose "$finger" --compare mvc,pmvc,harmonic --heatmap 7 --log-scale
 shoot compare-positive-families --pose "$finger" --compare pmvc,mec,mlc,harmonic
+shoot compare-grid-and-elastic-families --pose "$finger" --compare bbw,lbc,somigliana,harmonic
 bar=$(mktemp -d)
 "$PMVC_EDITOR" generate twisted-bar --mesh "$bar/bar.obj" --cage "$bar/bar_cage.obj"
 shoot compare-twisted-bar "$bar/bar.obj" "$bar/bar_cage.obj" --pose docs/poses/twisted-bar.obj --compare pmvc,green

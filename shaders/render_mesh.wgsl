@@ -92,7 +92,8 @@ fn vertex_value(vertex: u32, position: vec3<f32>) -> f32 {
             return chunk_weight(start.x, start.y + column);
         }
         case COLOURING_MOST_NEGATIVE: {
-            return lowest_in_row(start.x, start.y, min(columns, frame.vertex_columns));
+            let stride = max(frame.vertex_column_stride, 1u);
+            return lowest_in_row(start.x, start.y, min(columns, frame.vertex_columns), stride);
         }
         case COLOURING_METHOD_DISTANCE: {
             if frame.other_columns == 0u {

@@ -35,6 +35,9 @@ struct Frame {
     vertex_columns: u32,
     // Texels per row of the image that render::drawn reads the drawn positions from.
     probe_width: u32,
+    // Columns per cage vertex: the negativity view takes every such column
+    // from the first (9 for 3×3 blocks: their x-from-x entries).
+    vertex_column_stride: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

@@ -393,13 +393,11 @@ fn run(
                 method: options.method,
                 source: BindError::NothingKept,
             })?;
-            let quality = WeightQuality::measure_columns(
+            let quality = WeightQuality::measure_family(
                 &weights,
                 &prepared.points,
-                &options
-                    .method
-                    .rest_columns(&options.cage_to_bind(&prepared.cage)),
-                options.method.vertex_columns(&prepared.cage),
+                options.method,
+                &options.cage_to_bind(&prepared.cage),
                 &outside,
             );
             Ok(BindOutcome {

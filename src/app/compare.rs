@@ -387,19 +387,23 @@ pub fn column_range(weights: &Weights, column: usize) -> Option<ValueRange> {
 pub fn row_minimum_range(
     weights: &Weights,
     vertex_columns: usize,
+    stride: usize,
     outside: &[u32],
 ) -> Option<ValueRange> {
     let columns = vertex_columns.min(weights.cols);
     if columns == 0 {
         return None;
     }
+    let stride = stride.max(1);
     ValueRange::of(
         weights
             .values
             .chunks_exact(weights.cols)
             .enumerate()
             .filter(|(row, _)| outside.binary_search(&(*row as u32)).is_err())
-            .map(|(_, row)| row[..columns].iter().copied().fold(f32::INFINITY, f32::min)),
+            .map(|(_, row)| {
+                (row[..columns].iter().step_by(stride).copied()).fold(f32::INFINITY, f32::min)
+            }),
     )
 }
 

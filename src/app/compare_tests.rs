@@ -71,7 +71,7 @@ fn ranges_of_a_column_and_of_row_minima() {
     );
     assert_eq!(column_range(&weights, 3), None);
     assert_eq!(
-        row_minimum_range(&weights, weights.cols, &[]),
+        row_minimum_range(&weights, weights.cols, 1, &[]),
         Some(ValueRange {
             min: -0.1,
             max: 0.2
@@ -79,7 +79,7 @@ fn ranges_of_a_column_and_of_row_minima() {
     );
     // An outside row is left out.
     assert_eq!(
-        row_minimum_range(&weights, weights.cols, &[0]),
+        row_minimum_range(&weights, weights.cols, 1, &[0]),
         Some(ValueRange { min: 0.2, max: 0.2 })
     );
     assert_eq!(

@@ -123,7 +123,8 @@ impl Views {
                 }
                 Colouring::TriangleWeight(_) if document.weights(pane.method()).is_some() => {
                     format!(
-                        "{} has no per-triangle functions ψ; only Green coordinates do",
+                        "{} has no per-triangle functions; only Green and Somigliana \
+                         coordinates do",
                         pane.method()
                     )
                 }
@@ -171,25 +172,22 @@ impl Views {
     ) -> Option<Vec<f32>> {
         match colouring {
             Colouring::Shaded => None,
-            Colouring::CageVertexWeight(column) => {
+            Colouring::CageVertexWeight(_) | Colouring::TriangleWeight(_) => {
                 let weights = document.weights(pane.method())?;
-                let column = (column as usize).min(weights.cols.saturating_sub(1));
-                Some((0..weights.rows).map(|r| weights.row(r)[column]).collect())
-            }
-            Colouring::TriangleWeight(triangle) => {
-                let weights = document.weights(pane.method())?;
-                let column = document.cage().vertex_count() + triangle as usize;
+                let column = shown_column(document, colouring, pane.method())?;
                 (column < weights.cols)
                     .then(|| (0..weights.rows).map(|r| weights.row(r)[column]).collect())
             }
             Colouring::MostNegativeWeight => {
                 let weights = document.weights(pane.method())?;
-                let columns = document.cage().vertex_count().min(weights.cols);
+                let columns = (pane.method().vertex_columns(document.cage())).min(weights.cols);
+                let stride = pane.method().spec().columns.columns_per_element();
                 Some(
                     (0..weights.rows)
                         .map(|r| {
                             weights.row(r)[..columns]
                                 .iter()
+                                .step_by(stride)
                                 .copied()
                                 .fold(f32::INFINITY, f32::min)
                         })
@@ -220,9 +218,19 @@ impl Views {
         limit: f32,
         scale: Scale,
     ) -> Vec<String> {
+        let blocks = pane.method().spec().columns.columns_per_element() > 1;
         let what = match (colouring, pane) {
+            (Colouring::CageVertexWeight(vertex), _) if blocks => {
+                format!("{} block of cage vertex {vertex}, entry xx", pane.method())
+            }
             (Colouring::CageVertexWeight(vertex), _) => {
                 format!("{} coordinate of cage vertex {vertex}", pane.method())
+            }
+            (Colouring::TriangleWeight(triangle), _) if blocks => {
+                format!(
+                    "{} block of cage triangle {triangle}, entry xx",
+                    pane.method()
+                )
             }
             (Colouring::TriangleWeight(column), _) => match face {
                 Some(face) => format!("{} psi {column}, of cage {face}", pane.method()),
@@ -257,5 +265,23 @@ impl Views {
             );
         }
         comments
+    }
+}
+
+/// The weights column a heatmap of `colouring` shows for `method`, as the
+/// vertex shader picks it (`Colouring::code`); `None` for other colourings and
+/// for a triangle's function in a family without triangle columns.
+pub(super) fn shown_column(
+    document: &Document,
+    colouring: Colouring,
+    method: crate::coords::Method,
+) -> Option<usize> {
+    let layout = method.spec().columns;
+    match colouring {
+        Colouring::CageVertexWeight(vertex) => Some(layout.vertex_function_column(vertex as usize)),
+        Colouring::TriangleWeight(triangle) => {
+            layout.triangle_function_column(document.cage().vertex_count(), triangle as usize)
+        }
+        _ => None,
     }
 }

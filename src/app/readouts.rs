@@ -85,17 +85,15 @@ impl Views {
         let method = pane.method();
         match colouring {
             Colouring::Shaded => None,
-            Colouring::CageVertexWeight(vertex) => {
-                compare::column_range(document.weights(method)?, vertex as usize)
-            }
-            Colouring::TriangleWeight(triangle) => {
-                let column = document.cage().vertex_count() + triangle as usize;
+            Colouring::CageVertexWeight(_) | Colouring::TriangleWeight(_) => {
+                let column = super::exports::shown_column(document, colouring, method)?;
                 compare::column_range(document.weights(method)?, column)
             }
             Colouring::MostNegativeWeight => {
                 let weights = document.weights(method)?;
-                let cage_vertices = document.cage().vertex_count();
-                compare::row_minimum_range(weights, cage_vertices, document.outside())
+                let vertex_columns = method.vertex_columns(document.cage());
+                let stride = method.spec().columns.columns_per_element();
+                compare::row_minimum_range(weights, vertex_columns, stride, document.outside())
             }
             Colouring::MethodDistance => {
                 let Pane::Difference { against, shown } = pane else {

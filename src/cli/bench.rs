@@ -38,7 +38,9 @@ pub struct BenchArgs {
     /// kernel where the cage allows it), tiles, bands.
     #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = PmvcKernel::parse)]
     pub pmvc_kernels: Vec<PmvcKernel>,
-    /// Only these families (e.g. `pmvc,mvc`); all by default.
+    /// Only these families (e.g. `pmvc,mvc`); all by default, except that on the
+    /// shared models LBC and Somigliana coordinates (minutes per bind there)
+    /// are timed only when named.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub methods: Vec<Method>,
     /// Instead of timings, PMVC's cube-map error against exact PMVC at
@@ -457,11 +459,11 @@ fn bench_shared_data(
             &[QuadSplit::None]
         };
         // Every family quick to bind at its default parameter, so that a new
-        // family gets rows;
+        // family gets rows, and the slow ones when named in --methods;
         // a family that binds triangles only splits quads itself: one row.
         let mut configurations: Vec<_> = Method::ALL
             .into_iter()
-            .filter(|method| method.spec().quick_to_bind)
+            .filter(|method| method.spec().quick_to_bind || args.methods.contains(method))
             .flat_map(|method| {
                 let value = method.spec().parameter.map_or(0, |p| p.default);
                 let patches = matches!(method.spec().quads, QuadSupport::Patches { .. });

@@ -40,8 +40,8 @@ pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use parse::{
-    parse_grid, parse_object_name, parse_percent, parse_resolution, parse_seconds, parse_view,
-    TriangulateArg,
+    parse_grid, parse_object_name, parse_percent, parse_poisson_ratio, parse_resolution,
+    parse_seconds, parse_view, TriangulateArg,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -132,6 +132,10 @@ pub struct MethodChoice {
     /// Harmonic coordinates and BBW: grid cells along the cage's longest side (4–2048); default 64 for harmonic coordinates, 32 for BBW.
     #[arg(long, value_parser = parse_grid)]
     pub grid: Option<u32>,
+    /// Somigliana coordinates: the material's Poisson ratio ν (-0.999–0.499), in steps
+    /// of 0.001 (below 0: auxetic); default 0.
+    #[arg(long, value_parser = parse_poisson_ratio, allow_negative_numbers = true)]
+    pub poisson_ratio: Option<u32>,
     /// Split the cage's quads into triangles along their shorter or longer diagonal
     /// before binding, as before quads were bilinear patches, to reproduce earlier
     /// results or see how much the split moves the mesh. Without it, quads stay
@@ -169,6 +173,9 @@ impl MethodChoice {
             grid: self
                 .grid
                 .unwrap_or(crate::coords::BindOptions::for_method(self.method).grid),
+            poisson_ratio: self
+                .poisson_ratio
+                .unwrap_or(crate::coords::BindOptions::for_method(self.method).poisson_ratio),
             quads: self
                 .triangulate
                 .map_or(crate::coords::QuadSplit::None, TriangulateArg::split),

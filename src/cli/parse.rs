@@ -13,6 +13,11 @@ pub(super) fn parse_grid(text: &str) -> Result<u32, String> {
     parse_parameter(crate::coords::Parameter::Grid, text)
 }
 
+/// `--poisson-ratio`: a decimal, held in thousandths, checked by its spec.
+pub(super) fn parse_poisson_ratio(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::PoissonRatio, text)
+}
+
 fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
     parameter.spec().parse(text)
 }

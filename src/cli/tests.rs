@@ -30,23 +30,30 @@ fn parameter_flags_take_their_range_from_the_spec_and_their_help_says_it() {
         ("edit", Parameter::Resolution),
         ("edit", Parameter::Grid),
         ("check", Parameter::Grid),
+        ("bind", Parameter::PoissonRatio),
+        ("deform", Parameter::PoissonRatio),
     ] {
         let spec = parameter.spec();
-        let flag = spec.flag.trim_start_matches('-');
+        let flag = spec.flag.trim_start_matches('-').replace('-', "_");
         let help = cli
             .find_subcommand(subcommand)
-            .and_then(|command| command.get_arguments().find(|a| a.get_id() == flag))
+            .and_then(|command| {
+                command
+                    .get_arguments()
+                    .find(|a| a.get_id() == flag.as_str())
+            })
             .and_then(|argument| argument.get_help())
             .map(|help| help.to_string())
             .unwrap_or_default();
-        let range = format!("({}–{})", spec.min, spec.max);
+        let shown = |value: u32| spec.text(value);
+        let range = format!("({}–{})", shown(spec.min), shown(spec.max));
         assert!(help.contains(&range), "{subcommand} {}: {help}", spec.flag);
-        let too_large = (spec.max + 1).to_string();
+        let too_large = shown(spec.max + 1);
         let error = Cli::try_parse_from(["pmvc", subcommand, spec.flag, &too_large])
             .unwrap_err()
             .to_string();
         assert!(
-            error.contains(&format!("{} to {}", spec.min, spec.max)),
+            error.contains(&format!("{} to {}", shown(spec.min), shown(spec.max))),
             "{error}"
         );
     }

@@ -78,7 +78,7 @@ pub(super) fn read_weights_for(
 ) -> Result<AnyWeights> {
     let rows = input.mesh.mesh.positions.len();
     let (vertices, triangles) = (input.cage.vertex_count(), input.cage.triangle_count());
-    let expected = ExpectedArray::cage_vertices(rows, vertices);
+    let expected = ExpectedArray::of_layout(method.spec().columns, rows, vertices, triangles);
     Ok(match (dtype, writes_npz(method)) {
         (Dtype::Float32, true) => AnyWeights::F32(read_npz(path, rows, vertices, triangles)?),
         (Dtype::Float32, false) => AnyWeights::F32(read_npy(path, expected)?),

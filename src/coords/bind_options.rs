@@ -17,6 +17,10 @@ pub struct BindOptions {
     /// Grid cells along the cage's longest side for harmonic coordinates; ignored
     /// by the others.
     pub grid: u32,
+    /// Somigliana coordinates' Poisson ratio as held by its setting (thousandths
+    /// above 1000: [`Self::poisson_ratio`] gives ν);
+    /// ignored by the others.
+    pub poisson_ratio: u32,
     /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
     /// split into triangles along a diagonal first (`--triangulate`). Families that
     /// only take triangles (Green) split along the shorter one when this is `None`.
@@ -42,6 +46,7 @@ impl BindOptions {
         match parameter {
             Parameter::Resolution => self.resolution,
             Parameter::Grid => self.grid,
+            Parameter::PoissonRatio => self.poisson_ratio,
         }
     }
 
@@ -49,6 +54,7 @@ impl BindOptions {
         match parameter {
             Parameter::Resolution => self.resolution = value,
             Parameter::Grid => self.grid = value,
+            Parameter::PoissonRatio => self.poisson_ratio = value,
         }
     }
 
@@ -106,6 +112,11 @@ impl BindOptions {
     pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
         self.method
             .column_displacements(&self.cage_to_bind(cage), pose)
+    }
+
+    /// The Poisson ratio ν Somigliana coordinates bind with.
+    pub fn poisson_ratio(&self) -> f64 {
+        Parameter::PoissonRatio.spec().number(self.poisson_ratio)
     }
 
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
@@ -167,6 +178,7 @@ impl Default for BindOptions {
             method: Method::Pmvc,
             resolution: DEFAULT_RESOLUTION,
             grid: harmonic::DEFAULT_GRID,
+            poisson_ratio: Parameter::PoissonRatio.spec().default,
             quads: QuadSplit::None,
         }
     }

@@ -8,6 +8,10 @@
 //! or [`super::weights_at`] (one row at a time); if it has more columns than cage
 //! vertices, also in [`Method::columns`] and [`Method::column_displacements`].
 
+pub use super::parameter::{
+    decimal, signed_decimal, NamedValue, Parameter, ParameterError, ParameterSpec,
+};
+use super::parameter::{BBW_GRID, GRID, LBC_GRID, RESOLUTION};
 use crate::geometry::Cage;
 use glam::DVec3;
 
@@ -39,155 +43,10 @@ pub enum Method {
     /// total-variation minimisation of every cage vertex's weight together,
     /// subject to the barycentric constraints, on the harmonic solve's grid.
     Lbc,
-}
-
-/// A family's one integer parameter (a resolution, a grid size).
-#[derive(Clone, Copy, Debug)]
-pub struct ParameterSpec {
-    /// Which field of [`super::BindOptions`] holds it.
-    pub key: Parameter,
-    /// Shown beside its control, e.g. "PMVC resolution".
-    pub label: &'static str,
-    /// The command-line flag, e.g. "--resolution".
-    pub flag: &'static str,
-    /// The values the editor offers.
-    pub choices: &'static [u32],
-    pub default: u32,
-    /// The smallest and largest values accepted from any source ([`Self::validate`]).
-    pub min: u32,
-    pub max: u32,
-    /// Values outside `min..=max` that mean something else, by name
-    /// (PMVC's "exact": no cube map).
-    pub named: &'static [NamedValue],
-    /// How a value reads in titles, e.g. "32²" or "exact".
-    pub format: fn(u32) -> String,
-}
-
-/// A parameter value with a name, written and read as that name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct NamedValue {
-    pub value: u32,
-    pub name: &'static str,
-}
-
-/// A parameter value outside its family's range.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "{id} {value} is out of range: the {label} must be {min} to {max}{}",
-    or_named(named)
-)]
-pub struct ParameterError {
-    /// The name saved files give it ("resolution").
-    pub id: &'static str,
-    pub label: &'static str,
-    pub value: u64,
-    pub min: u32,
-    pub max: u32,
-    pub named: &'static [NamedValue],
-}
-
-/// `, or "exact"` after a range, for a parameter with named values.
-fn or_named(named: &[NamedValue]) -> String {
-    named
-        .iter()
-        .map(|named| format!(", or \"{}\"", named.name))
-        .collect()
-}
-
-impl ParameterSpec {
-    /// The one check of a value, wherever it comes from (the command line, a
-    /// session, the editor's controls): `value` when it is in `min..=max` or
-    /// one of the named values.
-    pub fn validate(&self, value: u64) -> Result<u32, ParameterError> {
-        match u32::try_from(value) {
-            Ok(value) if (self.min..=self.max).contains(&value) => Ok(value),
-            Ok(value) if self.named.iter().any(|named| named.value == value) => Ok(value),
-            _ => Err(self.out_of_range(value)),
-        }
-    }
-
-    fn out_of_range(&self, value: u64) -> ParameterError {
-        ParameterError {
-            id: self.key.id(),
-            label: self.label,
-            value,
-            min: self.min,
-            max: self.max,
-            named: self.named,
-        }
-    }
-
-    /// The one reading of a value from text (the command line, Python, saved
-    /// files): a whole number checked by [`Self::validate`], or a value's name.
-    pub fn parse(&self, text: &str) -> Result<u32, String> {
-        let text = text.trim();
-        if let Some(named) = self
-            .named
-            .iter()
-            .find(|n| n.name.eq_ignore_ascii_case(text))
-        {
-            return Ok(named.value);
-        }
-        let value: u64 = text.parse().map_err(|_| {
-            format!(
-                "'{text}' is not a whole number{}",
-                or_named(self.named).replacen(',', "", 1)
-            )
-        })?;
-        self.validate_number(value)
-            .map_err(|error| error.to_string())
-    }
-
-    /// [`Self::validate`] of a value given as a number by a user: a named
-    /// value is given by its name, so its code (PMVC's exact is 0) is refused.
-    pub fn validate_number(&self, value: u64) -> Result<u32, ParameterError> {
-        match u32::try_from(value) {
-            Ok(value) if (self.min..=self.max).contains(&value) => Ok(value),
-            _ => Err(self.out_of_range(value)),
-        }
-    }
-
-    /// The name of `value`, if it is a named one.
-    pub fn name_of(&self, value: u32) -> Option<&'static str> {
-        self.named
-            .iter()
-            .find(|named| named.value == value)
-            .map(|named| named.name)
-    }
-}
-
-/// The parameters families can have; each is a field of [`super::BindOptions`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Parameter {
-    /// Cube-map texels along one face edge (PMVC).
-    Resolution,
-    /// Grid cells along the cage's longest side (harmonic coordinates, BBW).
-    Grid,
-}
-
-impl Parameter {
-    pub const ALL: [Parameter; 2] = [Parameter::Resolution, Parameter::Grid];
-
-    /// The name saved files give it.
-    pub fn id(self) -> &'static str {
-        match self {
-            Parameter::Resolution => "resolution",
-            Parameter::Grid => "grid",
-        }
-    }
-
-    /// Its spec: label, flag, range and the editor's choices.
-    pub fn spec(self) -> &'static ParameterSpec {
-        match self {
-            Parameter::Resolution => &RESOLUTION,
-            Parameter::Grid => &GRID,
-        }
-    }
-
-    /// [`ParameterSpec::validate`] of this parameter.
-    pub fn validate(self, value: u64) -> Result<u32, ParameterError> {
-        self.spec().validate(value)
-    }
+    /// Somigliana coordinates (Chen, de Goes, Desbrun 2023), the global variant:
+    /// a 3×3 block per cage vertex and per triangle, by boundary integrals of the
+    /// elastic kernels ([`super::somigliana`]).
+    Somigliana,
 }
 
 /// What a family's weights matrix holds per mesh vertex.
@@ -200,6 +59,46 @@ pub enum ColumnLayout {
     /// lone triangle ([`Cage::lone_triangles`]), then four per quad, one per
     /// corner in the quad's order ([`super::green::face_columns`]).
     CageVerticesThenTriangles,
+    /// A 3×3 block per cage vertex, then per cage triangle in [`Cage::triangles`]
+    /// order, each as 9 columns, row-major (Somigliana coordinates:
+    /// [`super::somigliana`]).
+    BlocksPerVertexThenTriangle,
+}
+
+impl ColumnLayout {
+    /// Columns per cage vertex (and per cage triangle where there are triangle
+    /// columns): 9 for 3×3 blocks, else 1.
+    pub fn columns_per_element(self) -> usize {
+        match self {
+            ColumnLayout::BlocksPerVertexThenTriangle => super::somigliana::BLOCK_COLUMNS,
+            _ => 1,
+        }
+    }
+
+    /// The column a heatmap of cage vertex `vertex` shows: its weight, or the
+    /// first entry (x from x) of its block, which sums to 1 over the vertices.
+    pub fn vertex_function_column(self, vertex: usize) -> usize {
+        self.columns_per_element() * vertex
+    }
+
+    /// The column a heatmap of cage triangle `triangle` shows, on a cage of
+    /// `cage_vertices` vertices: Green's ψ of it, or the first entry of its
+    /// face block; `None` for a layout with no triangle columns.
+    pub fn triangle_function_column(self, cage_vertices: usize, triangle: usize) -> Option<usize> {
+        let per = self.columns_per_element();
+        match self {
+            ColumnLayout::CageVertices => None,
+            _ => Some(per * (cage_vertices + triangle)),
+        }
+    }
+
+    /// How a heatmap names a vertex's function and a triangle's ("λ", "ψ").
+    pub fn function_symbols(self) -> (&'static str, &'static str) {
+        match self {
+            ColumnLayout::BlocksPerVertexThenTriangle => ("Bxx", "Fxx"),
+            _ => ("λ", "ψ"),
+        }
+    }
 }
 
 /// What a family does with a cage's quads.
@@ -234,7 +133,8 @@ pub struct FamilySpec {
     /// Whether a bind at the default parameter takes seconds, not minutes, on
     /// a cage of a few hundred vertices: the families `pmvc check`'s split
     /// report and `pmvc bench`'s shared-data rows bind unasked (LBC's
-    /// iterations take minutes there).
+    /// iterations take minutes there, as do Somigliana coordinates'
+    /// quadratures: about 37 µs per point and cage triangle on one core).
     pub quick_to_bind: bool,
     pub quads: QuadSupport,
     /// Why a family of [`QuadSupport::Triangles`] cannot take quads, for its notice.
@@ -264,61 +164,6 @@ const MVC: FamilySpec = FamilySpec {
     rows_independent: true,
     quads: QuadSupport::Patches { name: "QMVC" },
     quads_reason: "",
-};
-
-/// PMVC's cube-map resolution. Past 1024 the six faces of one point's cube map
-/// alone are 24 MiB and a bind of a real mesh takes hours.
-const RESOLUTION: ParameterSpec = ParameterSpec {
-    key: Parameter::Resolution,
-    label: "PMVC resolution",
-    flag: "--resolution",
-    choices: &[16, 32, 64, 128, EXACT_RESOLUTION],
-    default: DEFAULT_RESOLUTION,
-    min: 1,
-    max: 1024,
-    named: &[NamedValue {
-        value: EXACT_RESOLUTION,
-        name: "exact",
-    }],
-    format: |value| match value {
-        EXACT_RESOLUTION => "exact".to_owned(),
-        side => format!("{side}²"),
-    },
-};
-
-/// Harmonic coordinates' grid: fewer than `MIN_GRID` cells cannot resolve a
-/// cage; 2048 cells along the longest side is already billions of nodes.
-const GRID: ParameterSpec = ParameterSpec {
-    key: Parameter::Grid,
-    label: "harmonic grid",
-    flag: "--grid",
-    choices: &[32, 64, 128],
-    default: super::harmonic::DEFAULT_GRID,
-    min: super::harmonic::MIN_GRID,
-    max: 2048,
-    named: &[],
-    format: |value| format!("grid {value}"),
-};
-
-/// Bounded biharmonic weights' grid: the `--grid` of harmonic coordinates, with
-/// a smaller default, since the factor of the biharmonic system grows about as
-/// the grid's fourth power (a cube cage at grid 32 factorises into 45 million
-/// entries, 360 MB).
-const BBW_GRID: ParameterSpec = ParameterSpec {
-    label: "BBW grid",
-    choices: &[16, 32, 48],
-    default: super::bbw::DEFAULT_GRID,
-    ..GRID
-};
-
-/// Local barycentric coordinates' grid: the `--grid` of harmonic coordinates,
-/// with a smaller default, since every cage vertex's weights are solved
-/// together (memory grows with the grid's cube times the cage's vertices).
-const LBC_GRID: ParameterSpec = ParameterSpec {
-    label: "LBC grid",
-    choices: &[16, 32, 48],
-    default: super::lbc::DEFAULT_GRID,
-    ..GRID
 };
 
 const PMVC: FamilySpec = FamilySpec {
@@ -422,9 +267,24 @@ const LBC: FamilySpec = FamilySpec {
     quads_reason: "",
 };
 
+const SOMIGLIANA: FamilySpec = FamilySpec {
+    id: "somigliana",
+    name: "Somigliana",
+    summary: "Somigliana coordinates: elasticity-based, a 3×3 block per cage vertex and triangle; not positive",
+    parameter: Some(super::somigliana::POISSON_RATIO_SETTING),
+    columns: ColumnLayout::BlocksPerVertexThenTriangle,
+    positive_inside: false,
+    outside_policy: "vertices outside the cage (or on it) get MVC weights (the triangle's barycentrics \
+         on it) as identity blocks with no face term, so they follow MVC's deformation of the cage",
+    quick_to_bind: false,
+    rows_independent: true,
+    quads: QuadSupport::Triangles,
+    quads_reason: "the tractions are constant per triangle",
+};
+
 impl Method {
     /// Every family, in the order menus list them.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Mvc,
         Method::Pmvc,
         Method::Harmonic,
@@ -433,6 +293,7 @@ impl Method {
         Method::Mlc,
         Method::Bbw,
         Method::Lbc,
+        Method::Somigliana,
     ];
 
     pub fn spec(self) -> &'static FamilySpec {
@@ -445,6 +306,7 @@ impl Method {
             Method::Mlc => &MLC,
             Method::Bbw => &BBW,
             Method::Lbc => &LBC,
+            Method::Somigliana => &SOMIGLIANA,
         }
     }
 
@@ -476,6 +338,7 @@ impl Method {
             ColumnLayout::CageVerticesThenTriangles => {
                 cage.vertex_count() + super::green::face_columns(cage)
             }
+            ColumnLayout::BlocksPerVertexThenTriangle => super::somigliana::column_count(cage),
         }
     }
 
@@ -484,6 +347,9 @@ impl Method {
     /// quads, QGC: each lone triangle's, then each quad's four corner normals
     /// `Nₖ`). A row reproduces its point when Σₖ wₖ cₖ equals it (linear precision).
     pub fn rest_columns(self, rest: &Cage) -> Vec<DVec3> {
+        if self.spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            return super::somigliana::rest_columns(rest);
+        }
         let mut columns = rest.positions().to_vec();
         if self.spec().columns == ColumnLayout::CageVerticesThenTriangles {
             columns.extend(super::green::rest_face_vectors(rest));
@@ -498,6 +364,9 @@ impl Method {
     /// the rest normal, and for a quad corner's (QGC) `σₖ Nₖ' − Nₖ`. A pose of the
     /// wrong length moves nothing.
     pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+        if self.spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            return super::somigliana::column_displacements(rest, pose);
+        }
         let mut moves: Vec<DVec3> = pose
             .iter()
             .zip(rest.positions())
@@ -520,7 +389,7 @@ impl Method {
     /// Columns that belong to cage vertices: where partition of unity and
     /// positivity are measured (Green coordinates' ψ columns are neither).
     pub fn vertex_columns(self, cage: &Cage) -> usize {
-        cage.vertex_count()
+        self.spec().columns.columns_per_element() * cage.vertex_count()
     }
 }
 

@@ -36,6 +36,7 @@ pub mod lbc;
 pub mod mec;
 pub mod mlc;
 pub mod mvc;
+mod parameter;
 pub mod parameter_values;
 pub mod pmvc;
 mod progress;
@@ -183,6 +184,8 @@ pub enum BindFailure {
     Parameter(#[from] ParameterError),
     #[error(transparent)]
     TooLarge(#[from] crate::budget::TooLarge),
+    #[error(transparent)]
+    Somigliana(#[from] somigliana::SomiglianaError),
 }
 
 impl From<harmonic::HarmonicError> for BindFailure {
@@ -213,6 +216,7 @@ pub fn bind_cpu(
     progress: &BindProgress,
 ) -> Result<Weights, BindFailure> {
     options.validate()?;
+    check_somigliana(options, cage)?;
     let cage = &*options.cage_to_bind(cage);
     if !options.method.spec().rows_independent {
         return bind_on_grid(points, classes, cage, options, progress);
@@ -223,6 +227,15 @@ pub fn bind_cpu(
         cols,
         values,
     })
+}
+
+/// The one check of Somigliana coordinates' Poisson ratio
+/// ([`somigliana::validate_poisson_ratio`]), before any row is computed.
+fn check_somigliana(options: BindOptions, cage: &Cage) -> Result<(), BindFailure> {
+    if options.method == Method::Somigliana {
+        somigliana::SomiglianaCage::new(cage, options.poisson_ratio())?;
+    }
+    Ok(())
 }
 
 /// A whole-scene solve on the harmonic solve's grid.
@@ -290,6 +303,7 @@ pub fn bind_cpu_f64(
     progress: &BindProgress,
 ) -> Result<WeightsF64, BindFailure> {
     options.validate()?;
+    check_somigliana(options, cage)?;
     if !options.method.spec().rows_independent {
         let columns = options.columns(cage) as u64;
         crate::budget::check_memory(
@@ -342,6 +356,9 @@ pub fn bind_rows<T: WeightValue>(
     }
     let integration = PmvcIntegration::of(options);
     let green_cage = (options.method == Method::Green).then(|| green::QgcCage::new(cage));
+    // Checked by `check_somigliana` before any bind; a ν it refuses gives NaN rows.
+    let somigliana_cage = (options.method == Method::Somigliana)
+        .then(|| somigliana::SomiglianaCage::new(cage, options.poisson_ratio()).ok());
     out.par_chunks_mut(cols * ROWS_PER_TASK)
         .zip(rows.par_chunks(ROWS_PER_TASK))
         .try_for_each_init(
@@ -353,6 +370,15 @@ pub fn bind_rows<T: WeightValue>(
                 for (row, &i) in block.chunks_mut(cols).zip(block_rows) {
                     if let Some(green_cage) = &green_cage {
                         green_row(green_cage, points[i], row_f64);
+                    } else if let Some(prepared) = &somigliana_cage {
+                        somigliana_row(
+                            prepared.as_ref(),
+                            points[i],
+                            classes[i],
+                            cage,
+                            row_f64,
+                            scratch,
+                        );
                     } else {
                         weights_at(
                             points[i],
@@ -384,6 +410,43 @@ fn green_row(green_cage: &green::QgcCage, x: DVec3, out: &mut [f64]) {
     }
 }
 
+/// Somigliana coordinates of `x` into one row: its blocks inside; on the cage
+/// or outside (or where Σ Bᵥ is not I), the row of the other families' policy as
+/// identity blocks ([`somigliana::identity_blocks`]).
+fn somigliana_row(
+    prepared: Option<&somigliana::SomiglianaCage>,
+    x: DVec3,
+    class: PointClass,
+    cage: &Cage,
+    out: &mut [f64],
+    scratch: &mut RowScratch,
+) {
+    let Some(prepared) = prepared else {
+        return out.fill(f64::NAN);
+    };
+    if class == PointClass::Inside && prepared.row(x, out) {
+        return;
+    }
+    let mut lambda = std::mem::take(&mut scratch.lambda);
+    lambda.resize(cage.vertex_count(), 0.0);
+    let integration = PmvcIntegration::of(BindOptions::for_method(Method::Mvc));
+    let class = match class {
+        PointClass::Inside => PointClass::Outside,
+        other => other,
+    };
+    weights_at(
+        x,
+        class,
+        cage,
+        Method::Mvc,
+        &integration,
+        &mut lambda,
+        scratch,
+    );
+    somigliana::identity_blocks(&lambda, out);
+    scratch.lambda = lambda;
+}
+
 /// Per-thread buffers of the families computed row by row, reused across rows.
 #[derive(Debug, Default)]
 pub struct RowScratch {
@@ -391,6 +454,8 @@ pub struct RowScratch {
     pub pmvc: pmvc::PmvcScratch,
     pub mec: mec::MecScratch,
     pub mlc: mlc::MlcScratch,
+    /// Scalar weights turned into Somigliana blocks.
+    pub lambda: Vec<f64>,
 }
 
 /// Coordinates of one point, following the policy of the module doc. `out` holds
@@ -409,7 +474,13 @@ pub fn weights_at(
         pmvc: pmvc_scratch,
         mec: mec_scratch,
         mlc: mlc_scratch,
+        ..
     } = scratch;
+    if method == Method::Somigliana {
+        // As Green: prepared per call here, once per bind in `bind_rows`.
+        let prepared = somigliana::SomiglianaCage::new(cage, somigliana::DEFAULT_POISSON_RATIO);
+        return somigliana_row(prepared.ok().as_ref(), x, class, cage, out, scratch);
+    }
     if method == Method::Green {
         // Its own policies for every class; prepared per call here, once per bind
         // in `bind_rows`.
@@ -446,9 +517,12 @@ pub fn weights_at(
         PointClass::Inside => match method {
             // Grid families have no per-point form; bind_cpu solves them
             // whole. Asked for one row, MVC is the outside policy's answer.
-            Method::Mvc | Method::Harmonic | Method::Bbw | Method::Lbc | Method::Green => {
-                mvc::mvc_weights(x, cage, out, mvc_scratch)
-            }
+            Method::Mvc
+            | Method::Harmonic
+            | Method::Bbw
+            | Method::Lbc
+            | Method::Green
+            | Method::Somigliana => mvc::mvc_weights(x, cage, out, mvc_scratch),
             Method::Pmvc => {
                 if !integration.weights_inside(x, cage, out, pmvc_scratch) {
                     // A ray escaped: x is not enclosed after all (numerically on the

@@ -13,6 +13,8 @@ use std::collections::BTreeMap;
 enum Written {
     Number(u64),
     Name(String),
+    /// A parameter in `1/scale` units, as the decimal it stands for.
+    Decimal(f64),
 }
 
 fn parameter_of(id: &str) -> Option<Parameter> {
@@ -33,9 +35,15 @@ where
                     .ok()
                     .and_then(|value| parameter.spec().name_of(value))
             });
-            let written = match name {
-                Some(name) => Written::Name(name.to_owned()),
-                None => Written::Number(value),
+            let decimal = parameter_of(id)
+                .map(|parameter| parameter.spec())
+                .filter(|spec| spec.scale > 1);
+            let written = match (name, decimal) {
+                (Some(name), _) => Written::Name(name.to_owned()),
+                (None, Some(spec)) => {
+                    Written::Decimal((value as f64 - f64::from(spec.zero)) / f64::from(spec.scale))
+                }
+                (None, None) => Written::Number(value),
             };
             (id.as_str(), written)
         })
@@ -55,9 +63,27 @@ where
         .into_iter()
         .map(|(id, value)| {
             let number = match value {
-                // A named value's code written as a number (resolution 0) is
-                // refused as a user's number is: the file says "exact".
+                Written::Decimal(decimal) => {
+                    let spec = parameter_of(&id)
+                        .filter(|parameter| parameter.spec().scale > 1)
+                        .ok_or_else(|| {
+                            serde::de::Error::custom(format!(
+                                "\"{id}\": {decimal} is not a whole number"
+                            ))
+                        })?
+                        .spec();
+                    u64::from(
+                        spec.validate_decimal(decimal)
+                            .map_err(serde::de::Error::custom)?,
+                    )
+                }
                 Written::Number(number) => match parameter_of(&id) {
+                    // A decimal parameter's whole number (ν 0 written as 0).
+                    Some(parameter) if parameter.spec().scale > 1 => u64::from(
+                        (parameter.spec())
+                            .validate_decimal(number as f64)
+                            .map_err(serde::de::Error::custom)?,
+                    ),
                     Some(parameter) => {
                         let spec = parameter.spec();
                         let named = u32::try_from(number)

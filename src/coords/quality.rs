@@ -61,6 +61,34 @@ impl WeightQuality {
         vertex_columns: usize,
         outside: &[u32],
     ) -> Self {
+        Self::measure_with(weights, points, columns, vertex_columns, false, outside)
+    }
+
+    /// [`Self::measure_columns`] of weights of `method` bound to `bound` (the
+    /// cage the family binds). For 3×3 blocks (Somigliana coordinates) the
+    /// partition error is the largest entry of Σ Bᵥ − I.
+    pub fn measure_family(
+        weights: &Weights,
+        points: &[DVec3],
+        method: super::Method,
+        bound: &crate::geometry::Cage,
+        outside: &[u32],
+    ) -> Self {
+        let blocks =
+            method.spec().columns == super::family::ColumnLayout::BlocksPerVertexThenTriangle;
+        let columns = method.rest_columns(bound);
+        let vertex_columns = method.vertex_columns(bound);
+        Self::measure_with(weights, points, &columns, vertex_columns, blocks, outside)
+    }
+
+    fn measure_with(
+        weights: &Weights,
+        points: &[DVec3],
+        columns: &[DVec3],
+        vertex_columns: usize,
+        blocks: bool,
+        outside: &[u32],
+    ) -> Self {
         assert_eq!(points.len(), weights.rows, "one point per weights row");
         assert_eq!(
             columns.len(),
@@ -69,7 +97,14 @@ impl WeightQuality {
         );
         let cage = &columns[..vertex_columns.min(columns.len())];
         let diagonal = {
-            let (lo, hi) = crate::geometry::bounds_of(cage);
+            // A block's columns (v, 0, b) hold (vᵥ)_b e_x.
+            let positions: Vec<DVec3> = match blocks {
+                true => (cage.chunks_exact(9))
+                    .map(|c| DVec3::new(c[0].x, c[1].x, c[2].x))
+                    .collect(),
+                false => cage.to_vec(),
+            };
+            let (lo, hi) = crate::geometry::bounds_of(&positions);
             (hi - lo).length()
         };
         let scale = if diagonal > 0.0 { 1.0 / diagonal } else { 1.0 };
@@ -77,7 +112,11 @@ impl WeightQuality {
         let (inside, beyond) = (0..weights.rows)
             .into_par_iter()
             .map(|i| {
-                let row = RowQuality::of(i, weights.row(i), points[i], columns, cage.len());
+                let row = if blocks {
+                    RowQuality::of_blocks(i, weights.row(i), points[i], columns, cage.len())
+                } else {
+                    RowQuality::of(i, weights.row(i), points[i], columns, cage.len())
+                };
                 if is_outside(i) {
                     (RowQuality::default(), row)
                 } else {
@@ -158,6 +197,44 @@ impl RowQuality {
         }
         quality.negative_rows = usize::from(quality.min < -NEGATIVE_TOLERANCE);
         quality.partition_error = (sum - 1.0).abs();
+        quality.linear_error = offset.length();
+        quality
+    }
+
+    /// [`Self::of`] for 3×3 blocks, 9 columns each, (a, b) at `3a + b`: column
+    /// (v, a, b) holds (vᵥ)_b e_a, centred as (vᵥ − x)_b e_a, and partition of
+    /// unity is Σ Bᵥ = I.
+    fn of_blocks(
+        i: usize,
+        row: &[f32],
+        x: DVec3,
+        columns: &[DVec3],
+        vertex_columns: usize,
+    ) -> Self {
+        let mut quality = Self::default();
+        let mut sum = [[0.0f64; 3]; 3];
+        let mut offset = DVec3::ZERO;
+        for (j, (&w, &c)) in row.iter().zip(columns).enumerate() {
+            let w = f64::from(w);
+            if j >= vertex_columns {
+                offset += w * c;
+                continue;
+            }
+            let (a, b) = ((j % 9) / 3, j % 3);
+            offset += w * (c - x[b] * DVec3::AXES[a]);
+            sum[a][b] += w;
+            // A vertex's weight, as the heatmap and the negativity view show
+            // it: its block's x-from-x entry (the off-diagonal ones are signed
+            // by design).
+            if j % 9 == 0 && w < quality.min {
+                quality.min = w;
+                quality.min_at = Some((i, j));
+            }
+        }
+        quality.negative_rows = usize::from(quality.min < -NEGATIVE_TOLERANCE);
+        quality.partition_error = (0..9)
+            .map(|k| (sum[k / 3][k % 3] - f64::from(u8::from(k / 3 == k % 3))).abs())
+            .fold(0.0, max_keeping_nan);
         quality.linear_error = offset.length();
         quality
     }

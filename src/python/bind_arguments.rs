@@ -49,8 +49,13 @@ pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) ->
         error(
             Kind::Parameter,
             format!(
-                "{} must be an integer{}, not {value}",
+                "{} must be {}{}, not {value}",
                 parameter.id(),
+                if spec.scale > 1 {
+                    "a number"
+                } else {
+                    "an integer"
+                },
                 names.concat()
             ),
         )
@@ -64,6 +69,11 @@ pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) ->
             .map(|named| named.value)
             .ok_or_else(refused);
     }
+    if spec.scale > 1 {
+        // A decimal (Somigliana's Poisson ratio), held in 1/scale units.
+        let number: f64 = value.extract().map_err(|_| refused())?;
+        return (spec.validate_decimal(number)).map_err(|message| error(Kind::Parameter, message));
+    }
     let value: i128 = value.extract().map_err(|_| refused())?;
     // Below zero or past u64 it is out of range all the same; the spec's
     // message gives the range.
@@ -76,13 +86,15 @@ pub(super) fn parameter_value(parameter: Parameter, value: &Bound<'_, PyAny>) ->
     })
 }
 
-/// The options of a bind of `method` with `resolution` and `grid`: the
+/// The options of a bind of `method` with `resolution`, `grid` and
+/// `poisson_ratio`: the
 /// family's own parameter is checked, the others are not read.
 /// A parameter not given keeps its default.
 pub(super) fn bind_options(
     method: Method,
     resolution: Option<&Bound<'_, PyAny>>,
     grid: Option<&Bound<'_, PyAny>>,
+    poisson_ratio: Option<&Bound<'_, PyAny>>,
     triangulate: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<BindOptions> {
     let mut options = BindOptions::for_method(method);
@@ -93,6 +105,7 @@ pub(super) fn bind_options(
         let given = match spec.key {
             Parameter::Resolution => resolution,
             Parameter::Grid => grid,
+            Parameter::PoissonRatio => poisson_ratio,
         };
         if let Some(given) = given.filter(|value| !value.is_none()) {
             options.set(spec.key, parameter_value(spec.key, given)?);

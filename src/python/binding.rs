@@ -144,8 +144,9 @@ fn choose_backend(
 /// ``method`` is a family id (see :func:`families`); ``resolution`` is PMVC's
 /// cube-map resolution (or ``"exact"``: no cube map, the visible cage
 /// integrated in closed form on the CPU), ``grid`` the grid of harmonic
-/// coordinates, BBW and LBC (each read only by its family; ``None``: the
-/// family's default, 64 for harmonic coordinates, 32 for BBW and LBC). A cage's quads are bilinear patches (MVC on them is QMVC);
+/// coordinates, BBW and LBC (``None``: the family's default, 64 for harmonic
+/// coordinates, 32 for BBW and LBC), ``poisson_ratio`` Somigliana coordinates'
+/// Poisson ratio (default 0); each is read only by its family. A cage's quads are bilinear patches (MVC on them is QMVC);
 /// ``triangulate="shorter"`` or ``"longer"`` splits them along that diagonal
 /// first, as before quads were patches (Green coordinates on patches are QGC). ``backend`` is ``"auto"`` (the CPU, or a hardware GPU where it
 /// is predicted faster for this bind), ``"cpu"`` or ``"gpu"``; families without
@@ -158,8 +159,8 @@ fn choose_backend(
 /// GIL is released while binding; Ctrl-C cancels within about a second.
 #[pyfunction]
 #[pyo3(
-    signature = (points, cage, method=None, resolution=None, grid=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None, dtype=None),
-    text_signature = "(points, cage, method='pmvc', resolution=32, grid=None, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False, dtype='float32')"
+    signature = (points, cage, method=None, resolution=None, grid=None, poisson_ratio=None, backend=None, progress=None, triangulate=None, pmvc_kernel=None, strict=None, dtype=None),
+    text_signature = "(points, cage, method='pmvc', resolution=32, grid=None, poisson_ratio=0.0, backend='auto', progress=None, triangulate=None, pmvc_kernel='auto', strict=False, dtype='float32')"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bind<'py>(
@@ -169,6 +170,7 @@ pub(super) fn bind<'py>(
     method: Option<Bound<'py, PyAny>>,
     resolution: Option<Bound<'py, PyAny>>,
     grid: Option<Bound<'py, PyAny>>,
+    poisson_ratio: Option<Bound<'py, PyAny>>,
     backend: Option<Bound<'py, PyAny>>,
     progress: Option<Bound<'py, PyAny>>,
     triangulate: Option<Bound<'py, PyAny>>,
@@ -181,6 +183,7 @@ pub(super) fn bind<'py>(
         method,
         resolution.as_ref(),
         grid.as_ref(),
+        poisson_ratio.as_ref(),
         triangulate.as_ref(),
     )?;
     let how = HowToBind::from_arguments(
@@ -448,9 +451,10 @@ pub(super) fn deform<'py>(
     method: Option<Bound<'py, PyAny>>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const BINDING: [&str; 8] = [
+    const BINDING: [&str; 9] = [
         "resolution",
         "grid",
+        "poisson_ratio",
         "backend",
         "progress",
         "triangulate",
@@ -542,6 +546,7 @@ pub(super) fn deform<'py>(
                 asked.unwrap_or(Method::Pmvc),
                 parameter("resolution")?.as_ref(),
                 parameter("grid")?.as_ref(),
+                parameter("poisson_ratio")?.as_ref(),
                 parameter("triangulate")?.as_ref(),
             )?;
             let progress = parameter("progress")?.filter(|p| !p.is_none());

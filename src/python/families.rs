@@ -27,14 +27,17 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             let entry = PyDict::new(py);
             entry.set_item("id", parameter.key.id())?;
             entry.set_item("label", parameter.label)?;
-            entry.set_item("default", parameter.default)?;
-            entry.set_item("min", parameter.min)?;
-            entry.set_item("max", parameter.max)?;
+            entry.set_item(
+                "default",
+                parameter_number(py, &parameter, parameter.default),
+            )?;
+            entry.set_item("min", parameter_number(py, &parameter, parameter.min))?;
+            entry.set_item("max", parameter_number(py, &parameter, parameter.max))?;
             let choices = PyList::empty(py);
             for &choice in parameter.choices {
                 match parameter.name_of(choice) {
                     Some(name) => choices.append(name)?,
-                    None => choices.append(choice)?,
+                    None => choices.append(parameter_number(py, &parameter, choice))?,
                 }
             }
             entry.set_item("choices", choices)?;
@@ -65,5 +68,26 @@ pub(super) fn columns_layout(layout: ColumnLayout) -> &'static str {
     match layout {
         ColumnLayout::CageVertices => "cage_vertices",
         ColumnLayout::CageVerticesThenTriangles => "cage_vertices_then_triangles",
+        ColumnLayout::BlocksPerVertexThenTriangle => "blocks_per_vertex_then_triangle",
+    }
+}
+
+/// A parameter's value as Python reads it: an int, or a float for a decimal
+/// parameter (the Poisson ratio's 300 thousandths are 0.3).
+pub(super) fn parameter_number<'py>(
+    py: Python<'py>,
+    spec: &crate::coords::ParameterSpec,
+    value: u32,
+) -> Bound<'py, PyAny> {
+    if spec.scale > 1 {
+        spec.number(value)
+            .into_pyobject(py)
+            .unwrap_or_else(|never| match never {})
+            .into_any()
+    } else {
+        value
+            .into_pyobject(py)
+            .unwrap_or_else(|never| match never {})
+            .into_any()
     }
 }

@@ -416,7 +416,8 @@ pub(super) fn classify<'py>(
     triangulate: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<i8>>> {
     let method = super::bind_arguments::method_argument(method.as_ref())?;
-    let options = super::bind_arguments::bind_options(method, None, None, triangulate.as_ref())?;
+    let options =
+        super::bind_arguments::bind_options(method, None, None, None, triangulate.as_ref())?;
     let cage = cage_argument(cage)?;
     let points = positions(points, "points")?;
     let cage = Arc::clone(&cage.cage);

@@ -138,17 +138,37 @@ impl PyWeights {
                     ),
                 ));
             }
-            if let Some((sum, tolerance)) = row_sum_off(&values[..vertices.min(values.len())]) {
+            if let Some(off) = self.partition_off(values, vertices) {
                 return Err(error(
                     Kind::Weights,
-                    format!(
-                        "{}: row {row}'s cage-vertex weights sum to {sum}, not 1 (± {tolerance:.1e})",
-                        shown_path(&self.shown())
-                    ),
+                    format!("{}: row {row}'s {off}", shown_path(&self.shown())),
                 ));
             }
         }
         Ok(values)
+    }
+
+    /// What is wrong with a row's partition of unity, if anything: the cage
+    /// vertices' weights must sum to 1; Somigliana's vertex blocks to the
+    /// identity, checked on its diagonal entries (each sums to 1).
+    fn partition_off<T: WeightValue>(&self, row: &[T], vertices: usize) -> Option<String> {
+        let layout = self.method().spec().columns;
+        let per = layout.columns_per_element();
+        if per == 1 {
+            let (sum, tolerance) = row_sum_off(&row[..vertices.min(row.len())])?;
+            return Some(format!(
+                "cage-vertex weights sum to {sum}, not 1 (± {tolerance:.1e})"
+            ));
+        }
+        (0..3).find_map(|a| {
+            let diagonal: Vec<T> = (0..vertices)
+                .filter_map(|v| row.get(per * v + 4 * a).copied())
+                .collect();
+            let (sum, tolerance) = row_sum_off(&diagonal)?;
+            Some(format!(
+                "vertex blocks' entries ({a}, {a}) sum to {sum}, not 1 (± {tolerance:.1e})"
+            ))
+        })
     }
 
     /// `strict=True` with these weights: an error when a row is outside the cage.
@@ -235,12 +255,15 @@ impl PyWeights {
         let parameters = PyDict::new(py);
         for (name, &value) in &self.metadata.parameters {
             // A named value ("exact") as its name, as W.json writes it.
-            let named = crate::coords::Parameter::ALL
-                .into_iter()
+            let spec = (crate::coords::Parameter::ALL.into_iter())
                 .find(|p| p.id() == name)
-                .and_then(|p| p.spec().name_of(value));
-            match named {
-                Some(named) => parameters.set_item(name, named)?,
+                .map(|p| p.spec());
+            match spec {
+                Some(spec) => match spec.name_of(value) {
+                    Some(named) => parameters.set_item(name, named)?,
+                    None => parameters
+                        .set_item(name, super::families::parameter_number(py, spec, value))?,
+                },
                 None => parameters.set_item(name, value)?,
             }
         }
@@ -270,9 +293,22 @@ impl PyWeights {
     /// for ``triangles[k]`` (ψ_k, which multiplies that triangle's scaled
     /// normal), then for QGC (Green on quads) ``("quad_corner", 4 q + c)`` for
     /// corner c of quad q of the metadata's ``quads`` (its scaled corner normal).
+    /// Somigliana coordinates' 3×3 blocks: ``("vertex_block", 9 j + 3 a + b)``
+    /// for entry (a, b) of cage vertex j's block, then ``("triangle_block",
+    /// 9 k + 3 a + b)`` for ``triangles[k]``'s (``matrix.reshape(n, -1, 3, 3)``).
     #[getter]
     fn columns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let vertices = self.metadata.cage.vertices;
+        if self.method().spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            let per = self.method().spec().columns.columns_per_element();
+            let triangles =
+                (self.metadata.triangles.as_ref()).map_or(self.metadata.cage.triangles, Vec::len);
+            let entries: Vec<(&str, usize)> = (0..per * vertices)
+                .map(|k| ("vertex_block", k))
+                .chain((0..per * triangles).map(|k| ("triangle_block", k)))
+                .collect();
+            return PyList::new(py, entries);
+        }
         let mut entries: Vec<(&str, usize)> = (0..vertices).map(|j| ("vertex", j)).collect();
         if self.method().spec().columns == ColumnLayout::CageVerticesThenTriangles {
             let triangles =

@@ -54,8 +54,13 @@ pub struct FrameUniform {
     pub vertex_columns: u32,
     /// Texels per row of the image [`super::drawn`] reads the drawn positions from.
     pub probe_width: u32,
+    /// Columns per cage vertex ([`ColumnLayout::columns_per_element`]): the
+    /// negativity view's minimum takes every such column from the first.
+    ///
+    /// [`ColumnLayout::columns_per_element`]: crate::coords::family::ColumnLayout::columns_per_element
+    pub vertex_column_stride: u32,
     /// Rounds the size up to WGSL's 16-byte struct alignment.
-    pub _padding: [u32; 2],
+    pub _padding: [u32; 1],
 }
 
 /// Texels per row of the image [`super::drawn`] draws the deformed positions

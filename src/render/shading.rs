@@ -3,6 +3,7 @@
 //! ([`super::viewport`]) turns into the frame uniform.
 
 use super::colormap::Scale;
+use crate::coords::family::ColumnLayout;
 use crate::coords::{Method, WeightsId};
 use glam::{Mat4, Vec3};
 
@@ -12,10 +13,11 @@ pub enum Colouring {
     /// Plain shading.
     #[default]
     Shaded,
-    /// The weight of one column: λᵢ of cage vertex i.
+    /// Cage vertex i's function: its weight λᵢ (or its block's first entry,
+    /// [`ColumnLayout::vertex_function_column`]).
     CageVertexWeight(u32),
-    /// Green coordinates' ψⱼ of cage triangle j: the column after the cage
-    /// vertices'; a family without it shows the mesh shaded.
+    /// Cage triangle j's function: Green coordinates' ψⱼ (or a face block's
+    /// first entry); a family without triangle columns shows the mesh shaded.
     TriangleWeight(u32),
     /// minⱼ λⱼ per mesh vertex: where the coordinates go negative.
     MostNegativeWeight,
@@ -25,15 +27,21 @@ pub enum Colouring {
 
 impl Colouring {
     /// The shader's `COLOURING_*` constant and the column it shows, for weights
-    /// of `columns` columns whose first `vertex_columns` are the cage vertices'.
-    pub(super) fn code(self, vertex_columns: u32, columns: u32) -> [u32; 2] {
+    /// of `columns` columns laid out as `layout` on a cage of `cage_vertices`
+    /// vertices.
+    pub(super) fn code(self, layout: ColumnLayout, cage_vertices: u32, columns: u32) -> [u32; 2] {
+        let shown = |column: Option<usize>| match column.and_then(|c| u32::try_from(c).ok()) {
+            Some(column) if column < columns => [1, column],
+            _ => [0, 0],
+        };
         match self {
             Colouring::Shaded => [0, 0],
-            Colouring::CageVertexWeight(vertex) => [1, vertex],
-            Colouring::TriangleWeight(triangle) => match vertex_columns.checked_add(triangle) {
-                Some(column) if column < columns => [1, column],
-                _ => [0, 0],
-            },
+            Colouring::CageVertexWeight(vertex) => {
+                shown(Some(layout.vertex_function_column(vertex as usize)))
+            }
+            Colouring::TriangleWeight(triangle) => {
+                shown(layout.triangle_function_column(cage_vertices as usize, triangle as usize))
+            }
             Colouring::MostNegativeWeight => [2, 0],
             Colouring::MethodDistance => [3, 0],
         }

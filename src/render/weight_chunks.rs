@@ -167,11 +167,11 @@ pub fn wgsl(slots: u32) -> String {
         out.push_str("    return moved;\n}\n");
     }
     out.push_str(
-        "\nfn lowest_in_row(chunk: u32, start: u32, columns: u32) -> f32 {\n    var lowest = 3.4e38;\n",
+        "\nfn lowest_in_row(chunk: u32, start: u32, columns: u32, stride: u32) -> f32 {\n    var lowest = 3.4e38;\n",
     );
     switch(&mut out, &|slot| {
         format!(
-            "for (var c = 0u; c < columns; c++) {{ lowest = min(lowest, weight_chunk_{slot}[start + c]); }}"
+            "for (var c = 0u; c < columns; c += stride) {{ lowest = min(lowest, weight_chunk_{slot}[start + c]); }}"
         )
     });
     out.push_str("    return lowest;\n}\n");

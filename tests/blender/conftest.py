@@ -132,7 +132,7 @@ def cage_faces(cage_obj):
 
 
 # LBC's bind takes over a minute at its default grid: the tests bind it coarser.
-TEST_PARAMETERS = {"lbc": {"grid": 16}}
+TEST_PARAMETERS = {"lbc": {"grid": 16}, "somigliana": {"poisson_ratio": -0.3}}
 
 
 def parameters(method):
@@ -167,7 +167,7 @@ def cli_deform(tmp_path, points, rest, faces, posed, method):
     arguments = [binary, "deform", "--mesh", str(tmp_path / "points.npy"), "--cage", str(tmp_path / "cage.obj"),
                  "--deformed-cage", str(tmp_path / "posed.obj"), "--method", method, "--out", str(tmp_path / "out.npy")]
     for key, value in parameters(method).items():
-        arguments += [f"--{key}", str(value)]
+        arguments += [f"--{key.replace('_', '-')}", str(value)]
     subprocess.run(arguments, check=True, capture_output=True)
     return np.load(tmp_path / "out.npy")
 

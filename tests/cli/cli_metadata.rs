@@ -72,18 +72,20 @@ fn bind_writes_metadata_and_row_classes_for_every_family() {
         // Read from the family's spec, so that a new family is covered unedited.
         let extension = match method.spec().columns {
             ColumnLayout::CageVerticesThenTriangles => "npz",
-            ColumnLayout::CageVertices => "npy",
+            ColumnLayout::CageVertices | ColumnLayout::BlocksPerVertexThenTriangle => "npy",
         };
         let (parameter, extra) = match method.spec().parameter {
             None => (serde_json::json!({}), Vec::new()),
             Some(spec) => {
                 // Small values, for speed.
                 let (value, text) = match spec.key {
-                    Parameter::Resolution => (8, "8"),
-                    Parameter::Grid => (16, "16"),
+                    Parameter::Resolution => (serde_json::json!(8), "8"),
+                    Parameter::Grid => (serde_json::json!(16), "16"),
+                    // A decimal parameter is written as the decimal.
+                    Parameter::PoissonRatio => (serde_json::json!(0.3), "0.3"),
                 };
                 let mut parameter = serde_json::Map::new();
-                parameter.insert(spec.key.id().to_owned(), value.into());
+                parameter.insert(spec.key.id().to_owned(), value);
                 (parameter.into(), vec![spec.flag, text])
             }
         };
@@ -120,6 +122,12 @@ fn bind_writes_metadata_and_row_classes_for_every_family() {
             let triangles: Vec<[u32; 3]> = serde_json::from_value(field("triangles")).unwrap();
             assert_eq!(triangles, cage.triangles());
             assert_eq!(triangles.len(), columns - cage.vertex_count());
+        } else if spec.columns == ColumnLayout::BlocksPerVertexThenTriangle {
+            assert_eq!(field("columns_layout"), "blocks_per_vertex_then_triangle");
+            // Block columns 9(V + t) on are the cage's t-th triangle.
+            let triangles: Vec<[u32; 3]> = serde_json::from_value(field("triangles")).unwrap();
+            assert_eq!(triangles, cage.triangles());
+            assert_eq!(9 * (triangles.len() + cage.vertex_count()), columns);
         } else {
             assert_eq!(field("columns_layout"), "cage_vertices");
             assert!(json.get("triangles").is_none(), "{json}");

@@ -16,6 +16,7 @@ mod cli_green;
 mod cli_messages;
 mod cli_metadata;
 mod cli_point_sets;
+mod cli_somigliana;
 #[cfg(unix)]
 mod cli_streamed_writes;
 mod gltf;

@@ -306,3 +306,25 @@ pub fn answer_file_dialog(harness: &mut Harness<'static, EditorApp>, path: &std:
     harness.key_press(egui::Key::Enter);
     harness.run_steps(2);
 }
+
+/// Loads, as a pose, the whole cage turned, scaled by 1.5 and shifted; returns
+/// the rest mesh under the same map (f32): what a family that follows every
+/// similarity of the cage must draw.
+pub fn load_a_similarity_pose(harness: &mut Harness<'static, EditorApp>) -> Vec<glam::Vec3> {
+    use glam::{DMat3, DVec3};
+    let cage = harness.state().document().cage().clone();
+    let rotation = DMat3::from_axis_angle(DVec3::new(0.3, 1.0, 0.2).normalize(), 0.6);
+    let centre = cage.positions().iter().sum::<DVec3>() / cage.vertex_count() as f64;
+    let moved = |p: DVec3| centre + 1.5 * (rotation * (p - centre)) + DVec3::X * 0.4;
+    let pose: Vec<DVec3> = cage.positions().iter().map(|&p| moved(p)).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let pose_path = super::write(
+        dir.path(),
+        "pose.obj",
+        &super::triangles_obj(&pose, cage.triangles()),
+    );
+    assert!(harness.state_mut().load_pose(&pose_path));
+    harness.run_steps(2);
+    let rest = rest_positions(harness.state());
+    rest.iter().map(|p| moved(p.as_dvec3()).as_vec3()).collect()
+}

@@ -296,10 +296,9 @@ fn the_library_refuses_a_parameter_outside_its_range() {
     let classes = classify_points(&cage, &points);
     for (method, resolution, grid) in [(Method::Pmvc, 100_000, 64), (Method::Harmonic, 32, 0)] {
         let options = BindOptions {
-            method,
             resolution,
             grid,
-            quads: pmvc::coords::QuadSplit::None,
+            ..BindOptions::for_method(method)
         };
         let error = bind_cpu(
             &points,

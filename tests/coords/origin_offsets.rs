@@ -64,7 +64,6 @@ fn comb_and_points() -> (Cage, Vec<DVec3>) {
 
 fn options(method: Method) -> BindOptions {
     BindOptions {
-        method,
         resolution: 32,
         // BBW's factor grows as the grid's fourth power and LBC's iterations
         // with its size: a coarse grid keeps this test about the offsets.
@@ -73,7 +72,7 @@ fn options(method: Method) -> BindOptions {
         } else {
             32
         },
-        quads: pmvc::coords::QuadSplit::None,
+        ..BindOptions::for_method(method)
     }
 }
 

@@ -129,6 +129,10 @@ fn every_family_reads_back_what_was_bound_with_its_classes_and_columns() {
                 cage.vertex_count() + cage.triangle_count()
             );
             assert_eq!(metadata.triangles.as_deref(), Some(cage.triangles()));
+        } else if method == Method::Somigliana {
+            let blocks = cage.vertex_count() + cage.triangle_count();
+            assert_eq!(metadata.columns, 9 * blocks);
+            assert_eq!(metadata.triangles.as_deref(), Some(cage.triangles()));
         } else {
             assert_eq!(metadata.columns, cage.vertex_count());
             assert_eq!(metadata.triangles, None);

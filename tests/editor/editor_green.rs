@@ -7,7 +7,7 @@ use crate::common;
 
 use common::editor::*;
 use egui_kittest::kittest::Queryable;
-use glam::{DMat3, DVec3};
+
 use pmvc::app::compare::{Overlay, Pane};
 use pmvc::coords::green::bind_green;
 use pmvc::coords::{BindProgress, Method};
@@ -34,22 +34,8 @@ fn green_binds_follows_a_similarity_and_shows_psi_and_phi_negativity() {
 
     // A rotation and uniform scale of the whole cage, loaded as a pose: the drawn
     // mesh is the rest mesh under the same map (to f32 blending).
-    let rotation = DMat3::from_axis_angle(DVec3::new(0.3, 1.0, 0.2).normalize(), 0.6);
-    let centre = cage.positions().iter().sum::<DVec3>() / vertices as f64;
-    let moved = |p: DVec3| centre + 1.5 * (rotation * (p - centre)) + DVec3::X * 0.4;
-    let pose: Vec<DVec3> = cage.positions().iter().map(|&p| moved(p)).collect();
-    let dir = tempfile::tempdir().unwrap();
-    let pose_path = common::write(
-        dir.path(),
-        "pose.obj",
-        &common::triangles_obj(&pose, cage.triangles()),
-    );
-    assert!(harness.state_mut().load_pose(&pose_path));
-    harness.run_steps(2);
-    let app = harness.state();
-    let drawn = app.read_back_deformed().unwrap().unwrap();
-    let rest = rest_positions(app);
-    let expected: Vec<glam::Vec3> = rest.iter().map(|p| moved(p.as_dvec3()).as_vec3()).collect();
+    let expected = load_a_similarity_pose(&mut harness);
+    let drawn = harness.state().read_back_deformed().unwrap().unwrap();
     let worst = max_distance(&drawn, &expected);
     assert!(
         worst < 2e-4 * cage.diagonal() as f32,

@@ -50,6 +50,7 @@ mod editor_scene;
 mod editor_sessions;
 #[cfg(feature = "ui-tests")]
 mod editor_shortcuts;
+mod editor_somigliana;
 #[cfg(feature = "ui-tests")]
 mod editor_timeline;
 #[cfg(feature = "ui-tests")]

@@ -61,6 +61,7 @@ fn frame_uniform_matches_the_wgsl_frame() {
             smooth_shading,
             vertex_columns,
             probe_width,
+            vertex_column_stride,
         ]
     );
     for source in [

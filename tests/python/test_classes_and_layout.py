@@ -127,7 +127,9 @@ def test_a_npy_point_set_loads_as_points_without_faces(tmp_path, test_points):
 
 def test_families_lists_every_family_with_its_parameters_and_promise():
     families = {family["id"]: family for family in pmvc.families()}
-    assert list(families) == ["mvc", "pmvc", "harmonic", "green", "mec", "mlc", "bbw", "lbc"]
+    assert list(families) == [
+        "mvc", "pmvc", "harmonic", "green", "mec", "mlc", "bbw", "lbc", "somigliana"
+    ]
     assert families["pmvc"]["positive_inside"] and not families["mvc"]["positive_inside"]
     for positive_on_the_cpu in ("mec", "mlc"):
         family = families[positive_on_the_cpu]

@@ -42,6 +42,6 @@ def test_everything_public_has_a_docstring_and_a_signature():
             if not member.startswith("_"):
                 assert inspect.getdoc(getattr(cls, member)), f"{cls.__name__}.{member}"
     assert str(inspect.signature(pmvc.bind)) == (
-        "(points, cage, method='pmvc', resolution=32, grid=None, backend='auto', progress=None, triangulate=None,"
+        "(points, cage, method='pmvc', resolution=32, grid=None, poisson_ratio=0.0, backend='auto', progress=None, triangulate=None,"
         " pmvc_kernel='auto', strict=False, dtype='float32')"
     )

@@ -97,12 +97,16 @@ fn heatmap_controls(ui: &mut egui::Ui, cx: &PanelContext, view: &mut ViewSetting
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut of_triangle, false, "λi of vertex")
-                .on_hover_text("Every family: the coordinate of cage vertex i (φi for Green)");
+                .on_hover_text(
+                    "Every family: the coordinate of cage vertex i (φi for Green; for \
+                     Somigliana Bxx, the x-from-x entry of its 3×3 block)",
+                );
             ui.selectable_value(&mut of_triangle, true, "ψj of face")
                 .on_hover_text(
-                    "Green coordinates only: ψ column j, the function of cage triangle j; \
+                    "Green coordinates: ψ column j, the function of cage triangle j; \
                      on quads (QGC) the lone triangles' columns, then four per quad, \
-                     one per corner normal (the colour bar names which)",
+                     one per corner normal (the colour bar names which). Somigliana: \
+                     Fxx, the x-from-x entry of triangle j's face block",
                 );
         })
         .response

@@ -38,10 +38,11 @@ impl Views {
         if let Colouring::TriangleWeight(_) = colouring {
             let has_triangle_columns =
                 method.columns(document.cage()) > method.vertex_columns(document.cage());
+            let (_, symbol) = method.spec().columns.function_symbols();
             notes.push(if has_triangle_columns {
-                "ψ is signed: blue below 0, red above".to_owned()
+                format!("{symbol} is signed: blue below 0, red above")
             } else {
-                format!("{method} has no ψ: shaded")
+                format!("{method} has no {symbol}: shaded")
             });
         }
         (!notes.is_empty()).then(|| BarNote {
@@ -58,15 +59,18 @@ impl Views {
             .map_or(kind.method().name().to_owned(), |set| {
                 set.options.family_name(document.cage())
             });
+        let (vertex_symbol, triangle_symbol) = kind.method().spec().columns.function_symbols();
         match (self.settings.colouring(kind), kind) {
-            (Colouring::CageVertexWeight(vertex), _) => format!("λ{vertex} ({method})"),
+            (Colouring::CageVertexWeight(vertex), _) => {
+                format!("{vertex_symbol}{vertex} ({method})")
+            }
             (Colouring::TriangleWeight(triangle), _) => {
                 match document.face_column(kind.method(), triangle as usize) {
-                    Some(face) => format!("ψ{triangle} of {face} ({method})"),
-                    None => format!("ψ{triangle} ({method})"),
+                    Some(face) => format!("{triangle_symbol}{triangle} of {face} ({method})"),
+                    None => format!("{triangle_symbol}{triangle} ({method})"),
                 }
             }
-            (Colouring::MostNegativeWeight, _) => format!("min λ ({method})"),
+            (Colouring::MostNegativeWeight, _) => format!("min {vertex_symbol} ({method})"),
             (Colouring::MethodDistance, Pane::Difference { .. }) => {
                 // The pane's title names the methods; the bar says how it scales.
                 match self.settings.difference_limit {

@@ -1,8 +1,8 @@
 //! Somigliana coordinates (Chen, de Goes, Desbrun, "Somigliana Coordinates: an
 //! elasticity-derived approach for cage deformation", SIGGRAPH 2023), the CPU
 //! core: 3×3 blocks per point and cage vertex or triangle, in f64, and the
-//! paper's global deformation. Not yet a [`super::Method`]: its columns are 3×3
-//! blocks, which the weights layout does not have.
+//! paper's global deformation; as the family [`super::Method::Somigliana`], each
+//! block expanded into 9 scalar columns (`columns.rs`).
 //!
 //! # Formulation
 //!
@@ -60,6 +60,7 @@
 //! the blocks are the identity's exterior value (Σ Bᵥ = 0), with no exterior
 //! extension.
 
+mod columns;
 mod fit;
 mod near;
 mod quadrature;
@@ -70,9 +71,15 @@ mod reference;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_family;
+#[cfg(test)]
 mod tests_schemes;
 
 use crate::geometry::Cage;
+pub use columns::{
+    column_count, column_displacements, identity_blocks, rest_columns, SomiglianaCage,
+    BLOCK_COLUMNS,
+};
 pub use fit::SimilarityFit;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -83,6 +90,31 @@ pub const DEFAULT_POISSON_RATIO: f64 = 0.0;
 /// The open range of Poisson ratios accepted: at −1 the face term vanishes, at ½
 /// it diverges (incompressible material).
 pub const POISSON_RATIO_RANGE: (f64, f64) = (-1.0, 0.5);
+
+/// The family's Poisson ratio setting ν, to a thousandth: −0.999 (auxetic) to
+/// 0.499 (at −1 the face term vanishes, at ½ it diverges), held as thousandths
+/// above a zero of 1000.
+pub const POISSON_RATIO_SETTING: super::ParameterSpec = super::ParameterSpec {
+    key: super::Parameter::PoissonRatio,
+    label: "Poisson ratio",
+    flag: "--poisson-ratio",
+    choices: &[500, 1000, 1250, 1300, 1400, 1450],
+    default: POISSON_RATIO_ZERO + (DEFAULT_POISSON_RATIO * 1000.0) as u32,
+    min: POISSON_RATIO_ZERO - 999,
+    max: POISSON_RATIO_ZERO + 499,
+    named: &[],
+    format: |value| {
+        format!(
+            "ν {}",
+            super::family::signed_decimal(value.into(), POISSON_RATIO_ZERO, 1000)
+        )
+    },
+    scale: 1000,
+    zero: POISSON_RATIO_ZERO,
+};
+
+/// The held value of ν = 0 in [`POISSON_RATIO_SETTING`].
+const POISSON_RATIO_ZERO: u32 = 1000;
 
 /// What can go wrong computing or applying Somigliana blocks.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

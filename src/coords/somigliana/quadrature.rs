@@ -1,6 +1,6 @@
 //! Quadrature with error estimates for vector-valued integrands: adaptive
 //! Gauss–Kronrod (7/15 points) on an interval, and an adaptive collapsed
-//! Gauss–Legendre rule on a triangle.
+//! Gauss–Legendre rule on a triangle, each with a bound on its pieces.
 
 use std::sync::OnceLock;
 
@@ -34,9 +34,15 @@ const GAUSS_WEIGHTS: [f64; 4] = [
     0.417_959_183_673_469_4,
 ];
 
-/// How deep an interval or a triangle may be bisected before its estimate is
-/// taken as it is (the integrands here have no singularity on the domain).
-const MAX_DEPTH: u32 = 40;
+/// How many pieces an interval or a triangle may be cut into before the
+/// estimate is taken as it is: the bound on the work per integral. The
+/// integrands here are smooth on the domain, so this is reached only where
+/// rounding keeps the error estimate above the tolerance.
+const MAX_PIECES: usize = 256;
+
+/// An error estimate within this many units of rounding of the integral of |f|
+/// is rounding, not truncation: refining would not lower it.
+const ROUNDOFF_ULPS: f64 = 64.0;
 
 fn add_scaled<const N: usize>(sum: &mut [f64; N], values: &[f64; N], scale: f64) {
     for (s, v) in sum.iter_mut().zip(values) {
@@ -44,21 +50,35 @@ fn add_scaled<const N: usize>(sum: &mut [f64; N], values: &[f64; N], scale: f64)
     }
 }
 
-/// One Gauss–Kronrod step on [a, b]: the Kronrod estimate and the largest
-/// component of its difference from the Gauss estimate.
+/// One Gauss–Kronrod step on [a, b].
+struct KronrodStep<const N: usize> {
+    lo: f64,
+    hi: f64,
+    estimate: [f64; N],
+    /// The largest component of the Kronrod estimate's difference from Gauss's.
+    error: f64,
+    /// The largest component of the integral of |f| (Kronrod's rule): the scale
+    /// of the rounding in `estimate`.
+    magnitude: f64,
+}
+
 fn kronrod_step<const N: usize>(
     f: &mut impl FnMut(f64) -> [f64; N],
-    a: f64,
-    b: f64,
-) -> ([f64; N], f64) {
-    let (centre, half) = (0.5 * (a + b), 0.5 * (b - a));
+    lo: f64,
+    hi: f64,
+) -> KronrodStep<N> {
+    let (centre, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
     let mut kronrod = [0.0; N];
     let mut gauss = [0.0; N];
+    let mut absolute = [0.0; N];
     for (k, (&node, &weight)) in KRONROD_NODES.iter().zip(&KRONROD_WEIGHTS).enumerate() {
         let offsets: &[f64] = if node == 0.0 { &[0.0] } else { &[-node, node] };
         for &offset in offsets {
             let value = f(centre + half * offset);
             add_scaled(&mut kronrod, &value, weight * half);
+            for (a, v) in absolute.iter_mut().zip(&value) {
+                *a += (weight * half * v).abs();
+            }
             if k % 2 == 1 {
                 add_scaled(&mut gauss, &value, GAUSS_WEIGHTS[k / 2] * half);
             }
@@ -68,12 +88,21 @@ fn kronrod_step<const N: usize>(
         .iter()
         .zip(&gauss)
         .fold(0.0f64, |m, (k, g)| m.max((k - g).abs()));
-    (kronrod, error)
+    let magnitude = absolute.iter().fold(0.0f64, |m, a| m.max(*a));
+    KronrodStep {
+        lo,
+        hi,
+        estimate: kronrod,
+        error,
+        magnitude,
+    }
 }
 
-/// ∫ₐᵇ f, every component within about `tolerance` (absolute): intervals are
-/// bisected until the Gauss–Kronrod difference of each is below its share of the
-/// tolerance (in proportion to its width). Adds the integral to `sum`.
+/// ∫ₐᵇ f, every component within about `tolerance` (absolute), by globally
+/// adaptive Gauss–Kronrod: the piece with the largest error estimate is halved
+/// until the estimates sum to at most `tolerance`, or are rounding
+/// ([`ROUNDOFF_ULPS`]), or there are [`MAX_PIECES`] pieces. Adds the integral to
+/// `sum`.
 pub(super) fn integrate_interval<const N: usize>(
     f: &mut impl FnMut(f64) -> [f64; N],
     a: f64,
@@ -81,21 +110,30 @@ pub(super) fn integrate_interval<const N: usize>(
     tolerance: f64,
     sum: &mut [f64; N],
 ) {
-    let width = (b - a).abs();
-    if width == 0.0 {
+    if a == b {
         return;
     }
-    let mut stack = vec![(a, b, 0u32)];
-    while let Some((lo, hi, depth)) = stack.pop() {
-        let (estimate, error) = kronrod_step(f, lo, hi);
-        let share = tolerance * (hi - lo).abs() / width;
-        if error <= share || depth >= MAX_DEPTH {
-            add_scaled(sum, &estimate, 1.0);
-        } else {
-            let middle = 0.5 * (lo + hi);
-            stack.push((lo, middle, depth + 1));
-            stack.push((middle, hi, depth + 1));
+    let mut pieces = vec![kronrod_step(f, a, b)];
+    loop {
+        let total_error: f64 = pieces.iter().map(|p| p.error).sum();
+        let rounding: f64 =
+            pieces.iter().map(|p| p.magnitude).sum::<f64>() * (ROUNDOFF_ULPS * f64::EPSILON);
+        if total_error <= tolerance.max(rounding) || pieces.len() >= MAX_PIECES {
+            break;
         }
+        let worst = (0..pieces.len())
+            .max_by(|&i, &j| pieces[i].error.total_cmp(&pieces[j].error))
+            .unwrap_or(0);
+        let (lo, hi) = (pieces[worst].lo, pieces[worst].hi);
+        let middle = 0.5 * (lo + hi);
+        if middle <= lo.min(hi) || middle >= lo.max(hi) {
+            break; // no room left between the floats
+        }
+        pieces[worst] = kronrod_step(f, lo, middle);
+        pieces.push(kronrod_step(f, middle, hi));
+    }
+    for piece in &pieces {
+        add_scaled(sum, &piece.estimate, 1.0);
     }
 }
 
@@ -159,6 +197,7 @@ pub(super) fn integrate_triangle<const N: usize>(
     let root: ParameterTriangle = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
     let root_estimate = collapsed_rule(f, &root);
     let mut stack = vec![(root, root_estimate, 0u32)];
+    let mut splits = 0;
     while let Some((triangle, estimate, depth)) = stack.pop() {
         let children = split_in_four(&triangle);
         let child_estimates = children.map(|child| collapsed_rule(f, &child));
@@ -171,9 +210,12 @@ pub(super) fn integrate_triangle<const N: usize>(
             .zip(&estimate)
             .fold(0.0f64, |m, (r, e)| m.max((r - e).abs()));
         let share = tolerance * 0.25f64.powi(depth as i32);
-        if difference <= share || depth >= MAX_DEPTH.min(8) {
+        let rounding =
+            estimate.iter().fold(0.0f64, |m, e| m.max(e.abs())) * (ROUNDOFF_ULPS * f64::EPSILON);
+        if difference <= share.max(rounding) || splits >= MAX_PIECES {
             add_scaled(sum, &refined, 1.0);
         } else {
+            splits += 1;
             for (child, child_estimate) in children.into_iter().zip(child_estimates) {
                 stack.push((child, child_estimate, depth + 1));
             }
@@ -239,5 +281,40 @@ mod tests {
         let exact_rational = 1.0 - 2.0 * (1.5f64).ln();
         assert!((sum[0] - exact_monomial).abs() < 1e-15, "{sum:?}");
         assert!((sum[1] - exact_rational).abs() < 1e-14, "{sum:?}");
+    }
+
+    #[test]
+    fn rounding_noise_stops_the_refinement() {
+        // A smooth integrand plus noise of 1e-13 relative, asked for 1e-16:
+        // refining cannot meet that, and the work stays bounded.
+        let mut calls = 0usize;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut noisy = |x: f64| {
+            calls += 1;
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let noise = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            [x.cos() * (1.0 + 1e-13 * noise)]
+        };
+        let mut sum = [0.0];
+        integrate_interval(&mut noisy, 0.0, 3.0, 1e-16, &mut sum);
+        assert!((sum[0] - 3f64.sin()).abs() < 1e-12, "{sum:?}");
+        assert!(calls <= 15 * (2 * MAX_PIECES), "{calls} evaluations");
+
+        let mut triangle_calls = 0usize;
+        let mut noisy_2d = |xi: f64, eta: f64| {
+            triangle_calls += 1;
+            let wobble = ((xi * 1e9).sin() * (eta * 1e9).cos()) * 1e-13;
+            [1.0 + wobble]
+        };
+        let mut area = [0.0];
+        integrate_triangle(&mut noisy_2d, 1e-18, &mut area);
+        assert!((area[0] - 0.5).abs() < 1e-12, "{area:?}");
+        let per_rule = COLLAPSED_ORDER * COLLAPSED_ORDER;
+        assert!(
+            triangle_calls <= per_rule * (1 + 4 * MAX_PIECES),
+            "{triangle_calls} evaluations"
+        );
     }
 }

@@ -5,7 +5,7 @@ use glam::DVec2;
 
 /// A non-convex L-shaped prism: the planes y = 1 and x = 1 of its step faces
 /// pass through its interior.
-fn l_cage() -> Cage {
+pub(super) fn l_cage() -> Cage {
     let outline = [
         (0.0, 0.0),
         (2.0, 0.0),

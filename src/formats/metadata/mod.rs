@@ -243,7 +243,8 @@ impl WeightsMetadata {
             rows: record.points.len(),
             columns: method.columns(&bound),
             columns_layout: layout_id(layout).to_owned(),
-            triangles: (layout == ColumnLayout::CageVerticesThenTriangles).then(|| {
+            // The triangles that own columns, in column order.
+            triangles: (layout != ColumnLayout::CageVertices).then(|| {
                 bound
                     .lone_triangles()
                     .map(|t| bound.triangles()[t])
@@ -428,6 +429,10 @@ impl WeightsMetadata {
         let expected = match layout {
             ColumnLayout::CageVertices => self.cage.vertices,
             ColumnLayout::CageVerticesThenTriangles => self.cage.vertices + self.face_columns(),
+            ColumnLayout::BlocksPerVertexThenTriangle => {
+                crate::coords::somigliana::BLOCK_COLUMNS
+                    * (self.cage.vertices + self.cage.triangles)
+            }
         };
         if self.columns != expected || self.columns_layout != layout_id(layout) {
             return Err(field(
@@ -456,6 +461,7 @@ fn layout_id(layout: ColumnLayout) -> &'static str {
     match layout {
         ColumnLayout::CageVertices => "cage_vertices",
         ColumnLayout::CageVerticesThenTriangles => "cage_vertices_then_triangles",
+        ColumnLayout::BlocksPerVertexThenTriangle => "blocks_per_vertex_then_triangle",
     }
 }
 

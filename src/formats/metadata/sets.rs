@@ -144,7 +144,12 @@ pub fn load_any_weights_set(path: &Path) -> Result<LoadedAnyWeights, MetadataErr
         metadata.face_columns(),
     );
     let npz = options.method.spec().columns == ColumnLayout::CageVerticesThenTriangles;
-    let expected = ExpectedArray::cage_vertices(rows, vertices);
+    let expected = ExpectedArray::of_layout(
+        options.method.spec().columns,
+        rows,
+        vertices,
+        metadata.cage.triangles,
+    );
     let weights = match (metadata.dtype(), npz) {
         (Dtype::Float32, true) => AnyWeights::F32(read_npz(path, rows, vertices, triangles)?),
         (Dtype::Float32, false) => AnyWeights::F32(read_npy(path, expected)?),

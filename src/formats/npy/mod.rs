@@ -150,6 +150,27 @@ impl ExpectedArray {
         }
     }
 
+    /// The one array of a family whose columns are not all cage vertices'
+    /// weights and that writes a .npy: 9 per cage vertex and triangle
+    /// (Somigliana blocks; the vertex blocks sum to I, not their entries to 1).
+    /// Other layouts: [`Self::cage_vertices`].
+    pub fn of_layout(
+        layout: crate::coords::family::ColumnLayout,
+        rows: usize,
+        cage_vertices: usize,
+        cage_triangles: usize,
+    ) -> Self {
+        match layout {
+            crate::coords::family::ColumnLayout::BlocksPerVertexThenTriangle => Self {
+                rows,
+                cols: crate::coords::somigliana::BLOCK_COLUMNS * (cage_vertices + cage_triangles),
+                columns: "block columns (9 per vertex and per triangle)",
+                rows_sum_to_one: false,
+            },
+            _ => Self::cage_vertices(rows, cage_vertices),
+        }
+    }
+
     fn what_sums(&self) -> &'static str {
         if self.rows_sum_to_one {
             "the weights of the cage vertices"

@@ -187,6 +187,7 @@ impl From<coords::BindFailure> for BindError {
             coords::BindFailure::Harmonic(error) => BindError::Harmonic(error),
             coords::BindFailure::Parameter(error) => BindError::InvalidInput(error.to_string()),
             coords::BindFailure::TooLarge(error) => BindError::InvalidInput(error.to_string()),
+            coords::BindFailure::Somigliana(error) => BindError::InvalidInput(error.to_string()),
         }
     }
 }

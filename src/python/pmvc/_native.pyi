@@ -106,8 +106,9 @@ class Weights:
         """The family's id: "mvc", "pmvc", "harmonic" or "green"."""
         ...
     @property
-    def parameters(self) -> Dict[str, int]:
-        """The family's own parameters, e.g. ``{"resolution": 32}``."""
+    def parameters(self) -> Dict[str, Union[int, float, str]]:
+        """The family's own parameters, e.g. ``{"resolution": 32}``,
+        ``{"resolution": "exact"}`` or ``{"poisson_ratio": 0.3}``."""
         ...
     @property
     def backend(self) -> str:
@@ -124,16 +125,21 @@ class Weights:
     @property
     def columns(self) -> List[Tuple[str, int]]:
         """What each column is: ``("vertex", j)`` per cage vertex (φ for
-        Green), then for Green ``("triangle", k)`` per ``triangles[k]`` (ψ)."""
+        Green), then for Green ``("triangle", k)`` per ``triangles[k]`` (ψ) and
+        on quads ``("quad_corner", 4 q + c)``; for Somigliana coordinates
+        ``("vertex_block", 9 j + 3 a + b)`` then ``("triangle_block", 9 k + 3 a
+        + b)``, entry (a, b) of a 3×3 block."""
         ...
     @property
     def columns_layout(self) -> str:
-        """"cage_vertices" or "cage_vertices_then_triangles"."""
+        """"cage_vertices", "cage_vertices_then_triangles" (Green) or
+        "blocks_per_vertex_then_triangle" (Somigliana)."""
         ...
     @property
     def triangles(self) -> Optional[npt.NDArray[np.int64]]:
-        """For Green coordinates, the triangles ψ refers to (int64 (t, 3),
-        corners in the order used); None otherwise."""
+        """For Green and Somigliana coordinates, the triangles the triangle
+        columns refer to (int64 (t, 3), corners in the order used); None
+        otherwise."""
         ...
     @property
     def metadata(self) -> Dict[str, Any]:
@@ -159,6 +165,7 @@ def bind(
     method: str = "pmvc",
     resolution: Union[int, str] = 32,
     grid: int | None = None,
+    poisson_ratio: float = 0.0,
     backend: str = "auto",
     progress: Optional[Progress] = None,
     triangulate: Optional[str] = None,
@@ -170,7 +177,8 @@ def bind(
 
     ``resolution`` is PMVC's cube-map resolution (or ``"exact"``), ``grid`` the
     grid of harmonic coordinates, BBW and LBC (``None``: the family's default,
-    64, 32 and 32); each is read only by its family and checked against its
+    64, 32 and 32), ``poisson_ratio`` Somigliana coordinates' Poisson ratio
+    (-0.999 to 0.499); each is read only by its family and checked against its
     range. Quads are bilinear patches (MVC on them is QMVC) unless
     ``triangulate`` is "shorter" or "longer", which splits them along that
     diagonal first; Green coordinates always bind on triangles. ``backend``: "auto" (the CPU, or a hardware GPU where it is

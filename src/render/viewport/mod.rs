@@ -322,7 +322,8 @@ impl ViewportRenderer {
             .scene
             .as_ref()
             .map_or(0, |scene| scene.cage_vertex_count);
-        let [colouring, colouring_column] = shading.colouring.code(cage_vertices, columns);
+        let layout = shading.method.spec().columns;
+        let [colouring, colouring_column] = shading.colouring.code(layout, cage_vertices, columns);
         FrameUniform {
             view_projection: params.view_projection.to_cols_array_2d(),
             eye: params.eye.to_array(),
@@ -343,9 +344,10 @@ impl ViewportRenderer {
             // The pool holds the shown family's chunks first (SceneGpu::bind_group).
             other_first_chunk: shown.map_or(0, |slot| slot.chunks.len() as u32),
             smooth_shading: u32::from(params.smooth_shading),
-            vertex_columns: cage_vertices,
+            vertex_columns: cage_vertices * layout.columns_per_element() as u32,
             probe_width: super::scene_gpu::PROBE_WIDTH,
-            _padding: [0; 2],
+            vertex_column_stride: layout.columns_per_element() as u32,
+            _padding: [0; 1],
         }
     }
 

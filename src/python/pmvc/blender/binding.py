@@ -42,9 +42,20 @@ def parameters_for(method, values):
     chosen = {}
     for p in family(method)["parameters"]:
         if p["id"] in values:
-            value = int(values[p["id"]])
+            value = parameter_value(p, values[p["id"]])
             chosen[p["id"]] = p["default"] if value == shared[p["id"]]["default"] else value
     return chosen
+
+
+def is_decimal(spec):
+    """Whether a parameter is a decimal (the Poisson ratio), not a whole number."""
+    return isinstance(spec["default"], float)
+
+
+def parameter_value(spec, value):
+    """A setting's value as the package takes it: a whole number, or a decimal
+    to the thousandth the package holds (Blender's floats are single precision)."""
+    return round(float(value), 3) if is_decimal(spec) else int(value)
 
 
 def mesh_and_cage(context):

@@ -6,7 +6,7 @@ import threading
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 import pmvc
@@ -137,9 +137,18 @@ def _parameter_annotations():
     default = "PMVC" if any(item[0] == "PMVC" for item in items) else items[0][0]
     annotations = {"method": EnumProperty(name="Method", items=items, default=default)}
     for pid, spec in binding.parameter_specs().items():
-        annotations[pid] = IntProperty(name=spec.get("label", pid), default=spec["default"],
-                                       min=spec["min"], max=spec["max"])
+        annotations[pid] = parameter_property(spec)
     return annotations
+
+
+def parameter_property(spec):
+    """A family's setting as a Blender property: whole numbers as an integer,
+    a decimal (the Poisson ratio) as a float shown to the thousandth."""
+    name = spec.get("label", spec["id"])
+    if binding.is_decimal(spec):
+        return FloatProperty(name=name, default=spec["default"], min=spec["min"], max=spec["max"],
+                             step=1, precision=3)
+    return IntProperty(name=name, default=spec["default"], min=spec["min"], max=spec["max"])
 
 
 class PMVC_OT_unbind(bpy.types.Operator):

@@ -11,8 +11,7 @@ def settings_class():
     default = "PMVC" if any(item[0] == "PMVC" for item in items) else items[0][0]
     annotations = {"method": EnumProperty(name="Method", items=items, default=default)}
     for pid, spec in binding.parameter_specs().items():
-        annotations[pid] = IntProperty(name=spec.get("label", pid), default=spec["default"],
-                                       min=spec["min"], max=spec["max"])
+        annotations[pid] = operators.parameter_property(spec)
     annotations["cage_vertex"] = IntProperty(name="Cage vertex", default=0, min=0)
     return type("PMVC_Settings", (bpy.types.PropertyGroup,), {"__annotations__": annotations})
 

@@ -1,0 +1,171 @@
+//! Somigliana coordinates as a weights matrix: each 3×3 block expanded into 9
+//! scalar columns, 9 per cage vertex then 9 per cage triangle, entry (a, b) of
+//! a block at offset `3a + b`. Column (v, a, b) multiplies the vector
+//! `(Rᵀ (vᵥ' − c'))_b R e_a + c'_b e_a` (c' the pose's vertex centroid) and
+//! column (f, a, b) the vector `s (n_f)_b R e_a`, with s R the similarity fitted
+//! to the pose, so that `Σ wₖ cₖ'` is the global deformation of
+//! [`super::deform`] about c' (inside, where Σ Bᵥ = I).
+
+use super::triangle::{Material, TriangleFrame};
+use super::{check_positions, fit, validate_poisson_ratio, SomiglianaError};
+use crate::geometry::Cage;
+use glam::{DMat3, DVec3};
+
+/// Scalar columns per block.
+pub const BLOCK_COLUMNS: usize = 9;
+
+/// How far from the identity Σ Bᵥ may be before a point counts as not inside
+/// (numerically on the surface or outside): the blocks there are the exterior
+/// value or lose digits.
+const INSIDE_TOLERANCE: f64 = 1e-3;
+
+/// Weights columns of a cage: 9 per vertex and per triangle.
+pub fn column_count(cage: &Cage) -> usize {
+    BLOCK_COLUMNS * (cage.vertex_count() + cage.triangle_count())
+}
+
+/// A cage prepared for rows of blocks at one Poisson ratio.
+#[derive(Clone, Debug)]
+pub struct SomiglianaCage {
+    material: Material,
+    frames: Vec<TriangleFrame>,
+    triangles: Vec<[u32; 3]>,
+    vertex_count: usize,
+}
+
+impl SomiglianaCage {
+    pub fn new(cage: &Cage, poisson_ratio: f64) -> Result<Self, SomiglianaError> {
+        let material = Material::new(validate_poisson_ratio(poisson_ratio)?);
+        Ok(Self {
+            material,
+            frames: (0..cage.triangle_count())
+                .map(|t| TriangleFrame::new(cage.triangle(t)))
+                .collect(),
+            triangles: cage.triangles().to_vec(),
+            vertex_count: cage.vertex_count(),
+        })
+    }
+
+    /// The blocks of `x` into `out` ([`column_count`] values). False, with
+    /// `out` unspecified, where Σ Bᵥ is not the identity: `x` is not inside.
+    pub fn row(&self, x: DVec3, out: &mut [f64]) -> bool {
+        out.fill(0.0);
+        let (vertices, faces) = out.split_at_mut(BLOCK_COLUMNS * self.vertex_count);
+        let mut total = DMat3::ZERO;
+        for ((frame, corners), face) in self
+            .frames
+            .iter()
+            .zip(&self.triangles)
+            .zip(faces.chunks_mut(BLOCK_COLUMNS))
+        {
+            let blocks = frame.blocks(x, &self.material);
+            for (&corner, block) in corners.iter().zip(blocks.vertex) {
+                let start = BLOCK_COLUMNS * corner as usize;
+                add_block(&mut vertices[start..start + BLOCK_COLUMNS], block);
+                total += block;
+            }
+            add_block(face, blocks.face);
+        }
+        let error = (total - DMat3::IDENTITY).to_cols_array();
+        x.is_finite() && error.iter().all(|e| e.abs() <= INSIDE_TOLERANCE)
+    }
+}
+
+/// `out[3a + b] += block[a][b]` (row a, column b).
+fn add_block(out: &mut [f64], block: DMat3) {
+    for a in 0..3 {
+        for b in 0..3 {
+            out[3 * a + b] += block.col(b)[a];
+        }
+    }
+}
+
+/// The row of scalar weights λ as blocks λᵥ I (no face term): `Σ λᵥ vᵥ'`, the
+/// deformation of the family λ comes from, whatever the pose's rotation.
+pub fn identity_blocks(lambda: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (block, &weight) in out.chunks_mut(BLOCK_COLUMNS).zip(lambda) {
+        for a in 0..3 {
+            block[4 * a] = weight;
+        }
+    }
+}
+
+/// Every column's vector for rotation `rotation` and scale `scale`, less
+/// `(vᵥ − c)_b e_a` for a vertex's (less nothing for a face's), where
+/// `centred[v]` is `Rᵀ (vᵥ' − c')` and `shift` is `c' − c`. Centred, so a cage
+/// far from the origin loses no digits to the weights' f32 rounding.
+fn column_moves(
+    rest: &Cage,
+    rotation: DMat3,
+    scale: f64,
+    centred: &[DVec3],
+    shift: DVec3,
+) -> Vec<DVec3> {
+    let mut columns = Vec::with_capacity(column_count(rest));
+    let centre = centroid(rest.positions());
+    for (&centred, &position) in centred.iter().zip(rest.positions()) {
+        let before = position - centre;
+        for a in 0..3 {
+            for b in 0..3 {
+                let axis = DVec3::AXES[a];
+                columns.push(centred[b] * rotation.col(a) + (shift[b] - before[b]) * axis);
+            }
+        }
+    }
+    for t in 0..rest.triangle_count() {
+        let [a, b, c] = rest.triangle(t);
+        let normal = (b - a).cross(c - a).normalize_or_zero();
+        for a in 0..3 {
+            for b in 0..3 {
+                columns.push(scale * normal[b] * rotation.col(a));
+            }
+        }
+    }
+    columns
+}
+
+fn centroid(points: &[DVec3]) -> DVec3 {
+    points.iter().sum::<DVec3>() / points.len().max(1) as f64
+}
+
+/// Each column's vector at rest: `(vᵥ)_b e_a`, then `(n_f)_b e_a`.
+pub fn rest_columns(rest: &Cage) -> Vec<DVec3> {
+    let mut columns = Vec::with_capacity(column_count(rest));
+    for &position in rest.positions() {
+        for a in 0..3 {
+            for b in 0..3 {
+                columns.push(position[b] * DVec3::AXES[a]);
+            }
+        }
+    }
+    let faces = column_moves(rest, DMat3::IDENTITY, 1.0, &[], DVec3::ZERO);
+    columns.extend(faces);
+    columns
+}
+
+/// Each column's vector in `pose` less its rest vector (the displacement
+/// form). A pose of the wrong length or not finite moves nothing.
+pub fn column_displacements(rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+    if check_positions(rest, pose).is_err() {
+        return vec![DVec3::ZERO; column_count(rest)];
+    }
+    let similarity = fit::fit_similarity(rest.positions(), pose);
+    let (rotation, centre) = (similarity.rotation, centroid(pose));
+    let centred: Vec<DVec3> = pose
+        .iter()
+        .map(|&p| rotation.transpose() * (p - centre))
+        .collect();
+    let shift = centre - centroid(rest.positions());
+    let mut moves = column_moves(rest, rotation, similarity.scale, &centred, shift);
+    // The faces' vectors less their rest vectors.
+    let vertex_columns = BLOCK_COLUMNS * rest.vertex_count();
+    let rested = rest_columns(rest);
+    for (moved, rested) in moves[vertex_columns..]
+        .iter_mut()
+        .zip(&rested[vertex_columns..])
+    {
+        *moved -= *rested;
+    }
+    moves
+}

@@ -1,0 +1,106 @@
+//! Somigliana coordinates on the command line: `pmvc bind --method somigliana`
+//! writes 9 columns per cage vertex and triangle with the layout and Poisson
+//! ratio in W.json, `pmvc deform` with them or bound afresh follows the
+//! library's global deformation, and a Poisson ratio out of range is refused.
+
+use crate::cli_support::*;
+use crate::common::*;
+use glam::{DQuat, DVec3};
+use pmvc::coords::somigliana::{deform as somigliana_deform, somigliana_blocks};
+use pmvc::formats::load_mesh;
+use std::path::Path;
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn bind_and_deform_follow_the_library_global_deformation() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, cage, points) = comb_scene(dir.path(), 30);
+    let weights = dir.path().join("w.npy");
+    let output = bind(
+        &mesh,
+        &cage_path,
+        "somigliana",
+        &weights,
+        &["--poisson-ratio", "0.3"],
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json = read_json(&dir.path().join("w.json"));
+    assert_eq!(json["method"], "somigliana");
+    assert_eq!(json["columns_layout"], "blocks_per_vertex_then_triangle");
+    assert_eq!(
+        json["parameters"],
+        serde_json::json!({"poisson_ratio": 0.3})
+    );
+    assert_eq!(
+        json["columns"],
+        9 * (cage.vertex_count() + cage.triangle_count())
+    );
+    // A bent tooth, turned, scaled and moved: no similarity.
+    let turn = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
+    let pose: Vec<DVec3> = comb_pose(&cage, 0.4)
+        .into_iter()
+        .map(|p| 1.3 * (turn * p) + DVec3::new(3.0, -1.0, 2.0))
+        .collect();
+    let pose_path = write(
+        dir.path(),
+        "pose.obj",
+        &triangles_obj(&pose, cage.triangles()),
+    );
+    let (stored, fresh) = (dir.path().join("a.obj"), dir.path().join("b.obj"));
+    let output = deform(
+        &mesh,
+        &cage_path,
+        &pose_path,
+        &stored,
+        &["--weights", path_str(&weights)],
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+    let fresh_args = ["--method", "somigliana", "--poisson-ratio", "0.3"];
+    let output = deform(&mesh, &cage_path, &pose_path, &fresh, &fresh_args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(
+        std::fs::read(&stored).unwrap(),
+        std::fs::read(&fresh).unwrap()
+    );
+    let blocks = somigliana_blocks(&points, &cage, 0.3).unwrap();
+    let expected = somigliana_deform(&blocks, &cage, &pose).unwrap();
+    let deformed = load_mesh(&stored).unwrap().mesh.positions;
+    let diagonal = cage.diagonal();
+    let worst = expected
+        .iter()
+        .zip(&deformed)
+        .map(|(a, b)| (*a - *b).length() / diagonal)
+        .fold(0.0f64, f64::max);
+    assert!(worst < 1e-5, "{worst} of the diagonal");
+}
+
+#[test]
+fn a_poisson_ratio_out_of_range_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, _, _) = comb_scene(dir.path(), 4);
+    for value in ["0.7", "-1", "soft"] {
+        let out = dir.path().join("w.npy");
+        let output = bind(
+            &mesh,
+            &cage_path,
+            "somigliana",
+            &out,
+            &["--poisson-ratio", value],
+        );
+        assert_eq!(output.status.code(), Some(1), "{value}");
+        let said = stderr(&output);
+        assert!(said.contains("--poisson-ratio"), "{value}: {said}");
+        assert!(!out.exists());
+    }
+    let said = stderr(&bind(
+        &mesh,
+        &cage_path,
+        "somigliana",
+        &dir.path().join("w.npy"),
+        &["--poisson-ratio", "0.7"],
+    ));
+    assert!(said.contains("-0.999 to 0.499"), "{said}");
+}

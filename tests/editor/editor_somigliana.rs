@@ -1,0 +1,92 @@
+//! Somigliana coordinates in the editor: bound on demand, the vertex shader's
+//! blend of their block columns (vectors recomputed per pose from the fitted
+//! similarity) following a similarity of the cage and drawing what the CPU
+//! computes for a pulled finger, and a vertex's heatmap showing its block's
+//! x-from-x entry.
+
+use crate::common;
+
+use common::editor::*;
+use glam::DVec3;
+use pmvc::app::compare::{Overlay, Pane};
+use pmvc::coords::Method;
+use pmvc::render::Colouring;
+
+#[test]
+fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_active_method(Method::Somigliana);
+    run_until_bound(&mut harness);
+    let app = harness.state();
+    let cage = app.document().cage().clone();
+    let (vertices, triangles) = (cage.vertex_count(), cage.triangle_count());
+    let weights = app
+        .document()
+        .weights(Method::Somigliana)
+        .expect("bound")
+        .clone();
+    assert_eq!(weights.cols, 9 * (vertices + triangles));
+    let quality = app.document().bound(Method::Somigliana).unwrap().quality;
+    assert!(quality.max_partition_error < 1e-5, "{quality:?}");
+
+    // A rotation, scale and shift of the whole cage: the drawn mesh is the rest
+    // mesh under the same map (to f32 blending).
+    let expected = load_a_similarity_pose(&mut harness);
+    let drawn = harness.state().read_back_deformed().unwrap().unwrap();
+    let rest = rest_positions(harness.state());
+    let worst = max_distance(&drawn, &expected);
+    assert!(worst < 2e-4 * cage.diagonal() as f32, "similarity: {worst}");
+
+    // A pulled finger tip: the drawn mesh is the CPU's f64 deformation.
+    let mut pulled = cage.positions().to_vec();
+    pulled[12] += DVec3::new(0.5, 1.0, 0.0);
+    pulled[32] += DVec3::new(0.5, 1.0, 0.0);
+    harness.state_mut().reset_pose();
+    harness.state_mut().set_handle_position(12, pulled[12]);
+    harness.state_mut().set_handle_position(32, pulled[32]);
+    harness.run_steps(2);
+    let app = harness.state();
+    let drawn = app.read_back_deformed().unwrap().unwrap();
+    let on_cpu: Vec<glam::Vec3> = (app.document().deformed_positions(Method::Somigliana))
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect();
+    let worst = max_distance(&drawn, &on_cpu);
+    assert!(worst < 1e-4 * cage.diagonal() as f32, "pulled: {worst}");
+    assert!(max_distance(&drawn, &rest) > 0.3, "the finger moved");
+
+    // Cage vertex 3's heatmap: column 27, the (x, x) entry of its block.
+    harness.state_mut().view_mut().overlay = Overlay::Heatmap;
+    harness.state_mut().view_mut().heat_vertex = 3;
+    harness.run_steps(2);
+    let shading = harness
+        .state_mut()
+        .shading_of(Pane::Method(Method::Somigliana));
+    assert_eq!(shading.colouring, Colouring::CageVertexWeight(3));
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    let column: Vec<f32> = (0..weights.rows).map(|r| weights.row(r)[27]).collect();
+    for (drawn, stored) in read.values.iter().zip(&column) {
+        assert!((drawn - stored).abs() < 1e-6, "{drawn} vs {stored}");
+    }
+    let range = (harness.state_mut())
+        .value_range(shading.colouring, Pane::Method(Method::Somigliana))
+        .unwrap();
+    let low = column.iter().copied().fold(f32::INFINITY, f32::min);
+    let high = column.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    assert_eq!((range.min, range.max), (low, high));
+    // Triangle 5's function: the (x, x) entry of its face block.
+    harness.state_mut().view_mut().heat_triangle = Some(5);
+    harness.run_steps(2);
+    let shading = harness
+        .state_mut()
+        .shading_of(Pane::Method(Method::Somigliana));
+    let read = harness.state().read_back(&shading).unwrap().unwrap();
+    let face_column = 9 * (vertices + 5);
+    for (row, drawn) in read.values.iter().enumerate() {
+        assert!(
+            (drawn - weights.row(row)[face_column]).abs() < 1e-6,
+            "row {row}"
+        );
+    }
+}
