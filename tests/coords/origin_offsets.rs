@@ -397,7 +397,12 @@ mod command_line {
         if green {
             read_npz(&out, rows, cage.vertex_count(), cage.triangle_count()).expect("npz")
         } else {
-            let expected = ExpectedArray::cage_vertices(rows, cage.vertex_count());
+            let expected = ExpectedArray::of_layout(
+                method.spec().columns,
+                rows,
+                cage.vertex_count(),
+                cage.triangle_count(),
+            );
             read_npy(&out, expected).expect("npy")
         }
     }
