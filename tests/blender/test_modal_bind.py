@@ -9,6 +9,8 @@ import time
 import bpy
 import numpy as np
 
+import pmvc
+
 from conftest import comb, coordinates, evaluated, select
 
 
@@ -66,7 +68,9 @@ def operator(method, **parameters):
     probe.reports = []
     probe.report = lambda kind, text: probe.reports.append((set(kind), text))
     probe.method = method
-    for key, value in {"resolution": 32, "grid": 64, **parameters}.items():
+    # Every family's setting at its default, as the operator's properties are.
+    defaults = {spec["id"]: spec["default"] for family in pmvc.families() for spec in family["parameters"]}
+    for key, value in {**defaults, "resolution": 32, "grid": 64, **parameters}.items():
         setattr(probe, key, value)
     return probe
 
