@@ -114,10 +114,10 @@ pub(super) fn integrate_interval<const N: usize>(
         return;
     }
     let mut pieces = vec![kronrod_step(f, a, b)];
+    // Running sums over the pieces, updated as one is replaced by its halves.
+    let (mut total_error, mut total_magnitude) = (pieces[0].error, pieces[0].magnitude);
     loop {
-        let total_error: f64 = pieces.iter().map(|p| p.error).sum();
-        let rounding: f64 =
-            pieces.iter().map(|p| p.magnitude).sum::<f64>() * (ROUNDOFF_ULPS * f64::EPSILON);
+        let rounding = total_magnitude * (ROUNDOFF_ULPS * f64::EPSILON);
         if total_error <= tolerance.max(rounding) || pieces.len() >= MAX_PIECES {
             break;
         }
@@ -129,8 +129,12 @@ pub(super) fn integrate_interval<const N: usize>(
         if middle <= lo.min(hi) || middle >= lo.max(hi) {
             break; // no room left between the floats
         }
-        pieces[worst] = kronrod_step(f, lo, middle);
-        pieces.push(kronrod_step(f, middle, hi));
+        let halves = [kronrod_step(f, lo, middle), kronrod_step(f, middle, hi)];
+        total_error += halves[0].error + halves[1].error - pieces[worst].error;
+        total_magnitude += halves[0].magnitude + halves[1].magnitude - pieces[worst].magnitude;
+        let [first, second] = halves;
+        pieces[worst] = first;
+        pieces.push(second);
     }
     for piece in &pieces {
         add_scaled(sum, &piece.estimate, 1.0);
