@@ -95,6 +95,9 @@ pub enum Action {
     SetParameter(Parameter, u32),
     /// One family's parameter, shown or not (the side panel's controls).
     SetFamilyParameter(Method, u32),
+    /// A setting read when weights deform a pose (Somigliana's bulging),
+    /// checked by its spec; an undo step, and nothing is bound again.
+    SetDeformParameter(Parameter, u32),
     /// Bind quads as bilinear patches, or split along a diagonal (`--triangulate`).
     SetQuadSplit(crate::coords::QuadSplit),
     /// Bind the methods the views show, replacing a running bind.

@@ -102,6 +102,12 @@ pub enum Command {
         action: String,
         view: Option<SessionView>,
     },
+    /// Deform with `value` for the deformation setting `parameter`
+    /// (Somigliana's bulging), checked by its spec, as one undo step.
+    SetDeformParameter {
+        parameter: crate::coords::Parameter,
+        value: u32,
+    },
     /// Make `document` current with nothing to undo (the start-up scene).
     InstallDocument(Box<Document>),
     /// Forget every step (what start-up opened is where editing begins).

@@ -28,8 +28,7 @@ impl Views {
         }
         let set = document.bound_id(id)?;
         let weights = &set.weights;
-        let moves = set
-            .options
+        let moves = (document.deform_options(set.options))
             .column_displacements(document.cage(), document.pose());
         let positions = Arc::new(compare::deform(
             weights,

@@ -277,7 +277,13 @@ pub fn save_session(
         method: settings.bind_options.method,
         parameters: Parameter::ALL
             .into_iter()
-            .map(|p| (p.id().to_owned(), settings.bind_options.get(p).into()))
+            .map(|p| {
+                let value = match p.read_when_deforming() {
+                    true => document.deform_value(p),
+                    false => settings.bind_options.get(p),
+                };
+                (p.id().to_owned(), value.into())
+            })
             .collect(),
         triangulate: settings.bind_options.quads,
         view: settings.view,
@@ -526,7 +532,12 @@ pub fn open_session(path: &Path) -> Result<OpenedSession, SessionError> {
     let mut document = Document::new(title, mesh, cage)
         .with_files(mesh_file, cage_path)
         .with_cage_objects(cage_objects)
-        .with_poses(pose, named_poses);
+        .with_poses(pose, named_poses)
+        .with_deform_values(
+            (Parameter::ALL.into_iter())
+                .filter(|p| p.read_when_deforming())
+                .map(|p| (p, bind_options.get(p))),
+        );
     if let Some(bundled) = bundled_mesh {
         document = document.bundled_as(bundled);
     }

@@ -8,7 +8,7 @@ use super::commands::{
 };
 use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
 use super::{CageInput, DeformArgs};
-use crate::coords::{AnyWeights, BindOptions, Dtype, Method};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method, Parameter};
 use crate::formats::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
 use crate::formats::metadata::{metadata_path, read_metadata, WeightsMetadata};
 use crate::formats::{shown_path, LoadError, ObjectError};
@@ -116,6 +116,19 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
             outside_policy(Some(args.method.method)),
         ),
     };
+    let mut options = options;
+    if let Some(bulging) = args.bulging {
+        options.bulging = bulging;
+        if options
+            .deform_parameters()
+            .all(|(spec, _)| spec.key != Parameter::Bulging)
+        {
+            warn_line!(
+                "pmvc: note: --bulging is ignored: {} weights read no bulging (Somigliana coordinates do)",
+                options.method.name()
+            );
+        }
+    }
     let method = options.method;
     let holds_weights = args.weights.is_none();
     let input = load_input(
@@ -151,9 +164,8 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     // origin, this form only times how far the cage moved. Rows were checked to
     // sum to 1 when read, so a translation of the cage moves every vertex with it.
     // Green's ψ columns follow the triangles the weights were bound on.
-    let bound_cage = options.cage_to_bind(&input.cage);
     let deform = |pose: &[DVec3]| -> Vec<DVec3> {
-        let moves = method.column_displacements(&bound_cage, pose);
+        let moves = options.column_displacements(&input.cage, pose);
         weights.apply_displacements(&input.mesh.mesh.positions, &moves)
     };
     let deformed = deform(&pose);
@@ -196,6 +208,11 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         (Some(path), _) => format!("weights from {}", shown_path(path)),
         (None, _) => format!("{} weights", method_label(options, &input.cage)),
     };
+    // Deformation settings away from their defaults ("γ 2.5").
+    let settings: String = (options.deform_labels().iter())
+        .map(|label| format!(" at {label}"))
+        .collect();
+    let source = source + &settings;
     let extra = match (args.poses.len(), args.animate) {
         (0, _) => String::new(),
         (poses, None) => format!(", and {poses} poses as morph targets"),

@@ -40,8 +40,8 @@ pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use parse::{
-    parse_grid, parse_object_name, parse_percent, parse_poisson_ratio, parse_resolution,
-    parse_seconds, parse_view, TriangulateArg,
+    parse_bulging, parse_grid, parse_object_name, parse_percent, parse_poisson_ratio,
+    parse_resolution, parse_seconds, parse_view, TriangulateArg,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -176,6 +176,7 @@ impl MethodChoice {
             poisson_ratio: self
                 .poisson_ratio
                 .unwrap_or(crate::coords::BindOptions::for_method(self.method).poisson_ratio),
+            bulging: crate::coords::BindOptions::for_method(self.method).bulging,
             quads: self
                 .triangulate
                 .map_or(crate::coords::QuadSplit::None, TriangulateArg::split),
@@ -224,6 +225,12 @@ pub struct DeformArgs {
     /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32 (float64 where W.json says "dtype": "float64"), one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
+    /// Somigliana coordinates: the bulging γ (0–10, in steps of 0.01; default 0,
+    /// none): each cage triangle pushes along its normal harder the more volume
+    /// the pose sweeps outward from where the fitted similarity puts it. Read
+    /// when deforming, so the same weights serve every γ.
+    #[arg(long, value_parser = parse_bulging, allow_negative_numbers = true)]
+    pub bulging: Option<u32>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format. A name ending in .glb gets binary glTF 2.0, and .gltf glTF's JSON with its buffer inside: positions, recomputed normals, texture coordinates (v flipped, as glTF has it) and the OBJ's groups as primitives.
     #[arg(long, value_name = "M2.obj|P2.npy|M2.glb|M2.gltf")]
     pub out: PathBuf,
@@ -286,6 +293,10 @@ pub struct EditArgs {
     /// instead of as bilinear patches (the Quads setting in the side panel).
     #[arg(long, value_enum, value_name = "DIAGONAL")]
     pub triangulate: Option<TriangulateArg>,
+    /// Somigliana coordinates' bulging γ (0–10), as `pmvc deform --bulging`:
+    /// the side panel's Bulging γ, applied after --pose.
+    #[arg(long, value_parser = parse_bulging, allow_negative_numbers = true)]
+    pub bulging: Option<u32>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
     pub method: Option<crate::coords::Method>,
@@ -400,6 +411,7 @@ impl EditArgs {
             pose: self.pose,
             resolution: self.resolution,
             grid: self.grid,
+            bulging: self.bulging,
             triangulate: self.triangulate.map(TriangulateArg::split),
             method,
             screenshot: self.screenshot,

@@ -18,6 +18,11 @@ pub(super) fn parse_poisson_ratio(text: &str) -> Result<u32, String> {
     parse_parameter(crate::coords::Parameter::PoissonRatio, text)
 }
 
+/// `--bulging`: a decimal, held in hundredths, checked by its spec.
+pub(super) fn parse_bulging(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::Bulging, text)
+}
+
 fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
     parameter.spec().parse(text)
 }

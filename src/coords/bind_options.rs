@@ -1,5 +1,7 @@
 //! What a bind is asked for: the family, its parameters and what to do with
-//! the cage's quads, with the one check of the parameters.
+//! the cage's quads, with the one check of the parameters; and the settings the
+//! family reads when its weights deform a pose (Somigliana's bulging), which
+//! are not part of the weights.
 
 use super::{
     harmonic, Method, Parameter, ParameterError, ParameterSpec, QuadSplit, QuadSupport,
@@ -21,6 +23,10 @@ pub struct BindOptions {
     /// above 1000: [`Self::poisson_ratio`] gives ν);
     /// ignored by the others.
     pub poisson_ratio: u32,
+    /// Somigliana coordinates' bulging γ, in hundredths ([`Self::bulging`] gives
+    /// γ): read when the weights deform a pose, so it is not part of the
+    /// weights ([`Self::same_weights_as`] ignores it); ignored by the others.
+    pub bulging: u32,
     /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
     /// split into triangles along a diagonal first (`--triangulate`). Families that
     /// only take triangles (Green) split along the shorter one when this is `None`.
@@ -47,6 +53,7 @@ impl BindOptions {
             Parameter::Resolution => self.resolution,
             Parameter::Grid => self.grid,
             Parameter::PoissonRatio => self.poisson_ratio,
+            Parameter::Bulging => self.bulging,
         }
     }
 
@@ -55,16 +62,35 @@ impl BindOptions {
             Parameter::Resolution => self.resolution = value,
             Parameter::Grid => self.grid = value,
             Parameter::PoissonRatio => self.poisson_ratio = value,
+            Parameter::Bulging => self.bulging = value,
         }
     }
 
     /// The one check of the method's parameter ([`ParameterSpec::validate`]),
     /// for callers of the library as for the command line and the editor.
     pub fn validate(&self) -> Result<(), ParameterError> {
-        match self.parameter() {
-            Some((spec, value)) => spec.validate(value.into()).map(|_| ()),
-            None => Ok(()),
+        if let Some((spec, value)) = self.parameter() {
+            spec.validate(value.into())?;
         }
+        for (spec, value) in self.deform_parameters() {
+            spec.validate(value.into())?;
+        }
+        Ok(())
+    }
+
+    /// The settings this method reads when its weights deform a pose, with
+    /// their values (Somigliana's bulging; none for the other families).
+    pub fn deform_parameters(&self) -> impl Iterator<Item = (ParameterSpec, u32)> + '_ {
+        (self.method.spec().deform_parameters.iter()).map(|spec| (*spec, self.get(spec.key)))
+    }
+
+    /// The deformation settings away from their defaults as titles say them
+    /// ("γ 2.5"), so that a result names how it was deformed.
+    pub fn deform_labels(&self) -> Vec<String> {
+        (self.deform_parameters())
+            .filter(|(spec, value)| *value != spec.default)
+            .map(|(spec, value)| (spec.format)(value))
+            .collect()
     }
 
     /// The parameter of this method and its value, if it has one.
@@ -108,15 +134,29 @@ impl BindOptions {
         self.method.columns(&self.cage_to_bind(cage))
     }
 
-    /// [`Method::column_displacements`] on the cage these options bind.
+    /// [`Method::column_displacements`] on the cage these options bind, with
+    /// these options' deformation settings (Somigliana's bulging).
     pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
-        self.method
-            .column_displacements(&self.cage_to_bind(cage), pose)
+        let bound = self.cage_to_bind(cage);
+        if self.method == Method::Somigliana {
+            return super::somigliana::column_displacements(
+                &bound,
+                pose,
+                self.poisson_ratio(),
+                self.bulging(),
+            );
+        }
+        self.method.column_displacements(&bound, pose)
     }
 
     /// The Poisson ratio ν Somigliana coordinates bind with.
     pub fn poisson_ratio(&self) -> f64 {
         Parameter::PoissonRatio.spec().number(self.poisson_ratio)
+    }
+
+    /// The bulging γ Somigliana coordinates deform with.
+    pub fn bulging(&self) -> f64 {
+        Parameter::Bulging.spec().number(self.bulging)
     }
 
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
@@ -179,6 +219,7 @@ impl Default for BindOptions {
             resolution: DEFAULT_RESOLUTION,
             grid: harmonic::DEFAULT_GRID,
             poisson_ratio: Parameter::PoissonRatio.spec().default,
+            bulging: Parameter::Bulging.spec().default,
             quads: QuadSplit::None,
         }
     }

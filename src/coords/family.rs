@@ -119,7 +119,11 @@ pub struct FamilySpec {
     pub name: &'static str,
     /// One line for menus and `--help`.
     pub summary: &'static str,
+    /// The parameter of its bind (PMVC's resolution, ν), if it has one.
     pub parameter: Option<ParameterSpec>,
+    /// Settings read when its weights deform a pose, not when they are bound
+    /// (Somigliana's bulging): changing one binds nothing again.
+    pub deform_parameters: &'static [ParameterSpec],
     pub columns: ColumnLayout,
     /// Whether the family promises non-negative weights inside the cage (so a
     /// negative weight there is a defect, not a property).
@@ -157,6 +161,7 @@ const MVC: FamilySpec = FamilySpec {
     name: "MVC",
     summary: "mean value coordinates, closed form (QMVC on quads); negative in non-convex cages",
     parameter: None,
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: false,
     outside_policy: OUTSIDE_BY_MVC,
@@ -171,6 +176,7 @@ const PMVC: FamilySpec = FamilySpec {
     name: "PMVC",
     summary: "positive mean value coordinates: only the visible cage counts (cube map, or exact)",
     parameter: Some(RESOLUTION),
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -185,6 +191,7 @@ const HARMONIC: FamilySpec = FamilySpec {
     name: "HC",
     summary: "harmonic coordinates: a grid solve of Laplace's equation inside the cage",
     parameter: Some(GRID),
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -199,6 +206,7 @@ const GREEN: FamilySpec = FamilySpec {
     name: "Green",
     summary: "Green coordinates: shape-preserving, one weight per cage vertex and per triangle; not positive",
     parameter: None,
+    deform_parameters: &[],
     columns: ColumnLayout::CageVerticesThenTriangles,
     positive_inside: false,
     outside_policy: "vertices outside the cage get Green's exterior extension: the inside \
@@ -214,6 +222,7 @@ const MEC: FamilySpec = FamilySpec {
     name: "MEC",
     summary: "maximum entropy coordinates: positive and smooth, a small convex solve per point",
     parameter: None,
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -228,6 +237,7 @@ const MLC: FamilySpec = FamilySpec {
     name: "MLC",
     summary: "maximum likelihood coordinates: positive and smooth, a small convex solve per point",
     parameter: None,
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -243,6 +253,7 @@ const BBW: FamilySpec = FamilySpec {
     name: "BBW",
     summary: "bounded biharmonic weights: a constrained grid solve per cage vertex, in [0, 1]",
     parameter: Some(BBW_GRID),
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -258,6 +269,7 @@ const LBC: FamilySpec = FamilySpec {
     summary:
         "local barycentric coordinates: a grid solve of least total variation, positive and local",
     parameter: Some(LBC_GRID),
+    deform_parameters: &[],
     columns: ColumnLayout::CageVertices,
     positive_inside: true,
     outside_policy: OUTSIDE_BY_MVC,
@@ -272,6 +284,7 @@ const SOMIGLIANA: FamilySpec = FamilySpec {
     name: "Somigliana",
     summary: "Somigliana coordinates: elasticity-based, a 3×3 block per cage vertex and triangle; not positive",
     parameter: Some(super::somigliana::POISSON_RATIO_SETTING),
+    deform_parameters: &[super::somigliana::BULGING_SETTING],
     columns: ColumnLayout::BlocksPerVertexThenTriangle,
     positive_inside: false,
     outside_policy: "vertices outside the cage (or on it) get MVC weights (the triangle's barycentrics \
@@ -365,7 +378,8 @@ impl Method {
     /// wrong length moves nothing.
     pub fn column_displacements(self, rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
         if self.spec().columns == ColumnLayout::BlocksPerVertexThenTriangle {
-            return super::somigliana::column_displacements(rest, pose);
+            // Without bulging, the tractions do not depend on ν.
+            return super::somigliana::column_displacements(rest, pose, 0.0, 0.0);
         }
         let mut moves: Vec<DVec3> = pose
             .iter()

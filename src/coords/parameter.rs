@@ -196,7 +196,7 @@ impl ParameterSpec {
 }
 
 /// The parameters families can have; each is a field of [`super::BindOptions`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Parameter {
     /// Cube-map texels along one face edge (PMVC).
     Resolution,
@@ -205,13 +205,17 @@ pub enum Parameter {
     /// The material's Poisson ratio, in thousandths above a zero of 1000
     /// (Somigliana coordinates).
     PoissonRatio,
+    /// The bulging γ of a deformation, in hundredths (Somigliana coordinates):
+    /// read when the weights deform a pose, not when they are bound.
+    Bulging,
 }
 
 impl Parameter {
-    pub const ALL: [Parameter; 3] = [
+    pub const ALL: [Parameter; 4] = [
         Parameter::Resolution,
         Parameter::Grid,
         Parameter::PoissonRatio,
+        Parameter::Bulging,
     ];
 
     /// The name saved files give it.
@@ -220,6 +224,7 @@ impl Parameter {
             Parameter::Resolution => "resolution",
             Parameter::Grid => "grid",
             Parameter::PoissonRatio => "poisson_ratio",
+            Parameter::Bulging => "bulging",
         }
     }
 
@@ -229,7 +234,16 @@ impl Parameter {
             Parameter::Resolution => &RESOLUTION,
             Parameter::Grid => &GRID,
             Parameter::PoissonRatio => &super::somigliana::POISSON_RATIO_SETTING,
+            Parameter::Bulging => &super::somigliana::BULGING_SETTING,
         }
+    }
+
+    /// Whether a family reads it when its weights deform a pose rather than
+    /// when they are bound ([`super::FamilySpec::deform_parameters`]).
+    pub fn read_when_deforming(self) -> bool {
+        super::Method::ALL
+            .iter()
+            .any(|method| (method.spec().deform_parameters.iter()).any(|spec| spec.key == self))
     }
 
     /// [`ParameterSpec::validate`] of this parameter.

@@ -106,6 +106,8 @@ pub(super) fn bind_options(
             Parameter::Resolution => resolution,
             Parameter::Grid => grid,
             Parameter::PoissonRatio => poisson_ratio,
+            // Read when deforming (`deform(..., bulging=)`), not binding.
+            Parameter::Bulging => None,
         };
         if let Some(given) = given.filter(|value| !value.is_none()) {
             options.set(spec.key, parameter_value(spec.key, given)?);

@@ -13,7 +13,7 @@ use super::errors::{backend_warning, error, Kind};
 use super::scene::{cage_argument, PyCage};
 use super::weights::PyWeights;
 use crate::coords::{
-    bind_cpu_f64, AnyWeights, BindOptions, BindProgress, Dtype, DtypeError, Method,
+    bind_cpu_f64, AnyWeights, BindOptions, BindProgress, Dtype, DtypeError, Method, Parameter,
 };
 use crate::formats::metadata::{class_codes, BindRecord, WeightsMetadata};
 use crate::gpu::backend_choice::{decide_and_open, BackendRequest, Decision, Work};
@@ -436,7 +436,9 @@ fn bind_error(cause: &BindError) -> PyErr {
 /// refuses weights with rows outside the cage). ``cage`` is a :class:`Cage` or
 /// libigl's ``(V, F)`` pair. Each point moves by Σₖ wₖ dₖ, dₖ the move of
 /// column k's vector (a cage vertex's position, or for Green coordinates a
-/// triangle's scaled normal), summed in float64.
+/// triangle's scaled normal), summed in float64. ``bulging`` (Somigliana
+/// coordinates' γ, 0 to 10, default 0) is read when deforming, so it may be
+/// given with ``weights``; the other families ignore it.
 #[pyfunction]
 #[pyo3(
     signature = (points, cage, deformed_vertices, weights=None, method=None, **parameters),
@@ -451,7 +453,10 @@ pub(super) fn deform<'py>(
     method: Option<Bound<'py, PyAny>>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const BINDING: [&str; 9] = [
+    /// Read when deforming, so given with weights too.
+    const DEFORMING: [&str; 2] = ["strict", "bulging"];
+    const BINDING: [&str; 10] = [
+        "bulging",
         "resolution",
         "grid",
         "poisson_ratio",
@@ -489,7 +494,7 @@ pub(super) fn deform<'py>(
                     ),
                 ));
             }
-            if weights.is_some() && key != "strict" {
+            if weights.is_some() && !DEFORMING.contains(&key.as_str()) {
                 return Err(error(
                     Kind::Parameter,
                     format!("deform: \"{key}\" is for binding, but weights were given"),
@@ -556,6 +561,13 @@ pub(super) fn deform<'py>(
             )?
         }
     };
-    let deformed = weights.get().apply(py, &points, &cage, &pose)?;
+    let mut deform_values = Vec::new();
+    if let Some(given) = parameter("bulging")?.filter(|value| !value.is_none()) {
+        let value = super::bind_arguments::parameter_value(Parameter::Bulging, &given)?;
+        deform_values.push((Parameter::Bulging, value));
+    }
+    let deformed = weights
+        .get()
+        .apply(py, &points, &cage, &pose, &deform_values)?;
     super::arrays::positions_array(py, &deformed)
 }

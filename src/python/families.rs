@@ -8,6 +8,8 @@ use pyo3::types::{PyDict, PyList};
 /// Every coordinate family: a list of dicts with ``id`` (the ``method``
 /// argument), ``name``, ``summary``, ``parameters`` (each with ``id``,
 /// ``label``, ``default``, ``min``, ``max`` and the editor's ``choices``),
+/// ``deform_parameters`` (the same for settings :func:`deform` reads, not
+/// :func:`bind`: Somigliana's ``bulging``),
 /// ``positive_inside`` (whether weights inside the cage are never negative),
 /// ``outside_policy``, ``columns_layout``, ``gpu_kernel`` (whether
 /// ``backend="gpu"`` runs it on the GPU on a cage of triangles; otherwise it
@@ -24,28 +26,14 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
         family.set_item("summary", spec.summary)?;
         let parameters = PyList::empty(py);
         if let Some(parameter) = spec.parameter {
-            let entry = PyDict::new(py);
-            entry.set_item("id", parameter.key.id())?;
-            entry.set_item("label", parameter.label)?;
-            entry.set_item(
-                "default",
-                parameter_number(py, &parameter, parameter.default),
-            )?;
-            entry.set_item("min", parameter_number(py, &parameter, parameter.min))?;
-            entry.set_item("max", parameter_number(py, &parameter, parameter.max))?;
-            let choices = PyList::empty(py);
-            for &choice in parameter.choices {
-                match parameter.name_of(choice) {
-                    Some(name) => choices.append(name)?,
-                    None => choices.append(parameter_number(py, &parameter, choice))?,
-                }
-            }
-            entry.set_item("choices", choices)?;
-            let named: Vec<&str> = parameter.named.iter().map(|n| n.name).collect();
-            entry.set_item("named", named)?;
-            parameters.append(entry)?;
+            parameters.append(parameter_entry(py, &parameter)?)?;
         }
         family.set_item("parameters", parameters)?;
+        let deform_parameters = PyList::empty(py);
+        for parameter in spec.deform_parameters {
+            deform_parameters.append(parameter_entry(py, parameter)?)?;
+        }
+        family.set_item("deform_parameters", deform_parameters)?;
         family.set_item("positive_inside", spec.positive_inside)?;
         family.set_item("outside_policy", spec.outside_policy)?;
         family.set_item("columns_layout", columns_layout(spec.columns))?;
@@ -61,6 +49,34 @@ pub(super) fn families(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
         list.append(family)?;
     }
     Ok(list)
+}
+
+/// A parameter as a dict: ``id``, ``label``, ``default``, ``min``, ``max``,
+/// the editor's ``choices`` and its ``named`` values.
+fn parameter_entry<'py>(
+    py: Python<'py>,
+    parameter: &crate::coords::ParameterSpec,
+) -> PyResult<Bound<'py, PyDict>> {
+    let entry = PyDict::new(py);
+    entry.set_item("id", parameter.key.id())?;
+    entry.set_item("label", parameter.label)?;
+    entry.set_item(
+        "default",
+        parameter_number(py, parameter, parameter.default),
+    )?;
+    entry.set_item("min", parameter_number(py, parameter, parameter.min))?;
+    entry.set_item("max", parameter_number(py, parameter, parameter.max))?;
+    let choices = PyList::empty(py);
+    for &choice in parameter.choices {
+        match parameter.name_of(choice) {
+            Some(name) => choices.append(name)?,
+            None => choices.append(parameter_number(py, parameter, choice))?,
+        }
+    }
+    entry.set_item("choices", choices)?;
+    let named: Vec<&str> = parameter.named.iter().map(|n| n.name).collect();
+    entry.set_item("named", named)?;
+    Ok(entry)
 }
 
 /// The name saved files give a column layout.

@@ -190,21 +190,26 @@ impl PyWeights {
 
     /// `points` moved as `pmvc deform --weights` moves them, after its checks:
     /// the weights were bound for these points and this cage (the metadata's
-    /// counts and digests), and the matrix is sound.
+    /// counts and digests), and the matrix is sound. `deform` holds the
+    /// deformation settings given (Somigliana's bulging), checked by their specs.
     pub(super) fn apply(
         &self,
         py: Python<'_>,
         points: &[DVec3],
         cage: &PyCage,
         pose: &[DVec3],
+        deform: &[(crate::coords::Parameter, u32)],
     ) -> PyResult<Vec<DVec3>> {
         self.metadata
             .check_inputs(&self.shown(), points, &cage.cage)
             .map_err(|cause| metadata_error(&cause))?;
         let weights = self.checked_matrix(py)?;
         // Green's ψ columns follow the triangles the weights were bound on.
-        let bound = self.options.cage_to_bind(&cage.cage);
-        let moves = self.method().column_displacements(&bound, pose);
+        let mut options = self.options;
+        for &(parameter, value) in deform {
+            options.set(parameter, value);
+        }
+        let moves = options.column_displacements(&cage.cage, pose);
         Ok(py.detach(|| weights.apply_displacements(points, &moves)))
     }
 }

@@ -9,7 +9,7 @@ use super::weight_attributes::{AttributeBlend, AttributeWeights};
 use super::weight_chunks::{
     ChunkLimits, ChunkSplit, FIRST_CHUNK_BINDING, OTHER_STORAGE_BUFFERS, UNIFORM_COLUMNS,
 };
-use crate::coords::{BindOptions, Method, QuadSplit, WeightsId};
+use crate::coords::{BindOptions, Method, Parameter, WeightsId};
 use crate::geometry::Cage;
 use eframe::egui_wgpu::wgpu::util::DeviceExt;
 use glam::DVec3;
@@ -171,9 +171,9 @@ pub struct WeightSlot {
     /// them ([`UNIFORM_DISPLACEMENT_BYTES`], zero past the columns).
     pub uniform_displacements: wgpu::Buffer,
     pub columns: u32,
-    /// How the weights were bound on the cage's quads: Green's columns differ
-    /// with them as patches (QGC) or split.
-    pub quads: QuadSplit,
+    /// How the weights were bound (their family, parameters and the cage's
+    /// quads: Green's columns differ with them as patches, QGC, or split).
+    pub options: BindOptions,
     /// How the rows' first columns are read as vertex attributes from the one
     /// chunk; `None`: from storage alone.
     pub attributes: Option<AttributeBlend>,
@@ -226,6 +226,9 @@ pub struct SceneGpu {
     /// and only then rounded.
     pub rest_cage: Cage,
     pub pose: Vec<DVec3>,
+    /// The deformation settings the displacements are computed with, where
+    /// not at their defaults (Somigliana's bulging).
+    pub deform: Vec<(Parameter, u32)>,
     /// How weights are split on this device.
     pub chunk_limits: ChunkLimits,
     /// Per (family shown, family compared): its bind group, made on first use.
@@ -288,6 +291,7 @@ impl SceneGpu {
             twin_slots: BTreeMap::new(),
             rest_cage: rest_cage.clone(),
             pose,
+            deform: Vec::new(),
             chunk_limits,
             bind_groups: HashMap::new(),
         }
@@ -304,14 +308,13 @@ impl SceneGpu {
         queue.write_buffer(&slot.uniform_displacements, 0, bytemuck::cast_slice(head));
     }
 
-    /// `method`'s column displacements for the current pose, as the shader reads
-    /// them, for weights bound with the quads as `quads` says.
-    pub fn displacements_of(&self, method: Method, quads: QuadSplit) -> Vec<[f32; 4]> {
-        let options = BindOptions {
-            method,
-            quads,
-            ..BindOptions::default()
-        };
+    /// The column displacements of weights bound with `bound` for the current
+    /// pose and deformation settings, as the shader reads them.
+    pub fn displacements_of(&self, bound: &BindOptions) -> Vec<[f32; 4]> {
+        let mut options = *bound;
+        for &(parameter, value) in &self.deform {
+            options.set(parameter, value);
+        }
         points_f32(
             &options.column_displacements(&self.rest_cage, &self.pose),
             0.0,

@@ -57,3 +57,40 @@ def test_the_panel_offers_bind_then_the_bound_operators():
     assert any(kind == "label" and text.startswith("Bound to comb cage with MVC") for kind, text in after)
     mesh_obj.modifiers.clear()
     assert ("label", "The pmvc modifier was removed: rebind") in draw()
+
+
+def test_the_bulging_of_a_somigliana_binding_is_a_property_of_the_object():
+    import numpy as np
+    import pmvc
+    from conftest import TEST_PARAMETERS, coordinates, evaluated, middle_tip, relative_error
+    from pmvc.blender import store
+
+    mesh_obj, cage_obj = comb()
+    select(mesh_obj, cage_obj)
+    assert bpy.ops.pmvc.bind(method="SOMIGLIANA", **TEST_PARAMETERS["somigliana"]) == {"FINISHED"}
+    assert ("prop", "pmvc_bulging") in draw()
+    points, rest = coordinates(mesh_obj.data), coordinates(cage_obj.data)
+    tip, width = middle_tip(rest)
+    for index in tip:
+        cage_obj.data.vertices[int(index)].co.y += 1.5 * width
+    cage_obj.data.update()
+    bpy.context.view_layer.update()
+    plain = evaluated(mesh_obj)
+    posed = coordinates(cage_obj.data)
+    weights = store.load(mesh_obj).weights
+    cage = pmvc.Cage(rest, [list(p.vertices) for p in cage_obj.data.polygons])
+    diagonal = cage.diagonal
+    # Setting it redeforms, as pmvc.deform does with the same weights and γ.
+    mesh_obj.pmvc_bulging = 3.0
+    bpy.context.view_layer.update()
+    bulged = evaluated(mesh_obj)
+    expected = pmvc.deform(points, cage, posed, weights=weights, bulging=3.0)
+    assert relative_error(bulged, expected, diagonal) < 1e-6
+    assert np.abs(bulged - plain).max() > 1e-3 * diagonal
+    mesh_obj.pmvc_bulging = 0.0
+    bpy.context.view_layer.update()
+    assert relative_error(evaluated(mesh_obj), plain, diagonal) < 1e-6
+    # Families that read no deformation setting do not offer it.
+    bpy.ops.pmvc.unbind()
+    assert bpy.ops.pmvc.bind(method="MVC") == {"FINISHED"}
+    assert ("prop", "pmvc_bulging") not in draw()

@@ -66,15 +66,59 @@ fn bind_and_deform_follow_the_library_global_deformation() {
         std::fs::read(&fresh).unwrap()
     );
     let blocks = somigliana_blocks(&points, &cage, 0.3).unwrap();
-    let expected = somigliana_deform(&blocks, &cage, &pose).unwrap();
+    let expected = somigliana_deform(&blocks, &cage, &pose, 0.0).unwrap();
     let deformed = load_mesh(&stored).unwrap().mesh.positions;
     let diagonal = cage.diagonal();
-    let worst = expected
-        .iter()
-        .zip(&deformed)
-        .map(|(a, b)| (*a - *b).length() / diagonal)
-        .fold(0.0f64, f64::max);
+    let worst = largest_gap(&expected, &deformed) / diagonal;
     assert!(worst < 1e-5, "{worst} of the diagonal");
+    // The bulging γ is read when deforming: the same weights, another result,
+    // the library's.
+    let bulged = dir.path().join("bulged.obj");
+    let weights_args = ["--weights", path_str(&weights), "--bulging", "2.5"];
+    let output = deform(&mesh, &cage_path, &pose_path, &bulged, &weights_args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let expected = somigliana_deform(&blocks, &cage, &pose, 2.5).unwrap();
+    let bulged = load_mesh(&bulged).unwrap().mesh.positions;
+    let worst = largest_gap(&expected, &bulged) / diagonal;
+    assert!(worst < 1e-5, "{worst} of the diagonal");
+    assert!(largest_gap(&deformed, &bulged) / diagonal > 1e-3);
+}
+
+fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0f64, f64::max)
+}
+
+#[test]
+fn a_bulging_out_of_range_is_refused_and_other_families_say_they_ignore_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, cage_path, cage, _) = comb_scene(dir.path(), 4);
+    let pose_path = write(
+        dir.path(),
+        "pose.obj",
+        &triangles_obj(&comb_pose(&cage, 0.4), cage.triangles()),
+    );
+    let out = dir.path().join("out.obj");
+    for value in ["10.5", "-1", "much"] {
+        let args = ["--method", "somigliana", "--bulging", value];
+        let output = deform(&mesh, &cage_path, &pose_path, &out, &args);
+        assert_eq!(output.status.code(), Some(1), "{value}");
+        let said = stderr(&output);
+        assert!(said.contains("--bulging"), "{value}: {said}");
+        assert!(!out.exists());
+    }
+    let output = deform(
+        &mesh,
+        &cage_path,
+        &pose_path,
+        &out,
+        &["--method", "mvc", "--bulging", "2"],
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+    let said = stderr(&output);
+    assert!(said.contains("--bulging is ignored"), "{said}");
 }
 
 #[test]

@@ -7,9 +7,10 @@
 use crate::common;
 
 use common::editor::*;
+use egui_kittest::kittest::Queryable;
 use glam::DVec3;
 use pmvc::app::compare::{Overlay, Pane};
-use pmvc::coords::Method;
+use pmvc::coords::{Method, Parameter};
 use pmvc::render::Colouring;
 
 #[test]
@@ -89,4 +90,76 @@ fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
             "row {row}"
         );
     }
+}
+
+/// The side panel's bulging γ: chosen in its list, it moves the drawn mesh to
+/// the CPU's bulged deformation with the same weights (nothing is bound
+/// again), is one undo step, and is saved with the session.
+#[test]
+fn bulging_is_chosen_in_the_side_panel_and_undone() {
+    let Some(mut harness) = editor() else { return };
+    run_until_bound(&mut harness);
+    harness.state_mut().set_active_method(Method::Somigliana);
+    run_until_bound(&mut harness);
+    let weights = harness
+        .state()
+        .document()
+        .weights(Method::Somigliana)
+        .unwrap()
+        .clone();
+    let cage = harness.state().document().cage().clone();
+    harness
+        .state_mut()
+        .set_handle_position(12, cage.positions()[12] + DVec3::new(0.5, 1.0, 0.0));
+    harness
+        .state_mut()
+        .set_handle_position(32, cage.positions()[32] + DVec3::new(0.5, 1.0, 0.0));
+    harness.run_steps(2);
+    let plain = harness.state().read_back_deformed().unwrap().unwrap();
+
+    let bulging = harness.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Bulging γ");
+    assert_eq!(bulging.value().as_deref(), Some("γ 0"));
+    bulging.click_accesskit();
+    harness.run_steps(2);
+    harness.get_by_label("γ 4").click_accesskit();
+    harness.run_steps(3);
+    let app = harness.state();
+    assert_eq!(app.document().deform_value(Parameter::Bulging), 400);
+    let same = app.document().weights(Method::Somigliana).unwrap();
+    assert!(std::sync::Arc::ptr_eq(same, &weights), "bound again");
+    let drawn = app.read_back_deformed().unwrap().unwrap();
+    let on_cpu: Vec<glam::Vec3> = (app.document().deformed_positions(Method::Somigliana))
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect();
+    let diagonal = cage.diagonal() as f32;
+    assert!(
+        max_distance(&drawn, &on_cpu) < 1e-4 * diagonal,
+        "bulged: GPU and CPU differ"
+    );
+    let bulge = max_distance(&drawn, &plain);
+    assert!(
+        bulge > 1e-3 * diagonal,
+        "the bulging moved nothing: {bulge}"
+    );
+    assert_eq!(app.undo_label().as_deref(), Some("Bulging γ 4"));
+
+    // A session keeps it.
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("s.json");
+    assert!(harness.state_mut().save_session(&session));
+    let text = std::fs::read_to_string(&session).unwrap();
+    assert!(text.contains("\"bulging\": 4.0"), "{text}");
+
+    harness.state_mut().undo();
+    harness.run_steps(3);
+    assert_eq!(
+        harness.state().document().deform_value(Parameter::Bulging),
+        0
+    );
+    let drawn = harness.state().read_back_deformed().unwrap().unwrap();
+    assert!(
+        max_distance(&drawn, &plain) < 1e-5 * diagonal,
+        "undo left the bulge"
+    );
 }

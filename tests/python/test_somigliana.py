@@ -93,3 +93,90 @@ def test_the_poisson_ratio_changes_the_weights_and_is_checked(test_points, comb_
     for refused in (0.5, -1.0, 0.7):
         with pytest.raises(pmvc.ParameterError, match=r"must be -0\.999 to 0\.499"):
             pmvc.bind(points, comb_cage, method="somigliana", poisson_ratio=refused)
+
+
+def prism_volume(to: np.ndarray, start: np.ndarray) -> float:
+    """The signed volume swept by the straight paths from triangle ``start`` to
+    triangle ``to`` (corresponding corners), by integrating the Jacobian of
+    x(u, v, t) = r(u, v) + t (p(u, v) − r(u, v)) over the triangle and t: a
+    polynomial of degree 2, so a 2-point Gauss rule in t and the 3-point
+    edge-midpoint rule on the triangle are exact."""
+    d = to - start
+    gauss_t = [(0.5 - np.sqrt(3) / 6, 0.5), (0.5 + np.sqrt(3) / 6, 0.5)]
+    midpoints = [(0.5, 0.5), (0.0, 0.5), (0.5, 0.0)]
+    total = 0.0
+    for u, v in midpoints:
+        for t, wt in gauss_t:
+            du = (start[1] - start[0]) + t * (d[1] - d[0])
+            dv = (start[2] - start[0]) + t * (d[2] - d[0])
+            dt = d[0] + u * (d[1] - d[0]) + v * (d[2] - d[0])
+            total += wt * (1.0 / 3.0) * 0.5 * np.linalg.det(np.array([du, dv, dt]))
+    return total
+
+
+def bulged_tractions(cage: pmvc.Cage, triangles, pose, poisson_ratio, gamma):
+    """Each triangle's traction factor with bulging γ, as docs/coordinates.md
+    defines it: h = s exp(γ² V_f / V), t = (h (1 − ν) + 2 ν s) / (1 + ν), then
+    the least-squares projection onto zero net force weighted by area."""
+    scale, rotation, centre = umeyama(cage.vertices, pose)
+    fitted = scale * (cage.vertices - cage.vertices.mean(axis=0)) @ rotation.T + centre
+    rest = cage.vertices[triangles]
+    area_normals = 0.5 * np.cross(rest[:, 1] - rest[:, 0], rest[:, 2] - rest[:, 0])
+    volume = abs(np.einsum("fi,fi->", area_normals, rest.mean(axis=1)) / 3.0)
+    swept = np.array([prism_volume(pose[t], fitted[t]) for t in triangles])
+    h = scale * np.exp(gamma**2 * swept / volume)
+    tractions = (h * (1 - poisson_ratio) + 2 * poisson_ratio * scale) / (1 + poisson_ratio)
+    areas = np.linalg.norm(area_normals, axis=1)
+    normals = area_normals / areas[:, None]
+    system = np.einsum("f,fi,fj->ij", areas, normals, normals)
+    z = np.linalg.solve(system, area_normals.T @ tractions)
+    return tractions - normals @ z
+
+
+@pytest.mark.parametrize("poisson_ratio, gamma", [(0.0, 2.0), (0.3, 4.5)])
+def test_bulging_in_numpy_deforms_as_pmvc(test_points, comb_cage, poisson_ratio, gamma):
+    points = test_points[::5]
+    weights = pmvc.bind(
+        points, comb_cage, method="somigliana", poisson_ratio=poisson_ratio, dtype=np.float64
+    )
+    pose = middle_finger_pose(comb_cage, lift=2.0)
+    tractions = bulged_tractions(comb_cage, weights.triangles, pose, poisson_ratio, gamma)
+    vertex_count = len(comb_cage.vertices)
+    blocks = weights.matrix.reshape(len(points), -1, 3, 3)
+    vertex_blocks, face_blocks = blocks[:, :vertex_count], blocks[:, vertex_count:]
+    scale, rotation, centre = umeyama(comb_cage.vertices, pose)
+    rest = comb_cage.vertices[weights.triangles]
+    normals = np.cross(rest[:, 1] - rest[:, 0], rest[:, 2] - rest[:, 0])
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    inner = np.einsum("pvab,vb->pa", vertex_blocks, (pose - centre) @ rotation)
+    inner += np.einsum("pfab,fb->pa", face_blocks, tractions[:, None] * normals)
+    by_numpy = centre + inner @ rotation.T
+    by_pmvc = pmvc.deform(points, comb_cage, pose, weights=weights, bulging=gamma)
+    inside = weights.classes == pmvc.INSIDE
+    np.testing.assert_allclose(
+        by_pmvc[inside], by_numpy[inside], rtol=0, atol=1e-9 * comb_cage.diagonal
+    )
+    # It does bulge: some inside point moves by more than 1e-3 of the diagonal.
+    plain = pmvc.deform(points, comb_cage, pose, weights=weights)
+    assert np.abs(by_pmvc - plain).max() > 1e-3 * comb_cage.diagonal
+    # At rest, nothing moves whatever γ.
+    at_rest = pmvc.deform(points, comb_cage, comb_cage.vertices, weights=weights, bulging=gamma)
+    np.testing.assert_allclose(at_rest[inside], points[inside], atol=1e-8 * comb_cage.diagonal)
+
+
+def test_bulging_is_a_deformation_setting_checked_by_its_spec(test_points, comb_cage):
+    points = test_points[:20]
+    family = {f["id"]: f for f in pmvc.families()}["somigliana"]
+    (setting,) = family["deform_parameters"]
+    assert (setting["id"], setting["default"], setting["min"], setting["max"]) == (
+        "bulging",
+        0.0,
+        0.0,
+        10.0,
+    )
+    weights = pmvc.bind(points, comb_cage, method="somigliana")
+    for refused in (-0.5, 10.5, "much"):
+        with pytest.raises(pmvc.ParameterError):
+            pmvc.deform(points, comb_cage, comb_cage.vertices, weights=weights, bulging=refused)
+    # Other families read none.
+    assert all(f["deform_parameters"] == [] for f in pmvc.families() if f["id"] != "somigliana")

@@ -38,7 +38,8 @@ impl EditorApp {
         // After the weights: every bound family's displacements follow the pose.
         if changes.scene || changes.pose {
             let pose = self.model.document().pose().to_vec();
-            self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose));
+            let deform = self.model.document().deform_values();
+            self.with_renderer(|renderer, _, queue| renderer.set_cage_pose(queue, &pose, &deform));
         }
         if changes.scene || changes.pose || !changes.weights.is_empty() {
             self.views.readouts.invalidate(&changes);
@@ -66,17 +67,17 @@ impl EditorApp {
             .filter_map(|&id| {
                 document
                     .bound_id(id)
-                    .map(|set| (id, Arc::clone(&set.weights), set.options.quads))
+                    .map(|set| (id, Arc::clone(&set.weights), set.options))
             })
             .collect();
         let uploaded = self.with_renderer(|renderer, device, queue| {
             renderer.set_outside(queue, rest, outside);
-            sets.iter().try_for_each(|(method, weights, quads)| {
+            sets.iter().try_for_each(|(method, weights, options)| {
                 let on_device = resident
                     .as_ref()
                     .filter(|(bound, _)| Arc::ptr_eq(bound, weights))
                     .map(|(_, buffer)| buffer);
-                renderer.set_weights(device, *method, Some(weights), *quads, on_device)
+                renderer.set_weights(device, *method, Some(weights), *options, on_device)
             })
         });
         if let Some(Err(error)) = uploaded {

@@ -236,6 +236,10 @@ impl EditorApp {
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
         }
+        if let Some(value) = options.bulging {
+            let parameter = crate::coords::Parameter::Bulging;
+            app.apply(Command::SetDeformParameter { parameter, value });
+        }
         app.report_heatmap_out_of_range(&options.view);
         if let Some(note) = app.views.settings.fit_compared() {
             app.error(format!("--compare: {note}"));

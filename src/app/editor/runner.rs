@@ -140,6 +140,9 @@ impl EditorApp {
                     Err(error) => self.error(error),
                 }
             }
+            Action::SetDeformParameter(parameter, value) => {
+                self.apply(Command::SetDeformParameter { parameter, value });
+            }
             Action::SetQuadSplit(split) => {
                 if self.binding.set_quad_split(split) {
                     self.request_wanted_binds();

@@ -8,7 +8,7 @@
 //! pose or the weights without the GPU copy and the caches learning about it.
 
 use crate::app::scenes::BundledScene;
-use crate::coords::{BindOptions, Method, Twin, WeightQuality, Weights, WeightsId};
+use crate::coords::{BindOptions, Method, Parameter, Twin, WeightQuality, Weights, WeightsId};
 use crate::formats::{FileObjects, MeshFile};
 use crate::geometry::{Cage, TriMesh};
 use glam::DVec3;
@@ -78,6 +78,10 @@ pub struct Document {
     named_poses: Arc<Vec<NamedPose>>,
     /// The bundled scene this document's mesh and cage are, when they are one.
     bundled: Option<BundledScene>,
+    /// Settings read when weights deform a pose (Somigliana's bulging), where
+    /// not at their default: part of what the document shows and exports,
+    /// not of the weights.
+    deform_values: BTreeMap<Parameter, u32>,
 }
 
 impl Document {
@@ -104,7 +108,42 @@ impl Document {
             edits: 0,
             named_poses: Arc::new(Vec::new()),
             bundled: None,
+            deform_values: BTreeMap::new(),
         }
+    }
+
+    /// The same document with these deformation settings (a session being
+    /// opened), each checked by its spec; a refused one keeps its default.
+    pub fn with_deform_values(
+        mut self,
+        values: impl IntoIterator<Item = (Parameter, u32)>,
+    ) -> Self {
+        for (parameter, value) in values {
+            if parameter.validate(value.into()).is_ok() {
+                self.deform_values.insert(parameter, value);
+            }
+        }
+        self
+    }
+
+    /// The value of deformation setting `parameter` (its default if not set).
+    pub fn deform_value(&self, parameter: Parameter) -> u32 {
+        (self.deform_values.get(&parameter)).map_or(parameter.spec().default, |&v| v)
+    }
+
+    /// The settings that differ from their defaults.
+    pub fn deform_values(&self) -> Vec<(Parameter, u32)> {
+        self.deform_values.iter().map(|(&p, &v)| (p, v)).collect()
+    }
+
+    /// `bound` (the options weights were bound with) with this document's
+    /// deformation settings: how those weights move the mesh here.
+    pub fn deform_options(&self, bound: BindOptions) -> BindOptions {
+        let mut options = bound;
+        for (&parameter, &value) in &self.deform_values {
+            options.set(parameter, value);
+        }
+        options
     }
 
     /// The same document, marked as the bundled scene `scene`.
@@ -259,7 +298,8 @@ impl Document {
             Some(set) => {
                 // On the cage the set was bound on: Green's columns differ with
                 // the quads as patches (QGC) or split.
-                let moves = set.options.column_displacements(&self.cage, pose);
+                let moves =
+                    (self.deform_options(set.options)).column_displacements(&self.cage, pose);
                 set.weights
                     .apply_displacements(&self.mesh.positions, &moves)
             }
@@ -378,6 +418,15 @@ impl Document {
         if let Some(pose) = named.get_mut(index) {
             pose.name = name.to_owned();
             self.named_poses = Arc::new(named);
+        }
+    }
+
+    /// Deform with `value` for `parameter` (checked by the model): every
+    /// deformed position changes, as after a pose change.
+    pub(in crate::app::model) fn set_deform_value(&mut self, parameter: Parameter, value: u32) {
+        if self.deform_value(parameter) != value {
+            self.deform_values.insert(parameter, value);
+            self.pose_changed();
         }
     }
 

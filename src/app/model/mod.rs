@@ -196,6 +196,9 @@ impl Model {
                 });
                 Applied::of(Outcome::Changed)
             }
+            Command::SetDeformParameter { parameter, value } => {
+                Applied::of(self.set_deform_value(parameter, value))
+            }
             Command::InstallDocument(document) => {
                 self.gesture = None;
                 self.document = *document;
@@ -287,6 +290,29 @@ impl Model {
             return Outcome::Unchanged;
         }
         self.document.set_pose(gesture.start_pose);
+        Outcome::Changed
+    }
+
+    /// A deformation setting, checked by its spec, as one undo step that
+    /// brings back the document as it was (its weights are shared, not copied).
+    fn set_deform_value(&mut self, parameter: crate::coords::Parameter, value: u32) -> Outcome {
+        let spec = parameter.spec();
+        let value = match spec.validate(value.into()) {
+            Ok(value) => value,
+            Err(error) => return Outcome::Refused(error.to_string()),
+        };
+        if self.document.deform_value(parameter) == value {
+            return Outcome::Unchanged;
+        }
+        self.cancel_gesture();
+        let mut next = self.document.clone();
+        next.set_deform_value(parameter, value);
+        let before = std::mem::replace(&mut self.document, next);
+        self.log.record(Step::Scene {
+            document: Box::new(before),
+            view: None,
+            action: format!("{} {}", spec.label, spec.text(value)),
+        });
         Outcome::Changed
     }
 

@@ -61,18 +61,12 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
         let Some(spec) = family.spec().parameter else {
             continue;
         };
-        let mut value = bound_value;
-        egui::ComboBox::from_label(spec.label)
-            .selected_text((spec.format)(value))
-            .show_ui(ui, |ui| {
-                for &choice in spec.choices {
-                    ui.selectable_value(&mut value, choice, (spec.format)(choice));
-                }
-            });
+        let value = parameter_choice(ui, &spec, bound_value).0;
         if value != bound_value {
             cx.send(Action::SetFamilyParameter(family, value));
         }
     }
+    deform_settings(ui, cx);
     quads_choice(ui, cx);
     if ui
             .button("Subdivide cage")
@@ -128,6 +122,48 @@ fn binding_section(ui: &mut egui::Ui, cx: &mut PanelContext, ctx: &egui::Context
         let mut highlight = cx.shown().highlight_outside;
         if outside > 0 && ui.checkbox(&mut highlight, "Highlight them").changed() {
             cx.send(Action::SetHighlightOutside(highlight));
+        }
+    }
+}
+
+/// A parameter's list of the spec's choices, showing `current`: the value
+/// chosen (`current` if none) and the list's response.
+fn parameter_choice(
+    ui: &mut egui::Ui,
+    spec: &crate::coords::ParameterSpec,
+    current: u32,
+) -> (u32, egui::Response) {
+    let mut value = current;
+    let response = egui::ComboBox::from_label(spec.label)
+        .selected_text((spec.format)(value))
+        .show_ui(ui, |ui| {
+            for &choice in spec.choices {
+                ui.selectable_value(&mut value, choice, (spec.format)(choice));
+            }
+        })
+        .response;
+    (value, response)
+}
+
+/// The settings the shown families read when their weights deform a pose
+/// (Somigliana's bulging): changing one moves the mesh and binds nothing.
+fn deform_settings(ui: &mut egui::Ui, cx: &mut PanelContext) {
+    let mut specs: Vec<crate::coords::ParameterSpec> = Vec::new();
+    for family in &cx.shown().wanted {
+        for spec in family.spec().deform_parameters {
+            if specs.iter().all(|listed| listed.key != spec.key) {
+                specs.push(*spec);
+            }
+        }
+    }
+    for spec in specs {
+        let current = cx.document().deform_value(spec.key);
+        let (value, response) = parameter_choice(ui, &spec, current);
+        response.on_hover_text(
+            "Read when the weights deform the pose: changing it binds nothing again.",
+        );
+        if value != current {
+            cx.send(Action::SetDeformParameter(spec.key, value));
         }
     }
 }

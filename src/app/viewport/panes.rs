@@ -275,7 +275,9 @@ impl Views {
         }
     }
 
-    /// "PMVC · 32² · bound in 0.41 s" and the like.
+    /// "PMVC · 32² · bound in 0.41 s" and the like; a deformation setting away
+    /// from its default too ("Somigliana · ν 0 · γ 4 · …"), so a picture says
+    /// how it was deformed.
     fn pane_title(&self, cx: &ViewportContext, kind: Pane) -> String {
         match kind {
             Pane::Method(method) => match cx.model.document().bound(method) {
@@ -285,6 +287,13 @@ impl Views {
                         .parameter()
                         .map(|(spec, value)| format!(" · {}", (spec.format)(value)))
                         .unwrap_or_default();
+                    let document = cx.model.document();
+                    let settings: String = (document.deform_options(set.options))
+                        .deform_labels()
+                        .iter()
+                        .map(|label| format!(" · {label}"))
+                        .collect();
+                    let parameter = parameter + &settings;
                     let seconds = if cx.facts.hide_timings {
                         String::new()
                     } else {

@@ -2,12 +2,13 @@
 //! scalar columns, 9 per cage vertex then 9 per cage triangle, entry (a, b) of
 //! a block at offset `3a + b`. Column (v, a, b) multiplies the vector
 //! `(Rᵀ (vᵥ' − c'))_b R e_a + c'_b e_a` (c' the pose's vertex centroid) and
-//! column (f, a, b) the vector `s (n_f)_b R e_a`, with s R the similarity fitted
-//! to the pose, so that `Σ wₖ cₖ'` is the global deformation of
+//! column (f, a, b) the vector `t_f (n_f)_b R e_a`, with s R the similarity
+//! fitted to the pose and t_f the triangle's traction (s without bulging,
+//! `bulging.rs`), so that `Σ wₖ cₖ'` is the global deformation of
 //! [`super::deform`] about c' (inside, where Σ Bᵥ = I).
 
 use super::triangle::{Material, TriangleFrame};
-use super::{check_positions, fit, validate_poisson_ratio, SomiglianaError};
+use super::{bulging, check_positions, fit, validate_poisson_ratio, SomiglianaError};
 use crate::geometry::Cage;
 use glam::{DMat3, DVec3};
 
@@ -91,14 +92,14 @@ pub fn identity_blocks(lambda: &[f64], out: &mut [f64]) {
     }
 }
 
-/// Every column's vector for rotation `rotation` and scale `scale`, less
+/// Every column's vector for rotation `rotation` and the faces' tractions, less
 /// `(vᵥ − c)_b e_a` for a vertex's (less nothing for a face's), where
 /// `centred[v]` is `Rᵀ (vᵥ' − c')` and `shift` is `c' − c`. Centred, so a cage
 /// far from the origin loses no digits to the weights' f32 rounding.
 fn column_moves(
     rest: &Cage,
     rotation: DMat3,
-    scale: f64,
+    tractions: &[f64],
     centred: &[DVec3],
     shift: DVec3,
 ) -> Vec<DVec3> {
@@ -113,12 +114,12 @@ fn column_moves(
             }
         }
     }
-    for t in 0..rest.triangle_count() {
+    for (t, &traction) in tractions.iter().enumerate() {
         let [a, b, c] = rest.triangle(t);
         let normal = (b - a).cross(c - a).normalize_or_zero();
         for a in 0..3 {
             for b in 0..3 {
-                columns.push(scale * normal[b] * rotation.col(a));
+                columns.push(traction * normal[b] * rotation.col(a));
             }
         }
     }
@@ -139,14 +140,21 @@ pub fn rest_columns(rest: &Cage) -> Vec<DVec3> {
             }
         }
     }
-    let faces = column_moves(rest, DMat3::IDENTITY, 1.0, &[], DVec3::ZERO);
+    let unit = vec![1.0; rest.triangle_count()];
+    let faces = column_moves(rest, DMat3::IDENTITY, &unit, &[], DVec3::ZERO);
     columns.extend(faces);
     columns
 }
 
 /// Each column's vector in `pose` less its rest vector (the displacement
-/// form). A pose of the wrong length or not finite moves nothing.
-pub fn column_displacements(rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+/// form), for weights bound at `poisson_ratio` and deformed with bulging γ
+/// `bulging` (0: none). A pose of the wrong length or not finite moves nothing.
+pub fn column_displacements(
+    rest: &Cage,
+    pose: &[DVec3],
+    poisson_ratio: f64,
+    bulging: f64,
+) -> Vec<DVec3> {
     if check_positions(rest, pose).is_err() {
         return vec![DVec3::ZERO; column_count(rest)];
     }
@@ -157,7 +165,8 @@ pub fn column_displacements(rest: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
         .map(|&p| rotation.transpose() * (p - centre))
         .collect();
     let shift = centre - centroid(rest.positions());
-    let mut moves = column_moves(rest, rotation, similarity.scale, &centred, shift);
+    let tractions = bulging::face_tractions(rest, pose, &similarity, poisson_ratio, bulging);
+    let mut moves = column_moves(rest, rotation, &tractions, &centred, shift);
     // The faces' vectors less their rest vectors.
     let vertex_columns = BLOCK_COLUMNS * rest.vertex_count();
     let rested = rest_columns(rest);

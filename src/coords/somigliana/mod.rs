@@ -40,10 +40,12 @@
 //! the deformed cage's centroid c' as `c' + R (Σ Bᵥ Rᵀ (vᵥ' − c') + …)`, equal
 //! inside where Σ Bᵥ = I, and exact far from the origin); the result is
 //! invariant under similarities of the cage (a similarity is followed exactly).
-//! Left out: the bulging term γ (σ = 0, so the paper's h = s), the local/global
-//! blend (its blend 0), and its projection of the tractions onto zero net force,
-//! which is the identity for the equal tractions of the global variant (a closed
-//! cage has Σ A_f n_f = 0).
+//! With the bulging term γ (`bulging.rs`), each triangle's traction is its own
+//! t_f instead of s (`s Σ F_f n_f` becomes `Σ t_f F_f n_f`), projected onto zero
+//! net force; a similarity sweeps nothing, so it is still followed exactly.
+//! Left out: the solid-angle measure of bulging, and the local/global blend
+//! (its blend 0), whose per-point normalisation `(Σ Rᵥ Bᵥ Rᵥᵀ)⁻¹` is not a
+//! weighted sum of per-column vectors.
 //!
 //! # Evaluation
 //!
@@ -60,6 +62,7 @@
 //! the blocks are the identity's exterior value (Σ Bᵥ = 0), with no exterior
 //! extension.
 
+mod bulging;
 mod columns;
 mod fit;
 mod near;
@@ -70,6 +73,8 @@ mod triangle;
 mod reference;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_bulging;
 #[cfg(test)]
 mod tests_family;
 #[cfg(test)]
@@ -116,11 +121,44 @@ pub const POISSON_RATIO_SETTING: super::ParameterSpec = super::ParameterSpec {
 /// The held value of ν = 0 in [`POISSON_RATIO_SETTING`].
 const POISSON_RATIO_ZERO: u32 = 1000;
 
+/// The largest bulging γ accepted: the normal stretch grows as exp(γ² V_f / V),
+/// and past 10 a triangle that sweeps a few percent of the cage's volume
+/// already pushes tens of times harder than the rest.
+pub const MAX_BULGING: f64 = 10.0;
+
+/// The bulging γ of the deformation (`bulging.rs`), to a hundredth: 0 (none,
+/// the default) to [`MAX_BULGING`]. Read when the weights deform a pose, not
+/// when they are bound: changing it binds nothing again.
+pub const BULGING_SETTING: super::ParameterSpec = super::ParameterSpec {
+    key: super::Parameter::Bulging,
+    label: "Bulging γ",
+    flag: "--bulging",
+    choices: &[0, 100, 200, 400, 800],
+    default: 0,
+    min: 0,
+    max: (MAX_BULGING * 100.0) as u32,
+    named: &[],
+    format: |value| format!("γ {}", super::family::decimal(value.into(), 100)),
+    scale: 100,
+    zero: 0,
+};
+
+/// Check that `bulging` is usable: finite, 0 to [`MAX_BULGING`].
+pub fn validate_bulging(bulging: f64) -> Result<f64, SomiglianaError> {
+    if (0.0..=MAX_BULGING).contains(&bulging) {
+        Ok(bulging)
+    } else {
+        Err(SomiglianaError::Bulging { value: bulging })
+    }
+}
+
 /// What can go wrong computing or applying Somigliana blocks.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SomiglianaError {
     #[error("the Poisson ratio must lie strictly between −1 and 0.5, got {value}")]
     PoissonRatio { value: f64 },
+    #[error("the bulging γ must be 0 to {MAX_BULGING}, got {value}")]
+    Bulging { value: f64 },
     #[error("point {index} is not finite")]
     NonFinitePoint { index: usize },
     #[error("deformed cage vertex {index} is not finite")]
@@ -268,11 +306,13 @@ fn check_positions(rest: &Cage, positions: &[DVec3]) -> Result<(), SomiglianaErr
 }
 
 /// Every point of `blocks` moved by the cage deformed from `rest` to
-/// `deformed_positions`, by the global variant of the module doc.
+/// `deformed_positions`, by the global variant of the module doc with bulging
+/// γ `bulging` (0: none; see [`BULGING_SETTING`]).
 pub fn deform(
     blocks: &SomiglianaBlocks,
     rest: &Cage,
     deformed_positions: &[DVec3],
+    bulging: f64,
 ) -> Result<Vec<DVec3>, SomiglianaError> {
     if rest.vertex_count() != blocks.vertex_count || rest.triangle_count() != blocks.triangle_count
     {
@@ -291,11 +331,19 @@ pub fn deform(
         .iter()
         .map(|&p| fit.rotation.transpose() * (p - centre))
         .collect();
-    // The traction of the dilation by s, per unit of the face block's constant.
+    // Each triangle's traction, per unit of the face block's constant.
+    let tractions = bulging::face_tractions(
+        rest,
+        deformed_positions,
+        &fit,
+        blocks.poisson_ratio,
+        validate_bulging(bulging)?,
+    );
     let face_vectors: Vec<DVec3> = (0..rest.triangle_count())
-        .map(|t| {
+        .zip(tractions)
+        .map(|(t, traction)| {
             let [a, b, c] = rest.triangle(t);
-            fit.scale * (b - a).cross(c - a).normalize_or_zero()
+            traction * (b - a).cross(c - a).normalize_or_zero()
         })
         .collect();
     Ok((0..blocks.point_count)

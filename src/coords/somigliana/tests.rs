@@ -18,7 +18,7 @@ pub(super) fn l_cage() -> Cage {
     extrude(&outline, 0.0, 1.0)
 }
 
-fn box_cage() -> Cage {
+pub(super) fn box_cage() -> Cage {
     let outline =
         [(-1.0, -0.5), (1.0, -0.5), (1.0, 0.5), (-1.0, 0.5)].map(|(x, y)| DVec2::new(x, y));
     extrude(&outline, -0.5, 0.5)
@@ -87,7 +87,7 @@ fn rest_cage_reproduces_every_inside_point() {
         let cage = l_cage();
         let points = l_points();
         let blocks = somigliana_blocks(&points, &cage, nu).unwrap();
-        let deformed = deform(&blocks, &cage, cage.positions()).unwrap();
+        let deformed = deform(&blocks, &cage, cage.positions(), 0.0).unwrap();
         let mut worst: f64 = 0.0;
         for (i, &x) in points.iter().enumerate() {
             worst = worst
@@ -121,7 +121,7 @@ fn similarities_of_the_cage_are_followed() {
     for (name, scale, rotation, translation) in cases {
         let map = |p: DVec3| scale * (rotation * p) + translation;
         let deformed: Vec<DVec3> = cage.positions().iter().map(|&p| map(p)).collect();
-        let moved = deform(&blocks, &cage, &deformed).unwrap();
+        let moved = deform(&blocks, &cage, &deformed, 0.0).unwrap();
         let worst = points
             .iter()
             .zip(&moved)
@@ -190,7 +190,7 @@ fn a_point_in_the_plane_of_another_face_deforms_continuously() {
     ] {
         let points = [on_plane - step * across, on_plane, on_plane + step * across];
         let blocks = somigliana_blocks(&points, &cage, 0.2).unwrap();
-        let moved = deform(&blocks, &cage, &deformed).unwrap();
+        let moved = deform(&blocks, &cage, &deformed, 0.0).unwrap();
         // Linear in the offset: the middle is the mean of its neighbours.
         let kink = (moved[1] - 0.5 * (moved[0] + moved[2])).length();
         let spread = (moved[2] - moved[0]).length();
@@ -259,7 +259,7 @@ fn a_cage_far_from_the_origin_gives_the_same_blocks() {
         }
     }
     let deformed: Vec<DVec3> = moved.positions().iter().map(|&p| p + DVec3::X).collect();
-    let moved_points = deform(&far, &moved, &deformed).unwrap();
+    let moved_points = deform(&far, &moved, &deformed, 0.0).unwrap();
     let translation_error = shifted
         .iter()
         .zip(&moved_points)
@@ -305,7 +305,7 @@ fn stretching_response_is_monotonic_in_the_poisson_ratio() {
         .iter()
         .map(|&nu| {
             let blocks = somigliana_blocks(&probe, &cage, nu).unwrap();
-            deform(&blocks, &cage, &deformed).unwrap()[0].y
+            deform(&blocks, &cage, &deformed, 0.0).unwrap()[0].y
         })
         .collect();
     for (nu, y) in ratios.iter().zip(&widths) {
@@ -342,7 +342,7 @@ fn deform_checks_its_inputs() {
     let blocks = somigliana_blocks(&[DVec3::ZERO], &cage, 0.0).unwrap();
     let mut positions = cage.positions().to_vec();
     assert_eq!(
-        deform(&blocks, &cage, &positions[1..]),
+        deform(&blocks, &cage, &positions[1..], 0.0),
         Err(SomiglianaError::PositionCount {
             expected: 8,
             actual: 7
@@ -350,12 +350,12 @@ fn deform_checks_its_inputs() {
     );
     positions[3].y = f64::NAN;
     assert_eq!(
-        deform(&blocks, &cage, &positions),
+        deform(&blocks, &cage, &positions, 0.0),
         Err(SomiglianaError::NonFinitePosition { index: 3 })
     );
     let other = l_cage();
     assert!(matches!(
-        deform(&blocks, &other, other.positions()),
+        deform(&blocks, &other, other.positions(), 0.0),
         Err(SomiglianaError::CageMismatch { .. })
     ));
     assert_eq!(

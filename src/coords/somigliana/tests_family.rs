@@ -6,7 +6,7 @@ use super::*;
 use crate::coords::{bind_cpu, BindOptions, BindProgress, Method, Parameter};
 use glam::DQuat;
 
-fn inside_points() -> Vec<DVec3> {
+pub(super) fn inside_points() -> Vec<DVec3> {
     vec![
         DVec3::new(0.5, 0.5, 0.5),
         DVec3::new(1.7, 0.3, 0.2),
@@ -17,14 +17,14 @@ fn inside_points() -> Vec<DVec3> {
 }
 
 /// The family's options with Poisson ratio `nu`, read by the setting's one check.
-fn options(nu: f64) -> BindOptions {
+pub(super) fn options(nu: f64) -> BindOptions {
     let mut options = BindOptions::for_method(Method::Somigliana);
     let held = Parameter::PoissonRatio.spec().validate_decimal(nu).unwrap();
     options.set(Parameter::PoissonRatio, held);
     options
 }
 
-fn bind(cage: &Cage, points: &[DVec3], options: BindOptions) -> crate::coords::Weights {
+pub(super) fn bind(cage: &Cage, points: &[DVec3], options: BindOptions) -> crate::coords::Weights {
     let classes = options.classify(cage, points);
     bind_cpu(
         points,
@@ -38,7 +38,7 @@ fn bind(cage: &Cage, points: &[DVec3], options: BindOptions) -> crate::coords::W
 
 /// A pose that is no similarity: the L's arm bent and the whole turned,
 /// scaled and moved.
-fn bent(cage: &Cage) -> Vec<DVec3> {
+pub(super) fn bent(cage: &Cage) -> Vec<DVec3> {
     let turn = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
     cage.positions()
         .iter()
@@ -49,7 +49,7 @@ fn bent(cage: &Cage) -> Vec<DVec3> {
         .collect()
 }
 
-fn diagonal(cage: &Cage) -> f64 {
+pub(super) fn diagonal(cage: &Cage) -> f64 {
     let (lo, hi) = crate::geometry::bounds_of(cage.positions());
     (hi - lo).length()
 }
@@ -90,6 +90,7 @@ fn the_column_vectors_give_the_global_deformation() {
         &somigliana_blocks(&points, &cage, 0.3).unwrap(),
         &cage,
         &pose,
+        0.0,
     )
     .unwrap();
     let moves = Method::Somigliana.column_displacements(&cage, &pose);

@@ -88,7 +88,7 @@ fn an_icosphere_matches_the_reference_and_keeps_the_identities() {
     let elapsed = started.elapsed();
     let mut identity: f64 = 0.0;
     let mut reproduction: f64 = 0.0;
-    let moved = deform(&blocks, &cage, cage.positions()).unwrap();
+    let moved = deform(&blocks, &cage, cage.positions(), 0.0).unwrap();
     for (i, &x) in points.iter().enumerate() {
         let sum: DMat3 = blocks.vertex_blocks(i).iter().copied().sum();
         let entries = (sum - DMat3::IDENTITY).to_cols_array();

@@ -202,9 +202,11 @@ def deform(
 ) -> npt.NDArray[np.float64]:
     """The points moved by the cage's move to ``deformed_vertices``, float64
     (n, 3), as ``pmvc deform`` computes them. Without ``weights``, ``method`` is
-    bound first with ``parameters`` (resolution, grid, backend, progress,
-    triangulate, pmvc_kernel, strict, dtype); with ``weights``, ``strict=True``
-    refuses weights with rows outside the cage."""
+    bound first with ``parameters`` (resolution, grid, poisson_ratio, backend,
+    progress, triangulate, pmvc_kernel, strict, dtype); with ``weights``,
+    ``strict=True`` refuses weights with rows outside the cage. ``bulging``
+    (Somigliana coordinates' γ, 0 to 10, default 0) is read when deforming, so
+    it may be given with ``weights``."""
     ...
 
 def classify(
@@ -234,7 +236,8 @@ def generate_cage(
     ...
 
 def families() -> List[Dict[str, Any]]:
-    """Every family: id, name, summary, parameters, positive_inside,
+    """Every family: id, name, summary, parameters, deform_parameters (read
+    by deform, not bind: Somigliana's bulging), positive_inside,
     outside_policy, columns_layout, gpu_kernel, gpu_kernel_quads."""
     ...
 

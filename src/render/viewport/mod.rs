@@ -25,7 +25,7 @@ use super::weight_attributes::AttributeBlend;
 use super::weight_chunks::{ChunkLimits, ChunksTooLarge};
 
 mod readbacks;
-use crate::coords::{Method, QuadSplit, Weights, WeightsId};
+use crate::coords::{BindOptions, Method, Parameter, Weights, WeightsId};
 use crate::geometry::Cage;
 use glam::{DVec3, Vec3};
 
@@ -202,7 +202,7 @@ impl ViewportRenderer {
         device: &wgpu::Device,
         id: WeightsId,
         weights: Option<&Weights>,
-        quads: QuadSplit,
+        options: BindOptions,
         resident: Option<&wgpu::Buffer>,
     ) -> Result<(), RenderError> {
         let Some(scene) = self.scene.as_mut() else {
@@ -231,7 +231,7 @@ impl ViewportRenderer {
         let attributes = AttributeBlend::new(&device.limits(), weights.cols as u32, chunks.len())
             .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
         // The columns' displacements, then room for the vertex normals.
-        let mut displacements = scene.displacements_of(id.method, quads);
+        let mut displacements = scene.displacements_of(&options);
         let uniform_displacements = uniform_displacements_buffer(device, &displacements);
         displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
@@ -250,7 +250,7 @@ impl ViewportRenderer {
                 displacements,
                 uniform_displacements,
                 columns: weights.cols as u32,
-                quads,
+                options,
                 attributes,
                 normals_pose: None,
             }),
@@ -273,9 +273,15 @@ impl ViewportRenderer {
         }
     }
 
-    /// Upload the posed cage and every bound family's column displacements; called
-    /// only when the pose changes.
-    pub fn set_cage_pose(&mut self, queue: &wgpu::Queue, pose: &[DVec3]) {
+    /// Upload the posed cage and every bound family's column displacements with
+    /// the deformation settings `deform` (Somigliana's bulging; those not listed
+    /// at their defaults); called only when the pose or those settings change.
+    pub fn set_cage_pose(
+        &mut self,
+        queue: &wgpu::Queue,
+        pose: &[DVec3],
+        deform: &[(Parameter, u32)],
+    ) {
         let Some(scene) = self.scene.as_mut() else {
             return;
         };
@@ -283,11 +289,12 @@ impl ViewportRenderer {
             return;
         }
         scene.pose = pose.to_vec();
+        scene.deform = deform.to_vec();
         scene.pose_revision += 1;
         let scene_pose = scene.origin.points_to_scene(pose, 1.0);
         queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&scene_pose));
-        for (&method, slot) in scene.slots.iter().chain(&scene.twin_slots) {
-            let displacements = scene.displacements_of(method, slot.quads);
+        for slot in scene.slots.values().chain(scene.twin_slots.values()) {
+            let displacements = scene.displacements_of(&slot.options);
             queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
             SceneGpu::write_uniform_displacements(queue, slot, &displacements);
         }

@@ -17,7 +17,7 @@ _registered = []
 def register():
     import bpy
 
-    from . import deform, operators, ui
+    from . import binding, deform, operators, store, ui
 
     if _registered:
         return
@@ -26,6 +26,11 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.WindowManager.pmvc = bpy.props.PointerProperty(type=settings)
+    # Deformation settings (Somigliana's bulging) belong to the bound object:
+    # undoable and animatable as any property; the handlers redeform when one
+    # changes.
+    for pid, spec in binding.deform_parameter_specs().items():
+        setattr(bpy.types.Object, store.deform_property_name(pid), operators.deform_property(spec))
     deform.add_handlers()
     _registered.extend(classes)
 
@@ -33,12 +38,16 @@ def register():
 def unregister():
     import bpy
 
-    from . import deform, store
+    from . import binding, deform, store
 
     if not _registered:
         return
     deform.remove_handlers()
     del bpy.types.WindowManager.pmvc
+    for pid in binding.deform_parameter_specs():
+        name = store.deform_property_name(pid)
+        if hasattr(bpy.types.Object, name):
+            delattr(bpy.types.Object, name)
     for cls in reversed(_registered):
         bpy.utils.unregister_class(cls)
     _registered.clear()

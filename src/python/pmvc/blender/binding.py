@@ -32,6 +32,17 @@ def parameter_specs():
     return specs
 
 
+def deform_parameter_specs():
+    """{setting id: spec} over every family of the settings read when deforming,
+    not binding (Somigliana's bulging): each is a property of the bound object
+    (:func:`store.deform_property_name`)."""
+    specs = {}
+    for entry in families():
+        for parameter in entry.get("deform_parameters", []):
+            specs.setdefault(parameter["id"], parameter)
+    return specs
+
+
 def parameters_for(method, values):
     """The parameters ``method`` reads, from ``values`` (a dict of every one).
 

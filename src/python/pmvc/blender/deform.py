@@ -126,7 +126,7 @@ def current_pose(obj, depsgraph, changed_only=False):
         raise ValueError(f"its cage {cage_obj.name} has {len(posed)} vertices, it was bound with {len(binding.rest)} "
                          "(a modifier on the cage that adds vertices, or an edit): rebind")
     last = binding.last_posed.get(obj.name_full)
-    if changed_only and last is not None and np.array_equal(posed, last):
+    if changed_only and last is not None and np.array_equal(posed, last[0]) and last[1] == store.deform_settings(obj):
         return binding, None
     return binding, posed
 
@@ -139,7 +139,8 @@ def update_object(obj, depsgraph):
         binding, posed = current_pose(obj, depsgraph, changed_only=True)
         if posed is None:
             return
-        offsets = binding.offsets(posed)
+        settings = store.deform_settings(obj)
+        offsets = binding.offsets(posed, settings)
     except NotInDepsgraph:
         return  # keep the offsets of the depsgraph that has it
     except (pmvc.PmvcError, ValueError, KeyError, TypeError, RuntimeError) as error:
@@ -154,7 +155,7 @@ def update_object(obj, depsgraph):
         return
     attribute.data.foreach_set("vector", offsets.astype(np.float32).ravel())
     obj.data.update_tag()
-    binding.last_posed[obj.name_full] = posed
+    binding.last_posed[obj.name_full] = (posed, settings)
     status.pop(obj.name, None)
 
 

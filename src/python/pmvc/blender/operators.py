@@ -151,6 +151,20 @@ def parameter_property(spec):
     return IntProperty(name=name, default=spec["default"], min=spec["min"], max=spec["max"])
 
 
+def deform_property(spec):
+    """A deformation setting (Somigliana's bulging γ) as a property of the
+    bound object, a float shown to the hundredth the package holds."""
+    return FloatProperty(name=spec.get("label", spec["id"]), default=spec["default"], min=spec["min"],
+                         max=spec["max"], step=10, precision=2, update=_redeform,
+                         description="Read when the weights deform the cage's pose: changing it binds nothing again")
+
+
+def _redeform(obj, _context):
+    """A deformation setting changed: the next depsgraph update redeforms
+    ``obj`` (its handler compares the settings with the last ones used)."""
+    obj.update_tag()
+
+
 class PMVC_OT_unbind(bpy.types.Operator):
     """Remove the binding: the mesh is back at its rest positions"""
     bl_idname = "pmvc.unbind"

@@ -64,8 +64,9 @@ class Binding:
         corners = vertices[self.triangles]
         return corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
 
-    def offsets(self, posed):
-        """The move of every point for the cage at ``posed`` (mesh space)."""
+    def offsets(self, posed, settings=None):
+        """The move of every point for the cage at ``posed`` (mesh space), with
+        the deformation ``settings`` the family reads (Somigliana's bulging)."""
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
             return np.zeros_like(self.points)
         if self.linear or self.green:
@@ -82,7 +83,7 @@ class Binding:
                 # term is 0 up to rounding).
                 out += _product(self.psi, turned.astype(self.psi.dtype), moved[self.triangles].any(axis=1))
             return out.astype(np.float64)
-        return pmvc.deform(self.points, self.cage, posed, weights=self.weights) - self.points
+        return pmvc.deform(self.points, self.cage, posed, weights=self.weights, **(settings or {})) - self.points
 
 
 def _product(matrix, values, mask):
@@ -94,6 +95,24 @@ def _product(matrix, values, mask):
     if len(columns) < len(mask) // 2:
         return matrix[:, columns] @ values[columns]
     return matrix @ values
+
+
+def deform_property_name(pid):
+    """The object property holding deformation setting ``pid``."""
+    return f"pmvc_{pid}"
+
+
+def deform_settings(obj):
+    """{setting id: value} of the deformation settings ``obj``'s family reads
+    (Somigliana's bulging), from its properties, to the hundredth the package
+    holds (Blender's floats are single precision)."""
+    method = obj[KEY]["method"]
+    entry = next((f for f in pmvc.families() if f["id"] == method), None)
+    settings = {}
+    for spec in entry.get("deform_parameters", []) if entry else []:
+        value = getattr(obj, deform_property_name(spec["id"]), spec["default"])
+        settings[spec["id"]] = round(float(value), 2) if isinstance(spec["default"], float) else int(value)
+    return settings
 
 
 def is_bound(obj):

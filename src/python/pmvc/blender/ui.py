@@ -42,6 +42,9 @@ def draw(layout, context):
         layout.label(text=problem, icon="ERROR")
     if deform.modifier_of(obj) is None:
         layout.label(text="The pmvc modifier was removed: rebind", icon="ERROR")
+    entry = next((f for f in binding.families() if f["id"] == method), None)
+    for setting in entry.get("deform_parameters", []) if entry else []:
+        layout.prop(obj, store.deform_property_name(setting["id"]))
     row = layout.row(align=True)
     row.operator("pmvc.rebind")
     row.operator("pmvc.unbind")
