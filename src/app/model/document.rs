@@ -78,9 +78,9 @@ pub struct Document {
     named_poses: Arc<Vec<NamedPose>>,
     /// The bundled scene this document's mesh and cage are, when they are one.
     bundled: Option<BundledScene>,
-    /// Settings read when weights deform a pose (Somigliana's bulging), where
-    /// not at their default: part of what the document shows and exports,
-    /// not of the weights.
+    /// Settings read when weights deform a pose (Somigliana's bulging), those
+    /// set (a session's, or chosen in the side panel); the others are at their
+    /// defaults. Part of what the document shows and exports, not of the weights.
     deform_values: BTreeMap<Parameter, u32>,
 }
 
@@ -131,7 +131,7 @@ impl Document {
         (self.deform_values.get(&parameter)).map_or(parameter.spec().default, |&v| v)
     }
 
-    /// The settings that differ from their defaults.
+    /// The settings set on this document (the others are at their defaults).
     pub fn deform_values(&self) -> Vec<(Parameter, u32)> {
         self.deform_values.iter().map(|(&p, &v)| (p, v)).collect()
     }
