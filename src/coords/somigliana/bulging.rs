@@ -36,7 +36,13 @@ pub(super) fn face_tractions(
     if volume <= 0.0 || !volume.is_finite() {
         return vec![scale; triangles];
     }
-    let fitted = |v: usize| scale * (fit.rotation * rest.positions()[v]) + fit.translation;
+    // Where the similarity alone puts each vertex, about the centroids (not
+    // the origin, so a cage far from it loses no digits).
+    let count = rest.vertex_count().max(1) as f64;
+    let rest_centre = rest.positions().iter().sum::<DVec3>() / count;
+    let posed_centre = pose.iter().sum::<DVec3>() / count;
+    let fitted =
+        |v: usize| posed_centre + scale * (fit.rotation * (rest.positions()[v] - rest_centre));
     let mut tractions: Vec<f64> = rest
         .triangles()
         .iter()
