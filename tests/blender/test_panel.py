@@ -87,6 +87,10 @@ def test_the_bulging_of_a_somigliana_binding_is_a_property_of_the_object():
     expected = pmvc.deform(points, cage, posed, weights=weights, bulging=3.0)
     assert relative_error(bulged, expected, diagonal) < 1e-6
     assert np.abs(bulged - plain).max() > 1e-3 * diagonal
+    # A baked shape key keeps the bulge.
+    assert bpy.ops.pmvc.bake_shape_key(name="bulged") == {"FINISHED"}
+    baked = coordinates(mesh_obj.data.shape_keys.key_blocks["bulged"])
+    assert relative_error(baked, expected, diagonal) < 1e-6
     mesh_obj.pmvc_bulging = 0.0
     bpy.context.view_layer.update()
     assert relative_error(evaluated(mesh_obj), plain, diagonal) < 1e-6

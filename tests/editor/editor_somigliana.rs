@@ -8,17 +8,27 @@ use crate::common;
 
 use common::editor::*;
 use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
 use glam::DVec3;
 use pmvc::app::compare::{Overlay, Pane};
 use pmvc::coords::{Method, Parameter};
 use pmvc::render::Colouring;
 
-#[test]
-fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
-    let Some(mut harness) = editor() else { return };
+/// The editor on its comb with Somigliana coordinates bound and shown
+/// (`None` without a GPU, as `editor()`).
+fn somigliana_shown() -> Option<Harness<'static, pmvc::app::EditorApp>> {
+    let mut harness = editor()?;
     run_until_bound(&mut harness);
     harness.state_mut().set_active_method(Method::Somigliana);
     run_until_bound(&mut harness);
+    Some(harness)
+}
+
+#[test]
+fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
+    let Some(mut harness) = somigliana_shown() else {
+        return;
+    };
     let app = harness.state();
     let cage = app.document().cage().clone();
     let (vertices, triangles) = (cage.vertex_count(), cage.triangle_count());
@@ -97,10 +107,9 @@ fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
 /// again), is one undo step, and is saved with the session.
 #[test]
 fn bulging_is_chosen_in_the_side_panel_and_undone() {
-    let Some(mut harness) = editor() else { return };
-    run_until_bound(&mut harness);
-    harness.state_mut().set_active_method(Method::Somigliana);
-    run_until_bound(&mut harness);
+    let Some(mut harness) = somigliana_shown() else {
+        return;
+    };
     let weights = harness
         .state()
         .document()

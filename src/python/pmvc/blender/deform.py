@@ -109,10 +109,11 @@ class NotInDepsgraph(ValueError):
     """The cage is not evaluated in this depsgraph (disabled in renders, say)."""
 
 
-def current_pose(obj, depsgraph, changed_only=False):
+def current_pose(obj, depsgraph, changed_only=False, settings=None):
     """(binding, posed cage in the mesh's space) as ``depsgraph`` has it
-    (posed None when ``changed_only`` and the cage did not move since the last
-    update); raises with a sentence when it cannot be read."""
+    (posed None when ``changed_only`` and neither the cage nor the deformation
+    ``settings`` changed since the last update); raises with a sentence when it
+    cannot be read."""
     binding = store.load(obj)
     cage_obj = store.cage_of(obj)
     if cage_obj is None:
@@ -126,7 +127,7 @@ def current_pose(obj, depsgraph, changed_only=False):
         raise ValueError(f"its cage {cage_obj.name} has {len(posed)} vertices, it was bound with {len(binding.rest)} "
                          "(a modifier on the cage that adds vertices, or an edit): rebind")
     last = binding.last_posed.get(obj.name_full)
-    if changed_only and last is not None and np.array_equal(posed, last[0]) and last[1] == store.deform_settings(obj):
+    if changed_only and last is not None and np.array_equal(posed, last[0]) and last[1] == settings:
         return binding, None
     return binding, posed
 
@@ -136,10 +137,10 @@ def update_object(obj, depsgraph):
     if obj.mode == "EDIT":
         return
     try:
-        binding, posed = current_pose(obj, depsgraph, changed_only=True)
+        settings = store.deform_settings(obj)
+        binding, posed = current_pose(obj, depsgraph, changed_only=True, settings=settings)
         if posed is None:
             return
-        settings = store.deform_settings(obj)
         offsets = binding.offsets(posed, settings)
     except NotInDepsgraph:
         return  # keep the offsets of the depsgraph that has it

@@ -209,7 +209,7 @@ class PMVC_OT_bake_shape_key(bpy.types.Operator):
         try:
             obj = bound_object(context)
             current, posed = deform.current_pose(obj, context.evaluated_depsgraph_get())
-            moves = current.offsets(posed)
+            moves = current.offsets(posed, store.deform_settings(obj))
         except REFUSED as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

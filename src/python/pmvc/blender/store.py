@@ -64,7 +64,7 @@ class Binding:
         corners = vertices[self.triangles]
         return corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
 
-    def offsets(self, posed, settings=None):
+    def offsets(self, posed, settings):
         """The move of every point for the cage at ``posed`` (mesh space), with
         the deformation ``settings`` the family reads (Somigliana's bulging)."""
         if np.array_equal(posed, self.rest):  # at rest: not moved, exactly
@@ -83,7 +83,7 @@ class Binding:
                 # term is 0 up to rounding).
                 out += _product(self.psi, turned.astype(self.psi.dtype), moved[self.triangles].any(axis=1))
             return out.astype(np.float64)
-        return pmvc.deform(self.points, self.cage, posed, weights=self.weights, **(settings or {})) - self.points
+        return pmvc.deform(self.points, self.cage, posed, weights=self.weights, **settings) - self.points
 
 
 def _product(matrix, values, mask):
@@ -106,13 +106,22 @@ def deform_settings(obj):
     """{setting id: value} of the deformation settings ``obj``'s family reads
     (Somigliana's bulging), from its properties, to the hundredth the package
     holds (Blender's floats are single precision)."""
-    method = obj[KEY]["method"]
-    entry = next((f for f in pmvc.families() if f["id"] == method), None)
     settings = {}
-    for spec in entry.get("deform_parameters", []) if entry else []:
+    for spec in _deform_specs().get(obj[KEY]["method"], []):
         value = getattr(obj, deform_property_name(spec["id"]), spec["default"])
         settings[spec["id"]] = round(float(value), 2) if isinstance(spec["default"], float) else int(value)
     return settings
+
+
+_deform_spec_cache = {}
+
+
+def _deform_specs():
+    """{method id: its deformation settings' specs}, read from the package once
+    (the handlers ask at every depsgraph update)."""
+    if not _deform_spec_cache:
+        _deform_spec_cache.update({f["id"]: f.get("deform_parameters", []) for f in pmvc.families()})
+    return _deform_spec_cache
 
 
 def is_bound(obj):
