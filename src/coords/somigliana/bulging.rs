@@ -84,24 +84,28 @@ pub(super) fn swept_volume(to: [DVec3; 3], from: [DVec3; 3]) -> f64 {
 
 /// Project `tractions` onto zero net force, least squares weighted by area:
 /// `t_f ← t_f − n_f · z` with `(Σ A_f n_f n_fᵀ) z = Σ A_f t_f n_f` (rest
-/// normals; the pose's common rotation drops out). Left as they are on a flat
-/// cage, where the system is singular.
+/// normals; the pose's common rotation drops out).
 fn without_net_force(rest: &Cage, tractions: &mut [f64]) {
-    let mut system = DMat3::ZERO;
-    let mut force = DVec3::ZERO;
-    let normals: Vec<DVec3> = (0..rest.triangle_count())
+    let (areas, normals): (Vec<f64>, Vec<DVec3>) = (0..rest.triangle_count())
         .map(|t| {
             let [a, b, c] = rest.triangle(t);
-            (b - a).cross(c - a) / 2.0
+            let area_normal = (b - a).cross(c - a) / 2.0;
+            (area_normal.length(), area_normal.normalize_or_zero())
         })
-        .collect();
-    for (&area_normal, &traction) in normals.iter().zip(tractions.iter()) {
-        let area = area_normal.length();
-        if area > 0.0 {
-            let unit = area_normal / area;
-            system += DMat3::from_cols(unit * unit.x, unit * unit.y, unit * unit.z) * area;
-            force += area_normal * traction;
-        }
+        .unzip();
+    without_net_force_along(&areas, &normals, tractions);
+}
+
+/// Project `tractions`, pushing along the unit `directions` over triangles of
+/// `areas`, onto zero net force, least squares weighted by area: `t_f ← t_f −
+/// d_f · z` with `(Σ A_f d_f d_fᵀ) z = Σ A_f t_f d_f`. Left as they are where
+/// the system is singular (a flat cage).
+pub(super) fn without_net_force_along(areas: &[f64], directions: &[DVec3], tractions: &mut [f64]) {
+    let mut system = DMat3::ZERO;
+    let mut force = DVec3::ZERO;
+    for ((&area, &unit), &traction) in areas.iter().zip(directions).zip(tractions.iter()) {
+        system += DMat3::from_cols(unit * unit.x, unit * unit.y, unit * unit.z) * area;
+        force += unit * (area * traction);
     }
     let determinant = system.determinant();
     let size = system
@@ -113,7 +117,7 @@ fn without_net_force(rest: &Cage, tractions: &mut [f64]) {
         return;
     }
     let correction = system.inverse() * force;
-    for (traction, area_normal) in tractions.iter_mut().zip(&normals) {
-        *traction -= area_normal.normalize_or_zero().dot(correction);
+    for (traction, direction) in tractions.iter_mut().zip(directions) {
+        *traction -= direction.dot(correction);
     }
 }

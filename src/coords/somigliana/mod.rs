@@ -62,6 +62,7 @@
 //! the blocks are the identity's exterior value (Σ Bᵥ = 0), with no exterior
 //! extension.
 
+mod blend;
 mod bulging;
 mod columns;
 mod fit;
@@ -74,6 +75,8 @@ mod reference;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_blend;
+#[cfg(test)]
 mod tests_bulging;
 #[cfg(test)]
 mod tests_family;
@@ -81,6 +84,7 @@ mod tests_family;
 mod tests_schemes;
 
 use crate::geometry::Cage;
+pub use blend::{blended_pose, deform_blended, BlendedPose, MAX_BLEND};
 pub use columns::{
     column_count, column_displacements, identity_blocks, rest_columns, SomiglianaCage,
     BLOCK_COLUMNS,
@@ -159,6 +163,8 @@ pub enum SomiglianaError {
     PoissonRatio { value: f64 },
     #[error("the bulging γ must be 0 to {MAX_BULGING}, got {value}")]
     Bulging { value: f64 },
+    #[error("the blend must be 0 (global) to 1 (local), got {value}")]
+    Blend { value: f64 },
     #[error("point {index} is not finite")]
     NonFinitePoint { index: usize },
     #[error("deformed cage vertex {index} is not finite")]
