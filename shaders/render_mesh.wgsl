@@ -7,7 +7,10 @@
 // `vs_*_attributes` are appended too) and each weights column's displacement d_k
 // (`Method::column_displacements`, uploaded per pose change), so the CPU never
 // touches mesh positions per frame. The displacement form is exact at rest for any
-// weights and keeps its precision far from the origin. Smooth shading reads each
+// weights and keeps its precision far from the origin. A family whose columns
+// also carry matrices (coords::ColumnMoves, normalised: Somigliana coordinates
+// with a local blend) has them after the vertex normals, and the blended
+// position is solved with their blend: p' = (I + Σ_k W[i,k] · M_k)⁻¹ (p + Σ_k W[i,k] · d_k). Smooth shading reads each
 // vertex's normal of the deformed mesh, recomputed per pose change; faceted
 // shading takes screen-space derivatives of the deformed position.
 //
@@ -24,7 +27,8 @@
 // xyz: how far each weights column's vector moved from rest, for the method shown.
 @group(0) @binding(2) var<storage, read> displacements: array<vec4<f32>>;
 // After them, smooth shading's vertex normals of the deformed mesh, recomputed
-// per pose change (shaders/render_normals.wgsl).
+// per pose change (shaders/render_normals.wgsl); after those, for a normalised
+// family, three `vec4`s per column: the columns of its matrix.
 // The same for the compared method (the difference view).
 @group(0) @binding(5) var<storage, read> other_displacements: array<vec4<f32>>;
 // The first UNIFORM_COLUMNS of both again, in uniform buffers: where the blend
@@ -65,7 +69,34 @@ fn deformed_position_after(vertex: u32, first_column: u32, head: vec3<f32>) -> v
         return rest[vertex].xyz;
     }
     let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
-    return rest[vertex].xyz + blend_row(start.x, start.y, first_column, frame.columns, head);
+    let moved = rest[vertex].xyz + blend_row(start.x, start.y, first_column, frame.columns, head);
+    return shown_normalised(vertex, moved);
+}
+
+// `moved` (p + Σ W d) solved with the shown family's blended matrix; itself for a
+// linear family, whose matrix blend is empty.
+fn shown_normalised(vertex: u32, moved: vec3<f32>) -> vec3<f32> {
+    let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
+    let base = frame.columns + frame.vertex_count;
+    return solved(blend_matrix_row(start.x, start.y, frame.matrix_columns, base), moved);
+}
+
+// (I + stretch)⁻¹ moved, by the adjugate: with a zero `stretch` every product is
+// by 0 or 1, so a linear family's position comes back exactly.
+fn solved(stretch: mat3x3<f32>, moved: vec3<f32>) -> vec3<f32> {
+    let m = mat3x3<f32>(
+        stretch[0] + vec3<f32>(1.0, 0.0, 0.0),
+        stretch[1] + vec3<f32>(0.0, 1.0, 0.0),
+        stretch[2] + vec3<f32>(0.0, 0.0, 1.0),
+    );
+    let r0 = cross(m[1], m[2]);
+    let r1 = cross(m[2], m[0]);
+    let r2 = cross(m[0], m[1]);
+    let determinant = dot(m[0], r0);
+    if abs(determinant) < 1e-30 {
+        return moved;
+    }
+    return vec3<f32>(dot(r0, moved), dot(r1, moved), dot(r2, moved)) / determinant;
 }
 
 fn other_deformed_position(vertex: u32) -> vec3<f32> {
@@ -75,8 +106,11 @@ fn other_deformed_position(vertex: u32) -> vec3<f32> {
         frame.other_columns,
         frame.other_first_chunk,
     );
-    return rest[vertex].xyz
+    let moved = rest[vertex].xyz
         + blend_other_row(start.x, start.y, 0u, frame.other_columns, vec3<f32>(0.0));
+    let base = frame.other_columns + frame.vertex_count;
+    let stretch = blend_other_matrix_row(start.x, start.y, frame.other_matrix_columns, base);
+    return solved(stretch, moved);
 }
 
 // The scalar the mesh is coloured by (0 when shaded or unbound).

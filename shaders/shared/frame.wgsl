@@ -38,6 +38,11 @@ struct Frame {
     // Columns per cage vertex: the negativity view takes every such column
     // from the first (9 for 3×3 blocks: their x-from-x entries).
     vertex_column_stride: u32,
+    // Columns whose matrices the shown family's blend solves with
+    // (coords::ColumnMoves, normalised); 0 for a linear move.
+    matrix_columns: u32,
+    // The same for the compared family.
+    other_matrix_columns: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

@@ -419,16 +419,16 @@ pub fn cage_size(cage: &[DVec3]) -> f64 {
     (hi - lo).length().max(1e-12)
 }
 
-/// Mesh positions `rest` moved by `weights` and the columns' displacements, in
-/// f32 scene coordinates (relative to `origin`) as drawn.
+/// Mesh positions `rest` moved by `weights` and the columns' moves, in f32
+/// scene coordinates (relative to `origin`) as drawn.
 pub fn deform(
     weights: &Weights,
     rest: &[DVec3],
-    moves: &[DVec3],
+    moves: &crate::coords::ColumnMoves,
     origin: crate::render::SceneOrigin,
 ) -> Vec<Vec3> {
     weights
-        .apply_displacements(rest, moves)
+        .apply_moves(rest, moves)
         .iter()
         .map(|&p| origin.to_scene(p))
         .collect()

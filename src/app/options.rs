@@ -24,9 +24,10 @@ pub struct EditorOptions {
     pub resolution: Option<u32>,
     /// Harmonic grid (cells along the cage's longest side); `None` for the default.
     pub grid: Option<u32>,
-    /// Somigliana coordinates' bulging γ in hundredths, applied once loaded
-    /// (a deformation setting, an undo step like `pose`); `None` keeps it.
-    pub bulging: Option<u32>,
+    /// Deformation settings (Somigliana's bulging γ and local blend, as their
+    /// specs hold them) applied once loaded, each an undo step like `pose`;
+    /// those not listed keep their values.
+    pub deform: Vec<(crate::coords::Parameter, u32)>,
     /// Split the cage's quads along a diagonal (`--triangulate`); `None` keeps
     /// the session's setting, or bilinear patches.
     pub triangulate: Option<crate::coords::QuadSplit>,

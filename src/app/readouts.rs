@@ -28,8 +28,8 @@ impl Views {
         }
         let set = document.bound_id(id)?;
         let weights = &set.weights;
-        let moves = (document.deform_options(set.options))
-            .column_displacements(document.cage(), document.pose());
+        let moves =
+            (document.deform_options(set.options)).column_moves(document.cage(), document.pose());
         let positions = Arc::new(compare::deform(
             weights,
             &document.mesh().positions,

@@ -117,15 +117,23 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         ),
     };
     let mut options = options;
-    if let Some(bulging) = args.bulging {
-        options.bulging = bulging;
+    let settings = [
+        (Parameter::Bulging, args.bulging),
+        (Parameter::LocalBlend, args.local_blend),
+    ];
+    for (parameter, value) in settings {
+        let Some(value) = value else { continue };
+        options.set(parameter, value);
         if options
             .deform_parameters()
-            .all(|(spec, _)| spec.key != Parameter::Bulging)
+            .all(|(spec, _)| spec.key != parameter)
         {
+            let spec = parameter.spec();
             warn_line!(
-                "pmvc: note: --bulging is ignored: {} weights read no bulging (Somigliana coordinates do)",
-                options.method.name()
+                "pmvc: note: {} is ignored: {} weights read no {} (Somigliana coordinates do)",
+                spec.flag,
+                options.method.name(),
+                spec.label.to_lowercase()
             );
         }
     }
@@ -165,8 +173,8 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
     // sum to 1 when read, so a translation of the cage moves every vertex with it.
     // Green's ψ columns follow the triangles the weights were bound on.
     let deform = |pose: &[DVec3]| -> Vec<DVec3> {
-        let moves = options.column_displacements(&input.cage, pose);
-        weights.apply_displacements(&input.mesh.mesh.positions, &moves)
+        let moves = options.column_moves(&input.cage, pose);
+        weights.apply_moves(&input.mesh.mesh.positions, &moves)
     };
     let deformed = deform(&pose);
     if writes_points_npy(&args.out) {

@@ -40,8 +40,8 @@ pub struct OutputError(pub std::io::Error);
 
 use clap::{Parser, Subcommand, ValueEnum};
 use parse::{
-    parse_bulging, parse_grid, parse_object_name, parse_percent, parse_poisson_ratio,
-    parse_resolution, parse_seconds, parse_view, TriangulateArg,
+    parse_bulging, parse_grid, parse_local_blend, parse_object_name, parse_percent,
+    parse_poisson_ratio, parse_resolution, parse_seconds, parse_view, TriangulateArg,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -177,6 +177,7 @@ impl MethodChoice {
                 .poisson_ratio
                 .unwrap_or(crate::coords::BindOptions::for_method(self.method).poisson_ratio),
             bulging: crate::coords::BindOptions::for_method(self.method).bulging,
+            local_blend: crate::coords::BindOptions::for_method(self.method).local_blend,
             quads: self
                 .triangulate
                 .map_or(crate::coords::QuadSplit::None, TriangulateArg::split),
@@ -231,6 +232,12 @@ pub struct DeformArgs {
     /// when deforming, so the same weights serve every γ.
     #[arg(long, value_parser = parse_bulging, allow_negative_numbers = true)]
     pub bulging: Option<u32>,
+    /// Somigliana coordinates: the local/global blend (0–1, in steps of 0.01;
+    /// default 0, the global variant): at 1 each cage triangle and vertex turns
+    /// and stretches with its own frame instead of the similarity fitted to
+    /// the whole cage. Read when deforming, as --bulging is.
+    #[arg(long, value_parser = parse_local_blend, allow_negative_numbers = true)]
+    pub local_blend: Option<u32>,
     /// Output OBJ. Faces, texture coordinates and groups of an OBJ mesh are kept; normals are recomputed from the deformed mesh. A name ending in .npy gets the deformed points instead, as little-endian float64 of shape (mesh vertices, 3), whatever the input's format. A name ending in .glb gets binary glTF 2.0, and .gltf glTF's JSON with its buffer inside: positions, recomputed normals, texture coordinates (v flipped, as glTF has it) and the OBJ's groups as primitives.
     #[arg(long, value_name = "M2.obj|P2.npy|M2.glb|M2.gltf")]
     pub out: PathBuf,
@@ -297,6 +304,10 @@ pub struct EditArgs {
     /// the side panel's Bulging γ, applied after --pose.
     #[arg(long, value_parser = parse_bulging, allow_negative_numbers = true)]
     pub bulging: Option<u32>,
+    /// Somigliana coordinates' local/global blend (0–1), as `pmvc deform
+    /// --local-blend`: the side panel's Local blend, applied after --pose.
+    #[arg(long, value_parser = parse_local_blend, allow_negative_numbers = true)]
+    pub local_blend: Option<u32>,
     /// Coordinates to bind first.
     #[arg(long, value_enum)]
     pub method: Option<crate::coords::Method>,
@@ -411,7 +422,13 @@ impl EditArgs {
             pose: self.pose,
             resolution: self.resolution,
             grid: self.grid,
-            bulging: self.bulging,
+            deform: [
+                (crate::coords::Parameter::Bulging, self.bulging),
+                (crate::coords::Parameter::LocalBlend, self.local_blend),
+            ]
+            .into_iter()
+            .filter_map(|(parameter, value)| Some((parameter, value?)))
+            .collect(),
             triangulate: self.triangulate.map(TriangulateArg::split),
             method,
             screenshot: self.screenshot,

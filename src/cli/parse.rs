@@ -23,6 +23,11 @@ pub(super) fn parse_bulging(text: &str) -> Result<u32, String> {
     parse_parameter(crate::coords::Parameter::Bulging, text)
 }
 
+/// `--local-blend`: a decimal, held in hundredths, checked by its spec.
+pub(super) fn parse_local_blend(text: &str) -> Result<u32, String> {
+    parse_parameter(crate::coords::Parameter::LocalBlend, text)
+}
+
 fn parse_parameter(parameter: crate::coords::Parameter, text: &str) -> Result<u32, String> {
     parameter.spec().parse(text)
 }

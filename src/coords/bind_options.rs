@@ -4,8 +4,8 @@
 //! are not part of the weights.
 
 use super::{
-    harmonic, Method, Parameter, ParameterError, ParameterSpec, QuadSplit, QuadSupport,
-    DEFAULT_RESOLUTION, EXACT_RESOLUTION,
+    harmonic, ColumnMoves, Method, Parameter, ParameterError, ParameterSpec, QuadSplit,
+    QuadSupport, DEFAULT_RESOLUTION, EXACT_RESOLUTION,
 };
 use crate::geometry::{Cage, PointClasses};
 use glam::DVec3;
@@ -27,6 +27,9 @@ pub struct BindOptions {
     /// γ): read when the weights deform a pose, so it is not part of the
     /// weights ([`Self::same_weights_as`] ignores it); ignored by the others.
     pub bulging: u32,
+    /// Somigliana coordinates' local/global blend, in hundredths
+    /// ([`Self::local_blend`] gives it): read when deforming, as bulging is.
+    pub local_blend: u32,
     /// Whether the cage's quads stay bilinear patches (`None`, the default) or are
     /// split into triangles along a diagonal first (`--triangulate`). Families that
     /// only take triangles (Green) split along the shorter one when this is `None`.
@@ -54,6 +57,7 @@ impl BindOptions {
             Parameter::Grid => self.grid,
             Parameter::PoissonRatio => self.poisson_ratio,
             Parameter::Bulging => self.bulging,
+            Parameter::LocalBlend => self.local_blend,
         }
     }
 
@@ -63,6 +67,7 @@ impl BindOptions {
             Parameter::Grid => self.grid = value,
             Parameter::PoissonRatio => self.poisson_ratio = value,
             Parameter::Bulging => self.bulging = value,
+            Parameter::LocalBlend => self.local_blend = value,
         }
     }
 
@@ -134,19 +139,28 @@ impl BindOptions {
         self.method.columns(&self.cage_to_bind(cage))
     }
 
-    /// [`Method::column_displacements`] on the cage these options bind, with
-    /// these options' deformation settings (Somigliana's bulging).
-    pub fn column_displacements(&self, cage: &Cage, pose: &[DVec3]) -> Vec<DVec3> {
+    /// How each weights column moves in `pose` ([`ColumnMoves`]) on the cage
+    /// these options bind, with these options' deformation settings
+    /// (Somigliana's bulging and local blend): [`Method::column_displacements`]
+    /// for every linear family.
+    pub fn column_moves(&self, cage: &Cage, pose: &[DVec3]) -> ColumnMoves {
         let bound = self.cage_to_bind(cage);
         if self.method == Method::Somigliana {
-            return super::somigliana::column_displacements(
+            return super::somigliana::column_moves(
                 &bound,
                 pose,
                 self.poisson_ratio(),
                 self.bulging(),
+                self.local_blend(),
             );
         }
-        self.method.column_displacements(&bound, pose)
+        ColumnMoves::linear(self.method.column_displacements(&bound, pose))
+    }
+
+    /// Whether [`Self::column_moves`] may be normalised (carry matrices) for
+    /// some setting: Somigliana coordinates, with a local blend.
+    pub fn moves_may_carry_matrices(&self) -> bool {
+        self.method == Method::Somigliana
     }
 
     /// The Poisson ratio ν Somigliana coordinates bind with.
@@ -157,6 +171,11 @@ impl BindOptions {
     /// The bulging γ Somigliana coordinates deform with.
     pub fn bulging(&self) -> f64 {
         Parameter::Bulging.spec().number(self.bulging)
+    }
+
+    /// The local/global blend Somigliana coordinates deform with (0: global).
+    pub fn local_blend(&self) -> f64 {
+        Parameter::LocalBlend.spec().number(self.local_blend)
     }
 
     /// Whether this is PMVC integrated exactly ([`EXACT_RESOLUTION`]).
@@ -220,6 +239,7 @@ impl Default for BindOptions {
             grid: harmonic::DEFAULT_GRID,
             poisson_ratio: Parameter::PoissonRatio.spec().default,
             bulging: Parameter::Bulging.spec().default,
+            local_blend: Parameter::LocalBlend.spec().default,
             quads: QuadSplit::None,
         }
     }

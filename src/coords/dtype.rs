@@ -163,6 +163,13 @@ impl WeightsF64 {
         assert_eq!(rest.len(), self.rows, "one rest position per weights row");
         displaced(&self.values, rest, moves)
     }
+
+    /// As [`super::Weights::apply_moves`].
+    pub fn apply_moves(&self, rest: &[DVec3], moves: &super::ColumnMoves) -> Vec<DVec3> {
+        assert_eq!(moves.len(), self.cols, "one move per weights column");
+        assert_eq!(rest.len(), self.rows, "one rest position per weights row");
+        moves.apply(&self.values, rest)
+    }
 }
 
 #[cfg(test)]

@@ -284,7 +284,10 @@ const SOMIGLIANA: FamilySpec = FamilySpec {
     name: "Somigliana",
     summary: "Somigliana coordinates: elasticity-based, a 3×3 block per cage vertex and triangle; not positive",
     parameter: Some(super::somigliana::POISSON_RATIO_SETTING),
-    deform_parameters: &[super::somigliana::BULGING_SETTING],
+    deform_parameters: &[
+        super::somigliana::BULGING_SETTING,
+        super::somigliana::LOCAL_BLEND_SETTING,
+    ],
     columns: ColumnLayout::BlocksPerVertexThenTriangle,
     positive_inside: false,
     outside_policy: "vertices outside the cage (or on it) get MVC weights (the triangle's barycentrics \

@@ -26,6 +26,7 @@
 
 pub mod bbw;
 mod bind_options;
+mod column_moves;
 pub mod cubemap;
 pub mod dtype;
 pub mod exact_pmvc;
@@ -49,6 +50,7 @@ mod weights_id;
 pub use crate::geometry::QuadSplit;
 use crate::geometry::{Cage, PointClass};
 pub use bind_options::BindOptions;
+pub use column_moves::ColumnMoves;
 pub use dtype::{Dtype, DtypeError, WeightValue, WeightsF64};
 pub use family::{
     FamilySpec, Method, NamedValue, Parameter, ParameterError, ParameterSpec, QuadSupport,
@@ -129,6 +131,14 @@ impl Weights {
         dtype::displaced(&self.values, rest, moves)
     }
 
+    /// `rest` moved by `moves` ([`ColumnMoves`]: linear or normalised), one per
+    /// column, accumulated in f64.
+    pub fn apply_moves(&self, rest: &[DVec3], moves: &ColumnMoves) -> Vec<DVec3> {
+        assert_eq!(moves.len(), self.cols, "one move per weights column");
+        assert_eq!(rest.len(), self.rows, "one rest position per weights row");
+        moves.apply(&self.values, rest)
+    }
+
     /// Smallest weight in the matrix; infinity for an empty one.
     pub fn min(&self) -> f32 {
         self.values.iter().copied().fold(f32::INFINITY, f32::min)
@@ -169,6 +179,14 @@ impl AnyWeights {
         match self {
             AnyWeights::F32(weights) => weights.apply_displacements(rest, moves),
             AnyWeights::F64(weights) => weights.apply_displacements(rest, moves),
+        }
+    }
+
+    /// [`Weights::apply_moves`], whatever the dtype.
+    pub fn apply_moves(&self, rest: &[DVec3], moves: &ColumnMoves) -> Vec<DVec3> {
+        match self {
+            AnyWeights::F32(weights) => weights.apply_moves(rest, moves),
+            AnyWeights::F64(weights) => weights.apply_moves(rest, moves),
         }
     }
 }

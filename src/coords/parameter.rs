@@ -208,14 +208,18 @@ pub enum Parameter {
     /// The bulging γ of a deformation, in hundredths (Somigliana coordinates):
     /// read when the weights deform a pose, not when they are bound.
     Bulging,
+    /// The local/global blend of a deformation, in hundredths (Somigliana
+    /// coordinates): read when the weights deform a pose.
+    LocalBlend,
 }
 
 impl Parameter {
-    pub const ALL: [Parameter; 4] = [
+    pub const ALL: [Parameter; 5] = [
         Parameter::Resolution,
         Parameter::Grid,
         Parameter::PoissonRatio,
         Parameter::Bulging,
+        Parameter::LocalBlend,
     ];
 
     /// The name saved files give it.
@@ -225,6 +229,7 @@ impl Parameter {
             Parameter::Grid => "grid",
             Parameter::PoissonRatio => "poisson_ratio",
             Parameter::Bulging => "bulging",
+            Parameter::LocalBlend => "local_blend",
         }
     }
 
@@ -235,6 +240,7 @@ impl Parameter {
             Parameter::Grid => &GRID,
             Parameter::PoissonRatio => &super::somigliana::POISSON_RATIO_SETTING,
             Parameter::Bulging => &super::somigliana::BULGING_SETTING,
+            Parameter::LocalBlend => &super::somigliana::LOCAL_BLEND_SETTING,
         }
     }
 

@@ -107,7 +107,7 @@ pub(super) fn bind_options(
             Parameter::Grid => grid,
             Parameter::PoissonRatio => poisson_ratio,
             // Read when deforming (`deform(..., bulging=)`), not binding.
-            Parameter::Bulging => None,
+            Parameter::Bulging | Parameter::LocalBlend => None,
         };
         if let Some(given) = given.filter(|value| !value.is_none()) {
             options.set(spec.key, parameter_value(spec.key, given)?);

@@ -437,8 +437,11 @@ fn bind_error(cause: &BindError) -> PyErr {
 /// libigl's ``(V, F)`` pair. Each point moves by Σₖ wₖ dₖ, dₖ the move of
 /// column k's vector (a cage vertex's position, or for Green coordinates a
 /// triangle's scaled normal), summed in float64. ``bulging`` (Somigliana
-/// coordinates' γ, 0 to 10, default 0) is read when deforming, so it may be
-/// given with ``weights``; the other families ignore it.
+/// coordinates' γ, 0 to 10, default 0) and ``local_blend`` (their local/global
+/// blend, 0 to 1, default 0: the global variant) are read when deforming, so
+/// they may be given with ``weights``; the other families ignore them. With a
+/// local blend the blocks of each point are normalised by the blended frames
+/// (``families()`` lists each family's ``deform_parameters``).
 #[pyfunction]
 #[pyo3(
     signature = (points, cage, deformed_vertices, weights=None, method=None, **parameters),
@@ -453,10 +456,13 @@ pub(super) fn deform<'py>(
     method: Option<Bound<'py, PyAny>>,
     parameters: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    /// Read when deforming, so given with weights too.
-    const DEFORMING: [&str; 2] = ["strict", "bulging"];
-    const BINDING: [&str; 10] = [
-        "bulging",
+    // Read when deforming, so given with weights too: `strict` and every
+    // family's deformation settings (Somigliana's bulging and local blend).
+    let deform_settings = || (Parameter::ALL.into_iter()).filter(|p| p.read_when_deforming());
+    let deforming: Vec<&str> = std::iter::once("strict")
+        .chain(deform_settings().map(Parameter::id))
+        .collect();
+    const BINDING: [&str; 9] = [
         "resolution",
         "grid",
         "poisson_ratio",
@@ -485,16 +491,18 @@ pub(super) fn deform<'py>(
     if let Some(given) = parameters {
         for key in given.keys() {
             let key: String = key.extract()?;
-            if !BINDING.contains(&key.as_str()) {
+            let deforms = deforming.contains(&key.as_str());
+            if !deforms && !BINDING.contains(&key.as_str()) {
+                let known: Vec<&str> = deforming[1..].iter().chain(&BINDING).copied().collect();
                 return Err(error(
                     Kind::Parameter,
                     format!(
                         "deform: unknown parameter \"{key}\" (known: {})",
-                        BINDING.join(", ")
+                        known.join(", ")
                     ),
                 ));
             }
-            if weights.is_some() && !DEFORMING.contains(&key.as_str()) {
+            if weights.is_some() && !deforms {
                 return Err(error(
                     Kind::Parameter,
                     format!("deform: \"{key}\" is for binding, but weights were given"),
@@ -562,9 +570,11 @@ pub(super) fn deform<'py>(
         }
     };
     let mut deform_values = Vec::new();
-    if let Some(given) = parameter("bulging")?.filter(|value| !value.is_none()) {
-        let value = super::bind_arguments::parameter_value(Parameter::Bulging, &given)?;
-        deform_values.push((Parameter::Bulging, value));
+    for setting in deform_settings() {
+        if let Some(given) = parameter(setting.id())?.filter(|value| !value.is_none()) {
+            let value = super::bind_arguments::parameter_value(setting, &given)?;
+            deform_values.push((setting, value));
+        }
     }
     let deformed = weights
         .get()

@@ -191,7 +191,7 @@ impl PyWeights {
     /// `points` moved as `pmvc deform --weights` moves them, after its checks:
     /// the weights were bound for these points and this cage (the metadata's
     /// counts and digests), and the matrix is sound. `deform` holds the
-    /// deformation settings given (Somigliana's bulging), checked by their specs.
+    /// deformation settings given (Somigliana's bulging and local blend), checked by their specs.
     pub(super) fn apply(
         &self,
         py: Python<'_>,
@@ -209,8 +209,8 @@ impl PyWeights {
         for &(parameter, value) in deform {
             options.set(parameter, value);
         }
-        let moves = options.column_displacements(&cage.cage, pose);
-        Ok(py.detach(|| weights.apply_displacements(points, &moves)))
+        let moves = options.column_moves(&cage.cage, pose);
+        Ok(py.detach(|| weights.apply_moves(points, &moves)))
     }
 }
 

@@ -59,8 +59,13 @@ pub struct FrameUniform {
     ///
     /// [`ColumnLayout::columns_per_element`]: crate::coords::family::ColumnLayout::columns_per_element
     pub vertex_column_stride: u32,
+    /// Columns whose matrices the shown family's blend solves with (a
+    /// normalised [`crate::coords::ColumnMoves`]); 0 for a linear move.
+    pub matrix_columns: u32,
+    /// The same for the compared family.
+    pub other_matrix_columns: u32,
     /// Rounds the size up to WGSL's 16-byte struct alignment.
-    pub _padding: [u32; 1],
+    pub _padding: [u32; 3],
 }
 
 /// Texels per row of the image [`super::drawn`] draws the deformed positions
@@ -158,15 +163,36 @@ pub fn buffer_with<T: bytemuck::Pod>(
     })
 }
 
+/// A family's column moves as the shader reads them
+/// ([`crate::coords::ColumnMoves`], about the scene origin).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShaderMoves {
+    /// One per column: its vector (its displacement when linear).
+    pub vectors: Vec<[f32; 4]>,
+    /// Three per column, the columns of its matrix; empty when linear.
+    pub matrices: Vec<[f32; 4]>,
+}
+
+impl ShaderMoves {
+    /// Columns carrying matrices.
+    pub fn matrix_columns(&self) -> u32 {
+        (self.matrices.len() / 3) as u32
+    }
+}
+
 /// One family's weights on the GPU, in chunks of whole rows, and how far each of
 /// its columns' vectors moved in the current pose (`Method::column_displacements`).
 pub struct WeightSlot {
     pub chunks: Vec<wgpu::Buffer>,
     pub split: ChunkSplit,
-    /// One `vec4` per column, then (smooth shading) one normal per mesh vertex:
-    /// the normals share the buffer so that drawing needs no storage binding
-    /// more than devices with the default 8 per stage have.
+    /// One `vec4` per column, then (smooth shading) one normal per mesh vertex,
+    /// then room for three `vec4`s per column (the columns of each column's
+    /// matrix, for a normalised move): the normals and matrices share the
+    /// buffer so that drawing needs no storage binding more than devices with
+    /// the default 8 per stage have.
     pub displacements: wgpu::Buffer,
+    /// Columns whose matrices the current pose's moves carry (0: linear).
+    pub matrix_columns: u32,
     /// The first [`UNIFORM_COLUMNS`] displacements again, where the blend reads
     /// them ([`UNIFORM_DISPLACEMENT_BYTES`], zero past the columns).
     pub uniform_displacements: wgpu::Buffer,
@@ -308,17 +334,35 @@ impl SceneGpu {
         queue.write_buffer(&slot.uniform_displacements, 0, bytemuck::cast_slice(head));
     }
 
-    /// The column displacements of weights bound with `bound` for the current
-    /// pose and deformation settings, as the shader reads them.
-    pub fn displacements_of(&self, bound: &BindOptions) -> Vec<[f32; 4]> {
+    /// The column moves of weights bound with `bound` for the current pose
+    /// and deformation settings, as the shader reads them: about the scene
+    /// origin, as the rest positions are.
+    pub fn displacements_of(&self, bound: &BindOptions) -> ShaderMoves {
         let mut options = *bound;
         for &(parameter, value) in &self.deform {
             options.set(parameter, value);
         }
-        points_f32(
-            &options.column_displacements(&self.rest_cage, &self.pose),
-            0.0,
-        )
+        let moves =
+            (options.column_moves(&self.rest_cage, &self.pose)).about(self.origin.world_from_scene);
+        let matrices = moves.matrices().iter().flat_map(|m| {
+            [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x as f32, c.y as f32, c.z as f32, 0.0])
+        });
+        ShaderMoves {
+            vectors: points_f32(moves.vectors(), 0.0),
+            matrices: matrices.collect(),
+        }
+    }
+
+    /// Write `moves` (as [`Self::displacements_of`] gives them) to `slot`'s
+    /// buffers: the vectors first, the matrices after the vertex normals.
+    pub fn write_moves(&self, queue: &wgpu::Queue, slot: &WeightSlot, moves: &ShaderMoves) {
+        queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&moves.vectors));
+        if !moves.matrices.is_empty() {
+            let offset = u64::from(slot.columns + self.vertex_count) * 16;
+            let bytes = bytemuck::cast_slice(&moves.matrices);
+            queue.write_buffer(&slot.displacements, offset, bytes);
+        }
+        Self::write_uniform_displacements(queue, slot, &moves.vectors);
     }
 
     /// The slot of weights `id`, if bound.

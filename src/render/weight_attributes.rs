@@ -29,12 +29,16 @@ pub struct AttributeBlend {
     columns: u32,
     /// Vertex attributes used, each holding up to four columns.
     attributes: u32,
+    /// Whether the family's columns may carry matrices (a normalised
+    /// [`crate::coords::ColumnMoves`]), whose blend then follows the row's.
+    matrices: bool,
 }
 
 impl AttributeBlend {
     /// The attribute reading of a `columns`-column matrix held in `chunks`
-    /// buffers on a device with `limits`; `None` where only storage can be read.
-    pub fn new(limits: &wgpu::Limits, columns: u32, chunks: usize) -> Option<Self> {
+    /// buffers on a device with `limits`, for a family whose columns may carry
+    /// matrices or not; `None` where only storage can be read.
+    pub fn new(limits: &wgpu::Limits, columns: u32, chunks: usize, matrices: bool) -> Option<Self> {
         let stride = u64::from(columns) * 4;
         if chunks != 1 || stride > u64::from(limits.max_vertex_buffer_array_stride) {
             return None;
@@ -47,6 +51,7 @@ impl AttributeBlend {
         (attributes > 0).then_some(Self {
             columns,
             attributes,
+            matrices,
         })
     }
 
@@ -122,7 +127,9 @@ impl AttributeBlend {
         let first = self.attribute_columns();
         // Without columns past the attributes the storage loops are left out
         // altogether: lavapipe runs every case of their `switch` over the chunks.
-        let position = if first == self.columns {
+        let position = if first == self.columns && self.matrices {
+            "shown_normalised(vertex, rest[vertex].xyz + attribute_blend(weights))".to_owned()
+        } else if first == self.columns {
             "rest[vertex].xyz + attribute_blend(weights)".to_owned()
         } else {
             format!("deformed_position_after(vertex, {first}u, attribute_blend(weights))")
@@ -157,7 +164,7 @@ mod tests {
 
     #[test]
     fn a_row_fills_the_attributes_it_needs_and_the_last_one_only_partly() {
-        let blend = AttributeBlend::new(&limits(32, 2048), 118, 1).expect("fits");
+        let blend = AttributeBlend::new(&limits(32, 2048), 118, 1, false).expect("fits");
         assert_eq!(blend.attribute_columns(), 118);
         let attributes = blend.vertex_attributes();
         assert_eq!(attributes.len(), 30);
@@ -172,7 +179,7 @@ mod tests {
 
     #[test]
     fn columns_past_the_devices_attributes_are_left_to_storage() {
-        let blend = AttributeBlend::new(&limits(16, 2048), 162, 1).expect("fits");
+        let blend = AttributeBlend::new(&limits(16, 2048), 162, 1, false).expect("fits");
         assert_eq!(blend.attribute_columns(), 64);
         assert!(blend
             .wgsl()
@@ -181,10 +188,10 @@ mod tests {
 
     #[test]
     fn split_or_too_wide_matrices_are_read_from_storage_alone() {
-        assert_eq!(AttributeBlend::new(&limits(32, 2048), 118, 2), None);
-        assert_eq!(AttributeBlend::new(&limits(32, 2048), 513, 1), None);
-        assert!(AttributeBlend::new(&limits(32, 2048), 512, 1).is_some());
-        assert_eq!(AttributeBlend::new(&limits(0, 2048), 118, 1), None);
-        assert_eq!(AttributeBlend::new(&limits(32, 2048), 0, 1), None);
+        assert_eq!(AttributeBlend::new(&limits(32, 2048), 118, 2, false), None);
+        assert_eq!(AttributeBlend::new(&limits(32, 2048), 513, 1, false), None);
+        assert!(AttributeBlend::new(&limits(32, 2048), 512, 1, false).is_some());
+        assert_eq!(AttributeBlend::new(&limits(0, 2048), 118, 1, false), None);
+        assert_eq!(AttributeBlend::new(&limits(32, 2048), 0, 1, false), None);
     }
 }

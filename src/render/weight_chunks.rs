@@ -166,6 +166,26 @@ pub fn wgsl(slots: u32) -> String {
         });
         out.push_str("    return moved;\n}\n");
     }
+    // Σ_c W[row, c] · M_c over a row's first `columns` columns, M_c the three
+    // `vec4`s from `base + 3c` (columns of the matrix): the normalised moves of
+    // coords::ColumnMoves; `columns` is 0 for a linear family, so the loop
+    // costs nothing there.
+    for (name, displacements) in [
+        ("blend_matrix_row", "displacements"),
+        ("blend_other_matrix_row", "other_displacements"),
+    ] {
+        let _ = writeln!(
+            out,
+            "\nfn {name}(chunk: u32, start: u32, columns: u32, base: u32) -> mat3x3<f32> {{\n    var m0 = vec3<f32>(0.0);\n    var m1 = vec3<f32>(0.0);\n    var m2 = vec3<f32>(0.0);"
+        );
+        switch(&mut out, &|slot| {
+            format!(
+                "for (var c = 0u; c < columns; c++) {{ let w = weight_chunk_{slot}[start + c]; let at = base + 3u * c; \
+                 m0 += w * {displacements}[at].xyz; m1 += w * {displacements}[at + 1u].xyz; m2 += w * {displacements}[at + 2u].xyz; }}"
+            )
+        });
+        out.push_str("    return mat3x3<f32>(m0, m1, m2);\n}\n");
+    }
     out.push_str(
         "\nfn lowest_in_row(chunk: u32, start: u32, columns: u32, stride: u32) -> f32 {\n    var lowest = 3.4e38;\n",
     );

@@ -84,7 +84,9 @@ fn bind_writes_metadata_and_row_classes_for_every_family() {
                     // A decimal parameter is written as the decimal.
                     Parameter::PoissonRatio => (serde_json::json!(0.3), "0.3"),
                     // Read when deforming: no family binds with it.
-                    Parameter::Bulging => unreachable!("bulging is no bind parameter"),
+                    Parameter::Bulging | Parameter::LocalBlend => {
+                        unreachable!("{spec:?} is no bind parameter")
+                    }
                 };
                 let mut parameter = serde_json::Map::new();
                 parameter.insert(spec.key.id().to_owned(), value);

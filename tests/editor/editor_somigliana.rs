@@ -2,7 +2,8 @@
 //! blend of their block columns (vectors recomputed per pose from the fitted
 //! similarity) following a similarity of the cage and drawing what the CPU
 //! computes for a pulled finger, and a vertex's heatmap showing its block's
-//! x-from-x entry.
+//! x-from-x entry; the deformation settings (bulging, the local blend, whose
+//! normalised columns the shader solves with) chosen in the side panel.
 
 use crate::common;
 
@@ -102,6 +103,29 @@ fn somigliana_binds_follows_a_similarity_and_shows_a_block_entry() {
     }
 }
 
+/// Pick `choice` in the side panel's list `label`, which shows `current`;
+/// then what the GPU draws and what the CPU computes.
+fn choose_setting(
+    harness: &mut Harness<'static, pmvc::app::EditorApp>,
+    label: &str,
+    current: &str,
+    choice: &str,
+) -> (Vec<glam::Vec3>, Vec<glam::Vec3>) {
+    let list = harness.get_by_role_and_label(egui::accesskit::Role::ComboBox, label);
+    assert_eq!(list.value().as_deref(), Some(current));
+    list.click_accesskit();
+    harness.run_steps(2);
+    harness.get_by_label(choice).click_accesskit();
+    harness.run_steps(3);
+    let app = harness.state();
+    let drawn = app.read_back_deformed().unwrap().unwrap();
+    let on_cpu = (app.document().deformed_positions(Method::Somigliana))
+        .iter()
+        .map(|p| p.as_vec3())
+        .collect();
+    (drawn, on_cpu)
+}
+
 /// The side panel's bulging γ: chosen in its list, it moves the drawn mesh to
 /// the CPU's bulged deformation with the same weights (nothing is bound
 /// again), is one undo step, and is saved with the session.
@@ -126,21 +150,11 @@ fn bulging_is_chosen_in_the_side_panel_and_undone() {
     harness.run_steps(2);
     let plain = harness.state().read_back_deformed().unwrap().unwrap();
 
-    let bulging = harness.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Bulging γ");
-    assert_eq!(bulging.value().as_deref(), Some("γ 0"));
-    bulging.click_accesskit();
-    harness.run_steps(2);
-    harness.get_by_label("γ 4").click_accesskit();
-    harness.run_steps(3);
+    let (drawn, on_cpu) = choose_setting(&mut harness, "Bulging γ", "γ 0", "γ 4");
     let app = harness.state();
     assert_eq!(app.document().deform_value(Parameter::Bulging), 400);
     let same = app.document().weights(Method::Somigliana).unwrap();
     assert!(std::sync::Arc::ptr_eq(same, &weights), "bound again");
-    let drawn = app.read_back_deformed().unwrap().unwrap();
-    let on_cpu: Vec<glam::Vec3> = (app.document().deformed_positions(Method::Somigliana))
-        .iter()
-        .map(|p| p.as_vec3())
-        .collect();
     let diagonal = cage.diagonal() as f32;
     assert!(
         max_distance(&drawn, &on_cpu) < 1e-4 * diagonal,
@@ -170,5 +184,62 @@ fn bulging_is_chosen_in_the_side_panel_and_undone() {
     assert!(
         max_distance(&drawn, &plain) < 1e-5 * diagonal,
         "undo left the bulge"
+    );
+}
+
+/// The side panel's local blend: the vertex shader solves with the columns'
+/// blended matrices and draws what the CPU computes, with the same weights;
+/// back at 0 it draws the global variant again.
+#[test]
+fn a_local_blend_is_drawn_as_the_cpu_computes_it() {
+    let Some(mut harness) = somigliana_shown() else {
+        return;
+    };
+    let weights = (harness.state().document())
+        .weights(Method::Somigliana)
+        .unwrap()
+        .clone();
+    let cage = harness.state().document().cage().clone();
+    // Two finger tips pulled sideways and up: their triangles turn.
+    for vertex in [12, 32] {
+        let moved = cage.positions()[vertex] + DVec3::new(1.0, 0.8, 0.0);
+        harness.state_mut().set_handle_position(vertex, moved);
+    }
+    harness.run_steps(2);
+    let plain = harness.state().read_back_deformed().unwrap().unwrap();
+
+    let (drawn, on_cpu) = choose_setting(
+        &mut harness,
+        "Local blend",
+        "local blend 0",
+        "local blend 1",
+    );
+    let app = harness.state();
+    assert_eq!(app.document().deform_value(Parameter::LocalBlend), 100);
+    let same = app.document().weights(Method::Somigliana).unwrap();
+    assert!(std::sync::Arc::ptr_eq(same, &weights), "bound again");
+    let diagonal = cage.diagonal() as f32;
+    let gap = max_distance(&drawn, &on_cpu);
+    assert!(
+        gap < 1e-4 * diagonal,
+        "blended: GPU and CPU differ by {gap}"
+    );
+    let change = max_distance(&drawn, &plain);
+    println!(
+        "local blend 1 moved the mesh by {} of the diagonal",
+        change / diagonal
+    );
+    assert!(
+        change > 1e-3 * diagonal,
+        "the blend moved nothing: {change}"
+    );
+    assert_eq!(app.undo_label().as_deref(), Some("Local blend 1"));
+
+    harness.state_mut().undo();
+    harness.run_steps(3);
+    let drawn = harness.state().read_back_deformed().unwrap().unwrap();
+    assert!(
+        max_distance(&drawn, &plain) < 1e-5 * diagonal,
+        "undo left the blend"
     );
 }

@@ -74,9 +74,11 @@ fn the_mesh_shader_reading_weights_as_vertex_attributes_validates() {
         max_vertex_attributes: 32,
         ..Default::default()
     };
-    // Ogre's 118 columns, all in attributes; a 162-vertex cage's, past them; one column.
-    for columns in [118, 162, 1] {
-        let blend = AttributeBlend::new(&limits, columns, 1).expect("fits");
+    // Ogre's 118 columns, all in attributes; a 162-vertex cage's, past them; one
+    // column; and a family whose columns carry matrices (Somigliana's 72 on a
+    // tetrahedron), all in attributes.
+    for (columns, matrices) in [(118, false), (162, false), (1, false), (72, true)] {
+        let blend = AttributeBlend::new(&limits, columns, 1, matrices).expect("fits");
         let source = pmvc::render::mesh::shader_source_for(16, Some(&blend));
         let name = format!("render_mesh.wgsl with {columns} columns as attributes");
         let module = validate(&name, &source).unwrap_or_else(|error| panic!("{error}"));

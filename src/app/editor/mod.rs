@@ -236,8 +236,7 @@ impl EditorApp {
         if let Some(pose) = &options.pose {
             app.load_pose(pose);
         }
-        if let Some(value) = options.bulging {
-            let parameter = crate::coords::Parameter::Bulging;
+        for &(parameter, value) in &options.deform {
             app.apply(Command::SetDeformParameter { parameter, value });
         }
         app.report_heatmap_out_of_range(&options.view);

@@ -298,10 +298,8 @@ impl Document {
             Some(set) => {
                 // On the cage the set was bound on: Green's columns differ with
                 // the quads as patches (QGC) or split.
-                let moves =
-                    (self.deform_options(set.options)).column_displacements(&self.cage, pose);
-                set.weights
-                    .apply_displacements(&self.mesh.positions, &moves)
+                let moves = (self.deform_options(set.options)).column_moves(&self.cage, pose);
+                set.weights.apply_moves(&self.mesh.positions, &moves)
             }
             None => self.mesh.positions.clone(),
         }

@@ -1,13 +1,19 @@
-//! The paper's local/global blend, on the CPU: rotations and stretches per cage
-//! triangle and vertex, blended by `blend` between the fitted similarity's (0,
-//! the global variant) and each triangle's own (1, the local variant).
+//! The paper's local/global blend: rotations and stretches per cage triangle
+//! and vertex, blended by `blend` between the fitted similarity's (0, the
+//! global variant) and each triangle's own (1, the local variant).
 //!
 //! - Triangle f's own rotation `r_f` takes its rest frame (first edge, the
 //!   normal cross it, the normal) to its posed frame; its blended rotation is
-//!   `R_f = R cay(b cay(Rᵀ r_f))`, cay the Cayley map `(I − M)(I + M)⁻¹`, which
-//!   takes a rotation to a skew matrix and back.
-//! - Vertex v's rotation averages its triangles' Cayley parameters, weighted by
-//!   rest area: `Rᵥ = R cay(Σ A_f cay(Rᵀ R_f) / Σ A_f)`.
+//!   `R_f = R exp(b log(Rᵀ r_f))`, the rotation vector scaled by the blend
+//!   (along the geodesic from R).
+//! - Vertex v's rotation averages its triangles' rotation vectors, weighted by
+//!   rest area: `Rᵥ = R exp(Σ A_f log(Rᵀ R_f) / Σ A_f)`.
+//!
+//! The authors' code blends and averages Cayley parameters `(I − M)(I +
+//! M)⁻¹` instead: the same at 0 and 1 and to second order in the angle, but
+//! unbounded towards a half turn, so that one triangle folded over by a pose
+//! (a finger tip corner pulled past its neighbour) sent whole fingers of the
+//! comb off by hundreds of cage sizes; rotation vectors stay within π.
 //! - Triangle f's stretch along the surface is `b σ̄_f + (1 − b) s`, σ̄_f the mean
 //!   singular value of its tangent map unrotated by R_f (`½ √(‖T‖² + 2 A'/A)`,
 //!   the area ratio for det T); along the normal, as
@@ -16,14 +22,14 @@
 //! - The point is `x' = c' + A⁻¹ (Σ Rᵥ Bᵥ Rᵥᵀ (vᵥ' − c') + Σ t_f R_f F_f n_f)`
 //!   with `A = Σ Rᵥ Bᵥ Rᵥᵀ`, which is I when every Rᵥ is R.
 //!
-//! Not a family setting yet: A depends on the point, so this is not a weighted
-//! sum of per-column vectors, the form the vertex shader and every other
-//! consumer apply.
+//! A depends on the point, so this is no weighted sum of per-column vectors:
+//! `columns::column_moves` writes it in the normalised form of
+//! [`crate::coords::ColumnMoves`], which every consumer applies.
 
 use super::bulging::{swept_volume, without_net_force_along};
 use super::{check_positions, fit, validate_bulging, SomiglianaBlocks, SomiglianaError};
 use crate::geometry::Cage;
-use glam::{DMat2, DMat3, DVec2, DVec3};
+use glam::{DMat2, DMat3, DQuat, DVec2, DVec3};
 use rayon::prelude::*;
 
 /// The largest blend: 1, the local variant.
@@ -40,9 +46,23 @@ pub struct BlendedPose {
     pub centre: DVec3,
 }
 
-/// `(I − M)(I + M)⁻¹`: a rotation (no half turn) to a skew matrix and back.
-fn cayley(m: DMat3) -> DMat3 {
-    (DMat3::IDENTITY - m) * (DMat3::IDENTITY + m).inverse()
+/// A rotation's rotation vector (axis times angle, the angle 0 to π): the
+/// logarithm, bounded where the authors' Cayley map `(I − R)(I + R)⁻¹` grows
+/// without bound towards a half turn, so that one folded triangle cannot
+/// swamp its vertices' averages.
+fn rotation_vector(rotation: DMat3) -> DVec3 {
+    let quat = DQuat::from_mat3(&rotation).normalize();
+    let quat = if quat.w < 0.0 { -quat } else { quat };
+    let sine = quat.xyz().length();
+    if sine < 1e-300 {
+        return DVec3::ZERO;
+    }
+    quat.xyz() * (2.0 * sine.atan2(quat.w) / sine)
+}
+
+/// The rotation of a rotation vector: the exponential.
+fn rotation_of(vector: DVec3) -> DMat3 {
+    DMat3::from_quat(DQuat::from_scaled_axis(vector))
 }
 
 /// A triangle's frame: its first edge, the normal cross it, the normal.
@@ -88,7 +108,7 @@ pub fn blended_pose(
         let face_rotation = if blend == 0.0 {
             rotation
         } else {
-            rotation * cayley(cayley(rotation.transpose() * own) * blend)
+            rotation * rotation_of(rotation_vector(rotation.transpose() * own) * blend)
         };
         // The tangent map with the triangle's rotation taken out.
         let unrotated = |p: DVec3| face_rotation.transpose() * p;
@@ -125,10 +145,10 @@ pub fn blended_pose(
     if bulging != 0.0 || blend != 0.0 {
         without_net_force_along(&areas, &directions, &mut tractions);
     }
-    let mut parameters = vec![DMat3::ZERO; rest.vertex_count()];
+    let mut parameters = vec![DVec3::ZERO; rest.vertex_count()];
     let mut weights = vec![0.0; rest.vertex_count()];
     for ((corners, face_rotation), &area) in triangles.iter().zip(&face_rotations).zip(&areas) {
-        let parameter = cayley(rotation.transpose() * *face_rotation);
+        let parameter = rotation_vector(rotation.transpose() * *face_rotation);
         for &v in corners {
             parameters[v as usize] += parameter * area;
             weights[v as usize] += area;
@@ -139,7 +159,7 @@ pub fn blended_pose(
         .zip(&weights)
         .map(|(&sum, &weight)| match blend == 0.0 || weight <= 0.0 {
             true => rotation,
-            false => rotation * cayley(sum * (1.0 / weight)),
+            false => rotation * rotation_of(sum / weight),
         })
         .collect();
     BlendedPose {

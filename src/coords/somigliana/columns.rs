@@ -8,7 +8,8 @@
 //! [`super::deform`] about c' (inside, where Σ Bᵥ = I).
 
 use super::triangle::{Material, TriangleFrame};
-use super::{bulging, check_positions, fit, validate_poisson_ratio, SomiglianaError};
+use super::{blend, bulging, check_positions, fit, validate_poisson_ratio, SomiglianaError};
+use crate::coords::ColumnMoves;
 use crate::geometry::Cage;
 use glam::{DMat3, DVec3};
 
@@ -96,7 +97,7 @@ pub fn identity_blocks(lambda: &[f64], out: &mut [f64]) {
 /// `(vᵥ − c)_b e_a` for a vertex's (less nothing for a face's), where
 /// `centred[v]` is `Rᵀ (vᵥ' − c')` and `shift` is `c' − c`. Centred, so a cage
 /// far from the origin loses no digits to the weights' f32 rounding.
-fn column_moves(
+fn global_columns(
     rest: &Cage,
     rotation: DMat3,
     tractions: &[f64],
@@ -141,7 +142,7 @@ pub fn rest_columns(rest: &Cage) -> Vec<DVec3> {
         }
     }
     let unit = vec![1.0; rest.triangle_count()];
-    let faces = column_moves(rest, DMat3::IDENTITY, &unit, &[], DVec3::ZERO);
+    let faces = global_columns(rest, DMat3::IDENTITY, &unit, &[], DVec3::ZERO);
     columns.extend(faces);
     columns
 }
@@ -166,7 +167,7 @@ pub fn column_displacements(
         .collect();
     let shift = centre - centroid(rest.positions());
     let tractions = bulging::face_tractions(rest, pose, &similarity, poisson_ratio, bulging);
-    let mut moves = column_moves(rest, rotation, &tractions, &centred, shift);
+    let mut moves = global_columns(rest, rotation, &tractions, &centred, shift);
     // The faces' vectors less their rest vectors.
     let vertex_columns = BLOCK_COLUMNS * rest.vertex_count();
     let rested = rest_columns(rest);
@@ -177,4 +178,59 @@ pub fn column_displacements(
         *moved -= *rested;
     }
     moves
+}
+
+/// How each column moves in `pose` with the local blend `local_blend` (0: the
+/// global variant, linear: [`column_displacements`]; past 0 the normalised
+/// form of [`ColumnMoves`], about the rest cage's centroid o), for weights bound
+/// at `poisson_ratio` and deformed with bulging γ `bulging`. With Rᵥ, R_f and
+/// t_f the blended rotations and tractions (`blend.rs`), column (v, a, b) has
+/// the matrix `(Rᵥ e_a)(Rᵥ e_b)ᵀ − e_a e_bᵀ` and the vector `(Rᵥ e_a)(Rᵥ e_b)·(vᵥ'
+/// − o) − (vᵥ − o)_b e_a`, column (f, a, b) no matrix and the vector `t_f (n_f)_b
+/// R_f e_a − (n_f)_b e_a`; their blend is `x' = o + A⁻¹ (Σ Rᵥ Bᵥ Rᵥᵀ (vᵥ' − o) + Σ
+/// t_f R_f F_f n_f)` with `A = Σ Rᵥ Bᵥ Rᵥᵀ` ([`super::deform_blended`]).
+pub fn column_moves(
+    rest: &Cage,
+    pose: &[DVec3],
+    poisson_ratio: f64,
+    bulging: f64,
+    local_blend: f64,
+) -> ColumnMoves {
+    if local_blend <= 0.0 || !local_blend.is_finite() || check_positions(rest, pose).is_err() {
+        return ColumnMoves::linear(column_displacements(rest, pose, poisson_ratio, bulging));
+    }
+    let blend = local_blend.min(blend::MAX_BLEND);
+    let posed = blend::blended_pose(rest, pose, poisson_ratio, bulging, blend);
+    let origin = centroid(rest.positions());
+    let outer = |u: DVec3, w: DVec3| DMat3::from_cols(u * w.x, u * w.y, u * w.z);
+    let count = column_count(rest);
+    let (mut vectors, mut matrices) = (Vec::with_capacity(count), Vec::with_capacity(count));
+    let vertices = (rest.positions().iter().zip(pose)).zip(&posed.vertex_rotations);
+    for ((&before, &after), rotation) in vertices {
+        for a in 0..3 {
+            for b in 0..3 {
+                let (turned_a, turned_b) = (rotation.col(a), rotation.col(b));
+                let (axis_a, axis_b) = (DVec3::AXES[a], DVec3::AXES[b]);
+                matrices.push(outer(turned_a, turned_b) - outer(axis_a, axis_b));
+                vectors
+                    .push(turned_a * turned_b.dot(after - origin) - axis_a * (before - origin)[b]);
+            }
+        }
+    }
+    for (t, (&traction, rotation)) in posed
+        .tractions
+        .iter()
+        .zip(&posed.face_rotations)
+        .enumerate()
+    {
+        let [a, b, c] = rest.triangle(t);
+        let normal = (b - a).cross(c - a).normalize_or_zero();
+        for a in 0..3 {
+            for b in 0..3 {
+                matrices.push(DMat3::ZERO);
+                vectors.push(normal[b] * (traction * rotation.col(a) - DVec3::AXES[a]));
+            }
+        }
+    }
+    ColumnMoves::normalised(origin, vectors, matrices)
 }

@@ -43,9 +43,11 @@
 //! With the bulging term γ (`bulging.rs`), each triangle's traction is its own
 //! t_f instead of s (`s Σ F_f n_f` becomes `Σ t_f F_f n_f`), projected onto zero
 //! net force; a similarity sweeps nothing, so it is still followed exactly.
-//! Left out: the solid-angle measure of bulging, and the local/global blend
-//! (its blend 0), whose per-point normalisation `(Σ Rᵥ Bᵥ Rᵥᵀ)⁻¹` is not a
-//! weighted sum of per-column vectors.
+//! The local/global blend (`blend.rs`, a second deformation setting) turns
+//! each vertex and triangle with its own blended frame and normalises each
+//! point by `(Σ Rᵥ Bᵥ Rᵥᵀ)⁻¹`, which is no weighted sum of per-column vectors:
+//! its columns carry matrices too ([`crate::coords::ColumnMoves`]). Left out:
+//! the solid-angle measure of bulging.
 //!
 //! # Evaluation
 //!
@@ -86,8 +88,8 @@ mod tests_schemes;
 use crate::geometry::Cage;
 pub use blend::{blended_pose, deform_blended, BlendedPose, MAX_BLEND};
 pub use columns::{
-    column_count, column_displacements, identity_blocks, rest_columns, SomiglianaCage,
-    BLOCK_COLUMNS,
+    column_count, column_displacements, column_moves, identity_blocks, rest_columns,
+    SomiglianaCage, BLOCK_COLUMNS,
 };
 pub use fit::SimilarityFit;
 use glam::{DMat3, DVec3};
@@ -143,6 +145,24 @@ pub const BULGING_SETTING: super::ParameterSpec = super::ParameterSpec {
     max: (MAX_BULGING * 100.0) as u32,
     named: &[],
     format: |value| format!("γ {}", super::family::decimal(value.into(), 100)),
+    scale: 100,
+    zero: 0,
+};
+
+/// The local/global blend of the deformation (`blend.rs`), to a hundredth: 0
+/// (the global variant, the default) to 1 (the local variant: each triangle
+/// and vertex turns and stretches with its own frame). Read when the weights
+/// deform a pose, as bulging is.
+pub const LOCAL_BLEND_SETTING: super::ParameterSpec = super::ParameterSpec {
+    key: super::Parameter::LocalBlend,
+    label: "Local blend",
+    flag: "--local-blend",
+    choices: &[0, 25, 50, 75, 100],
+    default: 0,
+    min: 0,
+    max: (blend::MAX_BLEND * 100.0) as u32,
+    named: &[],
+    format: |value| format!("local blend {}", super::family::decimal(value.into(), 100)),
     scale: 100,
     zero: 0,
 };

@@ -205,8 +205,9 @@ def deform(
     bound first with ``parameters`` (resolution, grid, poisson_ratio, backend,
     progress, triangulate, pmvc_kernel, strict, dtype); with ``weights``,
     ``strict=True`` refuses weights with rows outside the cage. ``bulging``
-    (Somigliana coordinates' γ, 0 to 10, default 0) is read when deforming, so
-    it may be given with ``weights``."""
+    (Somigliana coordinates' γ, 0 to 10, default 0) and ``local_blend`` (their
+    local/global blend, 0 to 1, default 0) are read when deforming, so they may
+    be given with ``weights``."""
     ...
 
 def classify(

@@ -228,12 +228,25 @@ impl ViewportRenderer {
                 .map(|values| buffer_with(device, "weights", values, usage))
                 .collect(),
         };
-        let attributes = AttributeBlend::new(&device.limits(), weights.cols as u32, chunks.len())
-            .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
-        // The columns' displacements, then room for the vertex normals.
-        let mut displacements = scene.displacements_of(&options);
-        let uniform_displacements = uniform_displacements_buffer(device, &displacements);
+        let matrices = options.moves_may_carry_matrices();
+        let attributes = AttributeBlend::new(
+            &device.limits(),
+            weights.cols as u32,
+            chunks.len(),
+            matrices,
+        )
+        .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
+        // The columns' vectors, then room for the vertex normals, then for the
+        // columns' matrices.
+        let moves = scene.displacements_of(&options);
+        let matrix_columns = moves.matrix_columns();
+        let uniform_displacements = uniform_displacements_buffer(device, &moves.vectors);
+        let mut displacements = moves.vectors;
         displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
+        if options.moves_may_carry_matrices() {
+            displacements.extend(&moves.matrices);
+            displacements.resize(4 * weights.cols + scene.vertex_count as usize, [0.0; 4]);
+        }
         let displacements = buffer_with(
             device,
             "column displacements and vertex normals",
@@ -248,6 +261,7 @@ impl ViewportRenderer {
                 chunks,
                 split,
                 displacements,
+                matrix_columns,
                 uniform_displacements,
                 columns: weights.cols as u32,
                 options,
@@ -293,10 +307,18 @@ impl ViewportRenderer {
         scene.pose_revision += 1;
         let scene_pose = scene.origin.points_to_scene(pose, 1.0);
         queue.write_buffer(&scene.cage, 0, bytemuck::cast_slice(&scene_pose));
+        let mut matrix_columns = Vec::new();
         for slot in scene.slots.values().chain(scene.twin_slots.values()) {
-            let displacements = scene.displacements_of(&slot.options);
-            queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&displacements));
-            SceneGpu::write_uniform_displacements(queue, slot, &displacements);
+            let moves = scene.displacements_of(&slot.options);
+            scene.write_moves(queue, slot, &moves);
+            matrix_columns.push(moves.matrix_columns());
+        }
+        let slots = scene
+            .slots
+            .values_mut()
+            .chain(scene.twin_slots.values_mut());
+        for (slot, columns) in slots.zip(matrix_columns) {
+            slot.matrix_columns = columns;
         }
     }
 
@@ -354,7 +376,9 @@ impl ViewportRenderer {
             vertex_columns: cage_vertices * layout.columns_per_element() as u32,
             probe_width: super::scene_gpu::PROBE_WIDTH,
             vertex_column_stride: layout.columns_per_element() as u32,
-            _padding: [0; 1],
+            matrix_columns: shown.map_or(0, |slot| slot.matrix_columns),
+            other_matrix_columns: against.map_or(0, |slot| slot.matrix_columns),
+            _padding: [0; 3],
         }
     }
 
