@@ -9,9 +9,9 @@
 // touches mesh positions per frame. The displacement form is exact at rest for any
 // weights and keeps its precision far from the origin. A family whose columns
 // also carry matrices (coords::ColumnMoves, normalised: Somigliana coordinates
-// with a local blend) has them after the vertex normals, and the blended
-// position is solved with their blend: p' = (I + Σ_k W[i,k] · M_k)⁻¹ (p + Σ_k W[i,k] · d_k). Smooth shading reads each
-// vertex's normal of the deformed mesh, recomputed per pose change; faceted
+// with a local blend) has them after the vectors, and the blended position is
+// solved with their blend: p' = (I + Σ_k W[i,k] · M_k)⁻¹ (p + Σ_k W[i,k] · d_k).
+// Smooth shading reads each vertex's normal of the deformed mesh, recomputed per pose change; faceted
 // shading takes screen-space derivatives of the deformed position.
 //
 // Besides plain shading the mesh can be coloured by a scalar per vertex: the
@@ -26,9 +26,10 @@
 @group(0) @binding(1) var<storage, read> rest: array<vec4<f32>>;
 // xyz: how far each weights column's vector moved from rest, for the method shown.
 @group(0) @binding(2) var<storage, read> displacements: array<vec4<f32>>;
-// After them, smooth shading's vertex normals of the deformed mesh, recomputed
-// per pose change (shaders/render_normals.wgsl); after those, for a normalised
-// family, three `vec4`s per column: the columns of its matrix.
+// After them, for a family whose columns may carry matrices, three `vec4`s per
+// column (the columns of its matrix, coords::ColumnMoves, normalised); last,
+// from `frame.normals_first`, smooth shading's vertex normals of the deformed
+// mesh, recomputed per pose change (shaders/render_normals.wgsl).
 // The same for the compared method (the difference view).
 @group(0) @binding(5) var<storage, read> other_displacements: array<vec4<f32>>;
 // The first UNIFORM_COLUMNS of both again, in uniform buffers: where the blend
@@ -77,8 +78,7 @@ fn deformed_position_after(vertex: u32, first_column: u32, head: vec3<f32>) -> v
 // linear family, whose matrix blend is empty.
 fn shown_normalised(vertex: u32, moved: vec3<f32>) -> vec3<f32> {
     let start = row_start(vertex, frame.rows_per_chunk, frame.columns, 0u);
-    let base = frame.columns + frame.vertex_count;
-    return solved(blend_matrix_row(start.x, start.y, frame.matrix_columns, base), moved);
+    return solved(blend_matrix_row(start.x, start.y, frame.matrix_columns, frame.columns), moved);
 }
 
 // (I + stretch)⁻¹ moved, by the adjugate: with a zero `stretch` every product is
@@ -108,7 +108,7 @@ fn other_deformed_position(vertex: u32) -> vec3<f32> {
     );
     let moved = rest[vertex].xyz
         + blend_other_row(start.x, start.y, 0u, frame.other_columns, vec3<f32>(0.0));
-    let base = frame.other_columns + frame.vertex_count;
+    let base = frame.other_columns;
     let stretch = blend_other_matrix_row(start.x, start.y, frame.other_matrix_columns, base);
     return solved(stretch, moved);
 }
@@ -210,7 +210,7 @@ fn mesh_vertex_at(vertex: u32, scene_position: vec3<f32>) -> MeshVarying {
     }
     out.outside_cage = rest[vertex].w;
     if frame.smooth_shading == 1u && frame.weights_bound == 1u {
-        out.normal = displacements[frame.columns + vertex].xyz;
+        out.normal = displacements[frame.normals_first + vertex].xyz;
     }
     return out;
 }

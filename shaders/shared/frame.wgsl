@@ -43,6 +43,9 @@ struct Frame {
     matrix_columns: u32,
     // The same for the compared family.
     other_matrix_columns: u32,
+    // Where the shown family's vertex normals start in its displacements: after
+    // its columns' vectors and the room for their matrices.
+    normals_first: u32,
 }
 
 const COLOURING_SHADED: u32 = 0u;

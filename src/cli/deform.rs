@@ -216,10 +216,12 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         (Some(path), _) => format!("weights from {}", shown_path(path)),
         (None, _) => format!("{} weights", method_label(options, &input.cage)),
     };
-    // Deformation settings away from their defaults ("γ 2.5").
-    let settings: String = (options.deform_labels().iter())
-        .map(|label| format!(" at {label}"))
-        .collect();
+    // Deformation settings away from their defaults ("γ 2.5, local blend 0.5").
+    let labels = options.deform_labels();
+    let settings = match labels.is_empty() {
+        true => String::new(),
+        false => format!(" at {}", labels.join(", ")),
+    };
     let source = source + &settings;
     let extra = match (args.poses.len(), args.animate) {
         (0, _) => String::new(),

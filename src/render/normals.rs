@@ -134,7 +134,7 @@ impl NormalsPass {
 
     /// Recompute the vertex normals of the family `bind_group` shows (its frame
     /// uniform at `frame_offset`) into the end of its `displacements` buffer,
-    /// after the columns, into `encoder`. With `positions_drawn` the deformed
+    /// after the columns' vectors and matrices, into `encoder`. With `positions_drawn` the deformed
     /// positions are already in the scene's scratch buffer ([`super::drawn`]);
     /// otherwise the first pass computes them.
     #[allow(clippy::too_many_arguments)]
@@ -234,7 +234,7 @@ pub fn read_back(
 ) -> Option<Result<Vec<Vec3>, wgpu::BufferAsyncError>> {
     let slot = scene.slots.get(&method)?;
     slot.normals_pose?;
-    let offset = u64::from(slot.columns) * 16;
+    let offset = u64::from(slot.normals_first) * 16;
     Some(read_normals(
         device,
         queue,

@@ -64,8 +64,11 @@ pub struct FrameUniform {
     pub matrix_columns: u32,
     /// The same for the compared family.
     pub other_matrix_columns: u32,
+    /// Where the shown family's vertex normals start in its displacements
+    /// ([`WeightSlot::normals_first`]).
+    pub normals_first: u32,
     /// Rounds the size up to WGSL's 16-byte struct alignment.
-    pub _padding: [u32; 3],
+    pub _padding: [u32; 2],
 }
 
 /// Texels per row of the image [`super::drawn`] draws the deformed positions
@@ -185,12 +188,15 @@ impl ShaderMoves {
 pub struct WeightSlot {
     pub chunks: Vec<wgpu::Buffer>,
     pub split: ChunkSplit,
-    /// One `vec4` per column, then (smooth shading) one normal per mesh vertex,
-    /// then room for three `vec4`s per column (the columns of each column's
-    /// matrix, for a normalised move): the normals and matrices share the
-    /// buffer so that drawing needs no storage binding more than devices with
-    /// the default 8 per stage have.
+    /// One `vec4` per column, then for a family whose columns may carry
+    /// matrices room for three `vec4`s per column (the columns of each
+    /// column's matrix, for a normalised move), then (smooth shading) one
+    /// normal per mesh vertex, last as `shaders/render_normals.wgsl` writes
+    /// them: one buffer, so that drawing needs no storage binding more than
+    /// devices with the default 8 per stage have.
     pub displacements: wgpu::Buffer,
+    /// Where the vertex normals start in `displacements`, in `vec4`s.
+    pub normals_first: u32,
     /// Columns whose matrices the current pose's moves carry (0: linear).
     pub matrix_columns: u32,
     /// The first [`UNIFORM_COLUMNS`] displacements again, where the blend reads
@@ -354,11 +360,11 @@ impl SceneGpu {
     }
 
     /// Write `moves` (as [`Self::displacements_of`] gives them) to `slot`'s
-    /// buffers: the vectors first, the matrices after the vertex normals.
-    pub fn write_moves(&self, queue: &wgpu::Queue, slot: &WeightSlot, moves: &ShaderMoves) {
+    /// buffers: the vectors first, the matrices after them.
+    pub fn write_moves(queue: &wgpu::Queue, slot: &WeightSlot, moves: &ShaderMoves) {
         queue.write_buffer(&slot.displacements, 0, bytemuck::cast_slice(&moves.vectors));
         if !moves.matrices.is_empty() {
-            let offset = u64::from(slot.columns + self.vertex_count) * 16;
+            let offset = u64::from(slot.columns) * 16;
             let bytes = bytemuck::cast_slice(&moves.matrices);
             queue.write_buffer(&slot.displacements, offset, bytes);
         }

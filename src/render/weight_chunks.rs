@@ -167,7 +167,8 @@ pub fn wgsl(slots: u32) -> String {
         out.push_str("    return moved;\n}\n");
     }
     // Σ_c W[row, c] · M_c over a row's first `columns` columns, M_c the three
-    // `vec4`s from `base + 3c` (columns of the matrix): the normalised moves of
+    // `vec4`s from `base + 3c` (the columns of the matrix; `base` is the
+    // family's column count: the matrices follow the vectors): the normalised moves of
     // coords::ColumnMoves; `columns` is 0 for a linear family, so the loop
     // costs nothing there.
     for (name, displacements) in [

@@ -59,7 +59,7 @@ def test_the_panel_offers_bind_then_the_bound_operators():
     assert ("label", "The pmvc modifier was removed: rebind") in draw()
 
 
-def test_the_bulging_of_a_somigliana_binding_is_a_property_of_the_object():
+def test_the_deformation_settings_of_a_somigliana_binding_are_properties_of_the_object():
     import numpy as np
     import pmvc
     from conftest import TEST_PARAMETERS, coordinates, evaluated, middle_tip, relative_error
@@ -69,6 +69,7 @@ def test_the_bulging_of_a_somigliana_binding_is_a_property_of_the_object():
     select(mesh_obj, cage_obj)
     assert bpy.ops.pmvc.bind(method="SOMIGLIANA", **TEST_PARAMETERS["somigliana"]) == {"FINISHED"}
     assert ("prop", "pmvc_bulging") in draw()
+    assert ("prop", "pmvc_local_blend") in draw()
     points, rest = coordinates(mesh_obj.data), coordinates(cage_obj.data)
     tip, width = middle_tip(rest)
     for index in tip:
@@ -87,14 +88,23 @@ def test_the_bulging_of_a_somigliana_binding_is_a_property_of_the_object():
     expected = pmvc.deform(points, cage, posed, weights=weights, bulging=3.0)
     assert relative_error(bulged, expected, diagonal) < 1e-6
     assert np.abs(bulged - plain).max() > 1e-3 * diagonal
-    # A baked shape key keeps the bulge.
+    # So does the local blend, with the bulging.
+    mesh_obj.pmvc_local_blend = 0.5
+    bpy.context.view_layer.update()
+    blended = evaluated(mesh_obj)
+    expected = pmvc.deform(points, cage, posed, weights=weights, bulging=3.0, local_blend=0.5)
+    assert relative_error(blended, expected, diagonal) < 1e-6
+    assert np.abs(blended - bulged).max() > 1e-3 * diagonal
+    # A baked shape key keeps both.
     assert bpy.ops.pmvc.bake_shape_key(name="bulged") == {"FINISHED"}
     baked = coordinates(mesh_obj.data.shape_keys.key_blocks["bulged"])
     assert relative_error(baked, expected, diagonal) < 1e-6
     mesh_obj.pmvc_bulging = 0.0
+    mesh_obj.pmvc_local_blend = 0.0
     bpy.context.view_layer.update()
     assert relative_error(evaluated(mesh_obj), plain, diagonal) < 1e-6
     # Families that read no deformation setting do not offer it.
     bpy.ops.pmvc.unbind()
     assert bpy.ops.pmvc.bind(method="MVC") == {"FINISHED"}
     assert ("prop", "pmvc_bulging") not in draw()
+    assert ("prop", "pmvc_local_blend") not in draw()

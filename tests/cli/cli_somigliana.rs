@@ -1,12 +1,13 @@
 //! Somigliana coordinates on the command line: `pmvc bind --method somigliana`
 //! writes 9 columns per cage vertex and triangle with the layout and Poisson
 //! ratio in W.json, `pmvc deform` with them or bound afresh follows the
-//! library's global deformation, and a Poisson ratio out of range is refused.
+//! library's global deformation (with bulging and a local blend, read when
+//! deforming), and settings out of range are refused.
 
 use crate::cli_support::*;
 use crate::common::*;
 use glam::{DQuat, DVec3};
-use pmvc::coords::somigliana::{deform as somigliana_deform, somigliana_blocks};
+use pmvc::coords::somigliana::{deform as somigliana_deform, deform_blended, somigliana_blocks};
 use pmvc::formats::load_mesh;
 use std::path::Path;
 
@@ -82,6 +83,23 @@ fn bind_and_deform_follow_the_library_global_deformation() {
     let worst = largest_gap(&expected, &bulged) / diagonal;
     assert!(worst < 1e-5, "{worst} of the diagonal");
     assert!(largest_gap(&deformed, &bulged) / diagonal > 1e-3);
+    // So is the local blend: the library's blended deformation.
+    let blended = dir.path().join("blended.obj");
+    let blend_args = [
+        "--weights",
+        path_str(&weights),
+        "--bulging",
+        "2.5",
+        "--local-blend",
+        "0.5",
+    ];
+    let output = deform(&mesh, &cage_path, &pose_path, &blended, &blend_args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let expected = deform_blended(&blocks, &cage, &pose, 2.5, 0.5).unwrap();
+    let blended = load_mesh(&blended).unwrap().mesh.positions;
+    let worst = largest_gap(&expected, &blended) / diagonal;
+    assert!(worst < 1e-5, "{worst} of the diagonal");
+    assert!(largest_gap(&bulged, &blended) / diagonal > 1e-3);
 }
 
 fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
@@ -92,7 +110,7 @@ fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
 }
 
 #[test]
-fn a_bulging_out_of_range_is_refused_and_other_families_say_they_ignore_it() {
+fn deformation_settings_out_of_range_are_refused_and_other_families_say_they_ignore_them() {
     let dir = tempfile::tempdir().unwrap();
     let (mesh, cage_path, cage, _) = comb_scene(dir.path(), 4);
     let pose_path = write(
@@ -101,24 +119,26 @@ fn a_bulging_out_of_range_is_refused_and_other_families_say_they_ignore_it() {
         &triangles_obj(&comb_pose(&cage, 0.4), cage.triangles()),
     );
     let out = dir.path().join("out.obj");
-    for value in ["10.5", "-1", "much"] {
-        let args = ["--method", "somigliana", "--bulging", value];
+    let refused = [
+        ("--bulging", ["10.5", "-1", "much"]),
+        ("--local-blend", ["1.01", "-0.1", "half"]),
+    ];
+    for (flag, values) in refused {
+        for value in values {
+            let args = ["--method", "somigliana", flag, value];
+            let output = deform(&mesh, &cage_path, &pose_path, &out, &args);
+            assert_eq!(output.status.code(), Some(1), "{flag} {value}");
+            let said = stderr(&output);
+            assert!(said.contains(flag), "{value}: {said}");
+            assert!(!out.exists());
+        }
+        let args = ["--method", "mvc", flag, "0.5"];
         let output = deform(&mesh, &cage_path, &pose_path, &out, &args);
-        assert_eq!(output.status.code(), Some(1), "{value}");
+        assert!(output.status.success(), "{}", stderr(&output));
         let said = stderr(&output);
-        assert!(said.contains("--bulging"), "{value}: {said}");
-        assert!(!out.exists());
+        assert!(said.contains(&format!("{flag} is ignored")), "{said}");
+        std::fs::remove_file(&out).unwrap();
     }
-    let output = deform(
-        &mesh,
-        &cage_path,
-        &pose_path,
-        &out,
-        &["--method", "mvc", "--bulging", "2"],
-    );
-    assert!(output.status.success(), "{}", stderr(&output));
-    let said = stderr(&output);
-    assert!(said.contains("--bulging is ignored"), "{said}");
 }
 
 #[test]

@@ -200,9 +200,13 @@ fn a_local_blend_is_drawn_as_the_cpu_computes_it() {
         .unwrap()
         .clone();
     let cage = harness.state().document().cage().clone();
-    // Two finger tips pulled sideways and up: their triangles turn.
-    for vertex in [12, 32] {
-        let moved = cage.positions()[vertex] + DVec3::new(1.0, 0.8, 0.0);
+    // The middle finger's tip turned by 90° about the finger's base.
+    let (pivot, turn) = (
+        DVec3::new(3.3, 1.1, 0.0),
+        glam::DQuat::from_rotation_z(1.5708),
+    );
+    for vertex in [10, 11, 30, 31] {
+        let moved = pivot + turn * (cage.positions()[vertex] - pivot);
         harness.state_mut().set_handle_position(vertex, moved);
     }
     harness.run_steps(2);
@@ -233,7 +237,44 @@ fn a_local_blend_is_drawn_as_the_cpu_computes_it() {
         change > 1e-3 * diagonal,
         "the blend moved nothing: {change}"
     );
+    // Smooth shading's normals share the buffer with the columns' matrices:
+    // drawn with them, the vertex shader still draws the CPU's positions.
+    harness.state_mut().view_mut().smooth_shading = true;
+    harness.run_steps(3);
+    harness.render().unwrap();
+    let app = harness.state();
+    let normals = app
+        .read_back_normals(Method::Somigliana)
+        .expect("normals drawn");
+    let shaded = app.read_back_drawn(Method::Somigliana).unwrap().unwrap();
+    let gap = max_distance(&shaded, &on_cpu);
+    assert!(gap < 1e-4 * diagonal, "smooth shaded: {gap}");
+    let deformed = app.document().deformed_positions(Method::Somigliana);
+    let cpu_normals = pmvc::geometry::vertex_normals(&deformed, &app.document().mesh().triangles);
+    let worst = (normals.iter().zip(&cpu_normals))
+        .map(|(g, c)| g.as_dvec3().angle_between(*c))
+        .fold(0.0f64, f64::max);
+    assert!(worst < 2e-3, "normals off by {worst} rad");
     assert_eq!(app.undo_label().as_deref(), Some("Local blend 1"));
+    // Compared against PMVC in the difference view, the blended family is the
+    // other one: its matrices are read from the compared slot.
+    let pane = Pane::Difference {
+        against: Method::Somigliana.into(),
+        shown: Method::Pmvc,
+    };
+    let shading = harness.state_mut().shading_of(pane);
+    assert_eq!(shading.colouring, Colouring::MethodDistance);
+    let app = harness.state();
+    let values = app.read_back(&shading).unwrap().unwrap().values;
+    let pmvc = app.document().deformed_positions(Method::Pmvc);
+    let somigliana = app.document().deformed_positions(Method::Somigliana);
+    for (i, value) in values.iter().enumerate() {
+        let expected = (pmvc[i].distance(somigliana[i]) / f64::from(shading.cage_size)) as f32;
+        assert!(
+            (value - expected).abs() < 1e-4,
+            "vertex {i}: {value} {expected}"
+        );
+    }
 
     harness.state_mut().undo();
     harness.run_steps(3);

@@ -62,6 +62,9 @@ fn frame_uniform_matches_the_wgsl_frame() {
             vertex_columns,
             probe_width,
             vertex_column_stride,
+            matrix_columns,
+            other_matrix_columns,
+            normals_first,
         ]
     );
     for source in [

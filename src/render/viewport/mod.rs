@@ -236,17 +236,18 @@ impl ViewportRenderer {
             matrices,
         )
         .filter(|_| chunks[0].usage().contains(wgpu::BufferUsages::VERTEX));
-        // The columns' vectors, then room for the vertex normals, then for the
-        // columns' matrices.
+        // The columns' vectors, then room for their matrices where the family's
+        // may carry them, then for the vertex normals.
         let moves = scene.displacements_of(&options);
         let matrix_columns = moves.matrix_columns();
         let uniform_displacements = uniform_displacements_buffer(device, &moves.vectors);
         let mut displacements = moves.vectors;
-        displacements.resize(weights.cols + scene.vertex_count as usize, [0.0; 4]);
         if options.moves_may_carry_matrices() {
             displacements.extend(&moves.matrices);
-            displacements.resize(4 * weights.cols + scene.vertex_count as usize, [0.0; 4]);
+            displacements.resize(4 * weights.cols, [0.0; 4]);
         }
+        let normals_first = displacements.len() as u32;
+        displacements.resize(displacements.len() + scene.vertex_count as usize, [0.0; 4]);
         let displacements = buffer_with(
             device,
             "column displacements and vertex normals",
@@ -262,6 +263,7 @@ impl ViewportRenderer {
                 split,
                 displacements,
                 matrix_columns,
+                normals_first,
                 uniform_displacements,
                 columns: weights.cols as u32,
                 options,
@@ -310,7 +312,7 @@ impl ViewportRenderer {
         let mut matrix_columns = Vec::new();
         for slot in scene.slots.values().chain(scene.twin_slots.values()) {
             let moves = scene.displacements_of(&slot.options);
-            scene.write_moves(queue, slot, &moves);
+            SceneGpu::write_moves(queue, slot, &moves);
             matrix_columns.push(moves.matrix_columns());
         }
         let slots = scene
@@ -378,7 +380,8 @@ impl ViewportRenderer {
             vertex_column_stride: layout.columns_per_element() as u32,
             matrix_columns: shown.map_or(0, |slot| slot.matrix_columns),
             other_matrix_columns: against.map_or(0, |slot| slot.matrix_columns),
-            _padding: [0; 3],
+            normals_first: shown.map_or(0, |slot| slot.normals_first),
+            _padding: [0; 2],
         }
     }
 
