@@ -200,10 +200,11 @@ fn a_local_blend_is_drawn_as_the_cpu_computes_it() {
         .unwrap()
         .clone();
     let cage = harness.state().document().cage().clone();
-    // The middle finger's tip turned by 90° about the finger's base.
+    // The middle finger's tip turned by 60° about the finger's base (past 81°
+    // the finger's sides fold over).
     let (pivot, turn) = (
         DVec3::new(3.3, 1.1, 0.0),
-        glam::DQuat::from_rotation_z(1.5708),
+        glam::DQuat::from_rotation_z(std::f64::consts::FRAC_PI_3),
     );
     for vertex in [10, 11, 30, 31] {
         let moved = pivot + turn * (cage.positions()[vertex] - pivot);

@@ -49,16 +49,24 @@ def family_label(weights: pmvc.Weights) -> str:
     return name
 
 
-def middle_finger_pose(cage: pmvc.Cage, lift: float = 1.5) -> np.ndarray:
-    """The comb cage with the tip of its middle finger pulled up (+y) by `lift`
-    times the width of that finger's cage: the cage vertices at the top whose x
-    lies in the middle one of the five fingers' x ranges."""
-    vertices = cage.vertices.copy()
+def middle_finger_tip(cage: pmvc.Cage):
+    """The comb cage's middle finger: the indices of the cage vertices at the
+    top whose x lies in the middle one of the five fingers' x ranges, and that
+    range."""
+    vertices = cage.vertices
     top = vertices[:, 1].max()
     tips = np.flatnonzero(vertices[:, 1] > top - 1e-9)
     fingers = np.unique(np.round(vertices[tips, 0], 9)).reshape(-1, 2)
     left, right = fingers[len(fingers) // 2]
     chosen = tips[(vertices[tips, 0] > left - 1e-9) & (vertices[tips, 0] < right + 1e-9)]
+    return chosen, (left, right)
+
+
+def middle_finger_pose(cage: pmvc.Cage, lift: float = 1.5) -> np.ndarray:
+    """The comb cage with the tip of its middle finger pulled up (+y) by `lift`
+    times the width of that finger's cage (`middle_finger_tip`)."""
+    vertices = cage.vertices.copy()
+    chosen, (left, right) = middle_finger_tip(cage)
     vertices[chosen, 1] += lift * (right - left)
     return vertices
 

@@ -3,7 +3,7 @@ blend: the bundled comb bound once, its middle finger's tip turned by 30° and
 60° about the finger's base (past 81° the finger's sides fold over), deformed at blends 0, 0.5 and 1; the tip's width
 (across the turned finger) and depth (z) against their rest values.
 
-    python docs/somigliana-blend.py [--pose-out bend60.obj]
+    python tests/python/somigliana_blend.py [--pose-out bend60.obj]
 """
 
 from __future__ import annotations
@@ -14,8 +14,9 @@ from pathlib import Path
 import numpy as np
 
 import pmvc
+from study import middle_finger_tip
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def turned_tip(cage: pmvc.Cage, degrees: float):
@@ -23,13 +24,9 @@ def turned_tip(cage: pmvc.Cage, degrees: float):
     about the finger's base centre (in the xy plane), that rotation, and the
     finger's x range."""
     vertices = cage.vertices.copy()
+    tip, (left, right) = middle_finger_tip(cage)
     top = vertices[:, 1].max()
-    tips = np.flatnonzero(vertices[:, 1] > top - 1e-9)
-    fingers = np.unique(np.round(vertices[tips, 0], 9)).reshape(-1, 2)
-    left, right = fingers[len(fingers) // 2]
-    tip = tips[(vertices[tips, 0] > left - 1e-9) & (vertices[tips, 0] < right + 1e-9)]
-    prong = vertices[:, 0] > left - 1e-9
-    prong &= vertices[:, 0] < right + 1e-9
+    prong = (vertices[:, 0] > left - 1e-9) & (vertices[:, 0] < right + 1e-9)
     base = vertices[prong & (vertices[:, 1] < top - 1e-9), 1].max()
     pivot = np.array([(left + right) / 2, base, 0.0])
     angle = np.radians(degrees)
