@@ -238,7 +238,7 @@ def generate_cage(
 
 def families() -> List[Dict[str, Any]]:
     """Every family: id, name, summary, parameters, deform_parameters (read
-    by deform, not bind: Somigliana's bulging), positive_inside,
+    by deform, not bind: Somigliana's bulging and local_blend), positive_inside,
     outside_policy, columns_layout, gpu_kernel, gpu_kernel_quads."""
     ...
 
