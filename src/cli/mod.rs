@@ -226,14 +226,14 @@ pub struct DeformArgs {
     /// Use weights from `pmvc bind` instead of computing them (--method, --resolution and --grid are then ignored): a .npy applies one weight per cage vertex, a .npz Green coordinates (phi and psi, as numpy.savez writes them). W.json beside them names their family and is checked against the mesh and cage (rows, cage vertices and triangles, digests); without it they are used with a warning that they cannot be checked. Values must be finite float32 (float64 where W.json says "dtype": "float64"), one row per mesh vertex, and each row's cage-vertex weights must sum to 1 (within 1e-4, times Σ|λᵢ| where that is over 1).
     #[arg(long, value_name = "W.npy|W.npz")]
     pub weights: Option<PathBuf>,
-    /// Somigliana coordinates: the bulging γ (0–10, in steps of 0.01; default 0,
-    /// none): each cage triangle pushes along its normal harder the more volume
+    /// Somigliana coordinates: the bulging γ (0–10), in steps of 0.01, default 0
+    /// (none): each cage triangle pushes along its normal harder the more volume
     /// the pose sweeps outward from where the fitted similarity puts it. Read
     /// when deforming, so the same weights serve every γ.
     #[arg(long, value_parser = parse_bulging, allow_negative_numbers = true)]
     pub bulging: Option<u32>,
-    /// Somigliana coordinates: the local/global blend (0–1, in steps of 0.01;
-    /// default 0, the global variant): at 1 each cage triangle and vertex turns
+    /// Somigliana coordinates: the local/global blend (0–1), in steps of 0.01,
+    /// default 0 (the global variant): at 1 each cage triangle and vertex turns
     /// and stretches with its own frame instead of the similarity fitted to
     /// the whole cage. Read when deforming, as --bulging is.
     #[arg(long, value_parser = parse_local_blend, allow_negative_numbers = true)]

@@ -32,6 +32,10 @@ fn parameter_flags_take_their_range_from_the_spec_and_their_help_says_it() {
         ("check", Parameter::Grid),
         ("bind", Parameter::PoissonRatio),
         ("deform", Parameter::PoissonRatio),
+        ("deform", Parameter::Bulging),
+        ("deform", Parameter::LocalBlend),
+        ("edit", Parameter::Bulging),
+        ("edit", Parameter::LocalBlend),
     ] {
         let spec = parameter.spec();
         let flag = spec.flag.trim_start_matches('-').replace('-', "_");
@@ -65,6 +69,17 @@ fn edit_options(args: &[&str]) -> crate::app::EditorOptions {
         Some(Command::Edit(args)) => args.editor_options(),
         other => panic!("not an edit command: {other:?}"),
     }
+}
+
+#[test]
+fn edit_applies_the_deformation_settings_given_and_keeps_the_others() {
+    use crate::coords::Parameter;
+    let options = edit_options(&["--local-blend", "0.5", "--bulging", "2"]);
+    assert_eq!(
+        options.deform,
+        [(Parameter::Bulging, 200), (Parameter::LocalBlend, 50)]
+    );
+    assert!(edit_options(&[]).deform.is_empty());
 }
 
 #[test]
