@@ -172,7 +172,8 @@ pub fn buffer_with<T: bytemuck::Pod>(
 pub struct ShaderMoves {
     /// One per column: its vector (its displacement when linear).
     pub vectors: Vec<[f32; 4]>,
-    /// Three per column, the columns of its matrix; empty when linear.
+    /// Three per column, the columns of its matrix, up to the last column
+    /// whose matrix is not zero; empty when linear.
     pub matrices: Vec<[f32; 4]>,
 }
 
@@ -350,7 +351,12 @@ impl SceneGpu {
         }
         let moves =
             (options.column_moves(&self.rest_cage, &self.pose)).about(self.origin.world_from_scene);
-        let matrices = moves.matrices().iter().flat_map(|m| {
+        // Trailing zero matrices (Somigliana's face columns) are left out, so
+        // the vertex shader's matrix blend stops at the last column that has one.
+        let carried = (moves.matrices().iter())
+            .rposition(|m| *m != glam::DMat3::ZERO)
+            .map_or(0, |last| last + 1);
+        let matrices = moves.matrices()[..carried].iter().flat_map(|m| {
             [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x as f32, c.y as f32, c.z as f32, 0.0])
         });
         ShaderMoves {
