@@ -10,7 +10,7 @@ use crate::cagegen::{
     DEFAULT_CELL_SIZE, DEFAULT_CLEARANCE, MAX_TARGET_VERTICES, MIN_TARGET_VERTICES,
 };
 use crate::geometry::{Cage, TriMesh};
-use crate::render::scene_gpu::unique_edges;
+use crate::render::draw_order::unique_edges;
 use glam::DVec3;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{channel, Receiver, TryRecvError};

@@ -8,7 +8,7 @@ use super::commands::{
 };
 use super::weights_format::{is_npz, read_weights_for, stored_family, writes_npz};
 use super::{CageInput, DeformArgs};
-use crate::coords::{AnyWeights, BindOptions, Dtype, Method, Parameter};
+use crate::coords::{AnyWeights, BindOptions, Dtype, Method};
 use crate::formats::gltf::{is_gltf_path, write_gltf, AnimationKey, GltfPose, GltfScene};
 use crate::formats::metadata::{metadata_path, read_metadata, WeightsMetadata};
 use crate::formats::{shown_path, LoadError, ObjectError};
@@ -117,12 +117,7 @@ pub(super) fn deform(args: &DeformArgs) -> Result<()> {
         ),
     };
     let mut options = options;
-    let settings = [
-        (Parameter::Bulging, args.bulging),
-        (Parameter::LocalBlend, args.local_blend),
-    ];
-    for (parameter, value) in settings {
-        let Some(value) = value else { continue };
+    for (parameter, value) in super::deform_settings(args.bulging, args.local_blend) {
         options.set(parameter, value);
         if options
             .deform_parameters()

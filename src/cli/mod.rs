@@ -164,6 +164,22 @@ pub struct MethodChoice {
     pub strict: bool,
 }
 
+/// The deformation settings given by `--bulging` and `--local-blend` (the
+/// same flags on `deform` and `edit`), in the order they are applied.
+fn deform_settings(
+    bulging: Option<u32>,
+    local_blend: Option<u32>,
+) -> Vec<(crate::coords::Parameter, u32)> {
+    use crate::coords::Parameter;
+    [
+        (Parameter::Bulging, bulging),
+        (Parameter::LocalBlend, local_blend),
+    ]
+    .into_iter()
+    .filter_map(|(parameter, value)| Some((parameter, value?)))
+    .collect()
+}
+
 impl MethodChoice {
     /// The bind options these flags ask for.
     pub fn options(&self) -> crate::coords::BindOptions {
@@ -422,13 +438,7 @@ impl EditArgs {
             pose: self.pose,
             resolution: self.resolution,
             grid: self.grid,
-            deform: [
-                (crate::coords::Parameter::Bulging, self.bulging),
-                (crate::coords::Parameter::LocalBlend, self.local_blend),
-            ]
-            .into_iter()
-            .filter_map(|(parameter, value)| Some((parameter, value?)))
-            .collect(),
+            deform: deform_settings(self.bulging, self.local_blend),
             triangulate: self.triangulate.map(TriangulateArg::split),
             method,
             screenshot: self.screenshot,

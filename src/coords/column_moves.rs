@@ -21,7 +21,8 @@ use rayon::prelude::*;
 pub struct ColumnMoves {
     origin: DVec3,
     vectors: Vec<DVec3>,
-    /// Empty for a linear move; else one per column.
+    /// One per column up to the last column whose matrix is not zero (later
+    /// columns carry none); empty for a linear move.
     matrices: Vec<DMat3>,
 }
 
@@ -36,9 +37,15 @@ impl ColumnMoves {
     }
 
     /// The normalised form about `origin`, one vector and one matrix per
-    /// column (equal lengths: the caller builds them together).
-    pub fn normalised(origin: DVec3, vectors: Vec<DVec3>, matrices: Vec<DMat3>) -> Self {
+    /// column (equal lengths: the caller builds them together). Trailing zero
+    /// matrices are dropped, so that neither the CPU nor the vertex shader
+    /// blends them (Somigliana's face columns carry none).
+    pub fn normalised(origin: DVec3, vectors: Vec<DVec3>, mut matrices: Vec<DMat3>) -> Self {
         debug_assert_eq!(vectors.len(), matrices.len());
+        let carried = (matrices.iter())
+            .rposition(|m| *m != DMat3::ZERO)
+            .map_or(0, |last| last + 1);
+        matrices.truncate(carried);
         Self {
             origin,
             vectors,
@@ -55,7 +62,8 @@ impl ColumnMoves {
         self.vectors.is_empty()
     }
 
-    /// Whether no column carries a matrix: `x' = x + Σ wₖ dₖ`.
+    /// Whether no column carries a matrix: `x' = x + Σ wₖ dₖ` (a normalised
+    /// form whose matrices are all zero is that too).
     pub fn is_linear(&self) -> bool {
         self.matrices.is_empty()
     }
@@ -70,7 +78,8 @@ impl ColumnMoves {
         &self.vectors
     }
 
-    /// Each column's matrix Mₖ; empty when linear.
+    /// Each column's matrix Mₖ, up to the last that is not zero (the rest are
+    /// zero); empty when linear.
     pub fn matrices(&self) -> &[DMat3] {
         &self.matrices
     }
@@ -83,11 +92,14 @@ impl ColumnMoves {
             return self.clone();
         }
         let shift = origin - self.origin;
+        let mut vectors = self.vectors.clone();
+        // Columns past the matrices carry none, and their vectors stay.
+        for (vector, &matrix) in vectors.iter_mut().zip(&self.matrices) {
+            *vector -= matrix * shift;
+        }
         Self {
             origin,
-            vectors: (self.vectors.iter().zip(&self.matrices))
-                .map(|(&vector, &matrix)| vector - matrix * shift)
-                .collect(),
+            vectors,
             matrices: self.matrices.clone(),
         }
     }
@@ -106,11 +118,12 @@ impl ColumnMoves {
             .zip(rest.par_iter())
             .map(|(row, &x)| {
                 let mut matrix = DMat3::IDENTITY;
+                for (&w, &m) in row.iter().zip(&self.matrices) {
+                    matrix += m * w.to_f64();
+                }
                 let mut vector = x - self.origin;
-                for ((&w, &d), &m) in row.iter().zip(&self.vectors).zip(&self.matrices) {
-                    let w = w.to_f64();
-                    vector += w * d;
-                    matrix += m * w;
+                for (&w, &d) in row.iter().zip(&self.vectors) {
+                    vector += w.to_f64() * d;
                 }
                 self.origin + solve(matrix, vector)
             })
@@ -157,6 +170,7 @@ mod tests {
         assert!((again - want).length() < 1e-8, "{again}");
         // At rest (zero vectors and matrices) any weights give the rest point.
         let still = ColumnMoves::normalised(DVec3::ONE, vec![DVec3::ZERO; 2], vec![DMat3::ZERO; 2]);
+        assert!(still.is_linear());
         assert_eq!(still.apply(&[0.3f32, -2.0], &rest), rest.to_vec());
     }
 }

@@ -132,6 +132,12 @@ impl Cage {
         self.triangles[t].map(|i| self.positions[i as usize])
     }
 
+    /// Triangle `t`'s outward unit normal (zero for a degenerate triangle).
+    pub fn unit_normal(&self, t: usize) -> DVec3 {
+        let [a, b, c] = self.triangle(t);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
     /// Length of the bounding-box diagonal: the cage's size for relative tolerances.
     pub fn diagonal(&self) -> f64 {
         let (lo, hi) = super::bounds_of(&self.positions);

@@ -2,6 +2,7 @@
 //! run one way: the renderers depend on the leaf [`scene_gpu`], and only the
 //! orchestrator [`viewport`] depends on the renderers.
 //! - [`scene_gpu`]: formats, the frame uniform, the scene's buffers and layout;
+//! - [`draw_order`]: the mesh's triangle and edge indices as drawn (no GPU);
 //! - [`weight_chunks`]: weights split by rows over several buffers (a leaf that
 //!   [`scene_gpu`] uses);
 //! - [`mesh`]: the deformed mesh (deformation in the vertex shader);
@@ -25,6 +26,7 @@ pub mod callback;
 pub mod camera;
 pub mod colormap;
 pub mod composite;
+pub mod draw_order;
 pub mod drawn;
 pub mod mesh;
 pub mod normals;

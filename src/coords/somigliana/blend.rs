@@ -137,10 +137,7 @@ pub fn blended_pose(
     // Pushed along each triangle's own rotated normal: project onto zero net
     // force along those.
     let directions: Vec<DVec3> = (0..triangles.len())
-        .map(|t| {
-            let [a, b, c] = rest.triangle(t);
-            face_rotations[t] * (b - a).cross(c - a).normalize_or_zero()
-        })
+        .map(|t| face_rotations[t] * rest.unit_normal(t))
         .collect();
     if bulging != 0.0 || blend != 0.0 {
         without_net_force_along(&areas, &directions, &mut tractions);
@@ -207,10 +204,7 @@ pub fn deform_blended(
         .map(|&p| p - posed.centre)
         .collect();
     let face_vectors: Vec<DVec3> = (0..rest.triangle_count())
-        .map(|t| {
-            let [a, b, c] = rest.triangle(t);
-            posed.tractions[t] * (b - a).cross(c - a).normalize_or_zero()
-        })
+        .map(|t| posed.tractions[t] * rest.unit_normal(t))
         .collect();
     Ok((0..blocks.point_count())
         .into_par_iter()

@@ -116,8 +116,7 @@ fn global_columns(
         }
     }
     for (t, &traction) in tractions.iter().enumerate() {
-        let [a, b, c] = rest.triangle(t);
-        let normal = (b - a).cross(c - a).normalize_or_zero();
+        let normal = rest.unit_normal(t);
         for a in 0..3 {
             for b in 0..3 {
                 columns.push(traction * normal[b] * rotation.col(a));
@@ -223,8 +222,7 @@ pub fn column_moves(
         .zip(&posed.face_rotations)
         .enumerate()
     {
-        let [a, b, c] = rest.triangle(t);
-        let normal = (b - a).cross(c - a).normalize_or_zero();
+        let normal = rest.unit_normal(t);
         for a in 0..3 {
             for b in 0..3 {
                 matrices.push(DMat3::ZERO);

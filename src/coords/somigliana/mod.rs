@@ -367,10 +367,7 @@ pub fn deform(
     );
     let face_vectors: Vec<DVec3> = (0..rest.triangle_count())
         .zip(tractions)
-        .map(|(t, traction)| {
-            let [a, b, c] = rest.triangle(t);
-            traction * (b - a).cross(c - a).normalize_or_zero()
-        })
+        .map(|(t, traction)| traction * rest.unit_normal(t))
         .collect();
     Ok((0..blocks.point_count)
         .into_par_iter()
